@@ -1,0 +1,94 @@
+"""What accuracy costs in time: soft shadow maps against Mitsuba's ray_test.
+
+    python benchmarks/bench_bunny.py [--resolutions 128 256 512] [--repeats 9]
+
+For the bunny floating over the floor (light 1x1 at distance 4, bunny 1 unit
+tall), at each resolution: the SSM's time end to end from meshes (one and two
+passes; median of --repeats runs) and its error (the paper's §4.2.1 metric)
+against a 1024-sample Mitsuba reference; Mitsuba's ray_test time (median,
+rays already in Dr.Jit arrays: the tracing alone) and error at 16, 64 and 256
+samples per texel; and the ratio of the SSM's time to Mitsuba's at equal
+error, Mitsuba's time and error being interpolated log-log between the
+measured sample counts (error ~ 1/sqrt(samples), time ~ samples). All in one
+run, on the machine at hand. Prints a markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+
+os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
+
+import softshadow as ss  # noqa: E402
+from softshadow import metrics, reference, scenes  # noqa: E402
+
+MITSUBA_SAMPLES = (4, 16, 64, 256)
+
+
+def median_time(fn, repeats):
+    fn()  # warm-up
+    ts = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t)
+    return float(np.median(ts))
+
+
+def mitsuba_at_equal_error(err, mi):
+    """Mitsuba's time at error `err`, interpolated log-log in (error, time)."""
+    e = np.array([m[1] for m in mi])
+    t = np.array([m[2] for m in mi])
+    order = np.argsort(e)
+    le, lt = np.log(e[order]), np.log(t[order])
+    return float(np.exp(np.interp(np.log(err), le, lt, left=np.nan, right=np.nan))), (err < e.min() or err > e.max())
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--resolutions", type=int, nargs="+", default=[128, 256, 512])
+    p.add_argument("--repeats", type=int, default=9)
+    p.add_argument("--reference-samples", type=int, default=1024)
+    a = p.parse_args()
+
+    scene, light = scenes.bunny_floating()
+    rscene = reference.ReferenceScene(scene.occluders)
+    print(f"# bunny floating, {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Mitsuba {reference.variant()}")
+    print()
+    print("| map | method | samples | time (ms) | error | Mitsuba time at equal error (ms) | SSM time / Mitsuba time |")
+    print("|---|---|---|---|---|---|---|")
+    for res in a.resolutions:
+        maps = {}
+        for passes in (1, 2):
+            def run(passes=passes):
+                return ss.soft_shadow_map(scene, light, resolution=res, passes=passes)
+
+            t = median_time(run, a.repeats)
+            maps[passes] = (run(), t)
+        ref = reference.reference_map(maps[2][0], rscene, samples=a.reference_samples, seed=12345)
+        mi = []
+        for k in MITSUBA_SAMPLES:
+            ts = []
+            for rep in range(max(3, a.repeats // 3)):
+                v = reference.reference_map(maps[2][0], rscene, samples=k, seed=rep)
+                ts.append(rscene.last_stats.trace_seconds)
+            mi.append((k, metrics.shadow_error(v, ref), float(np.median(ts))))
+        for passes in (1, 2):
+            sm, t = maps[passes]
+            err = metrics.shadow_error(sm.visibility, ref)
+            t_mi, extrapolated = mitsuba_at_equal_error(err, mi)
+            note = " (outside the measured range)" if extrapolated else ""
+            ratio = f"{t / t_mi:.2f}" if np.isfinite(t_mi) else "n/a"
+            t_mi_s = f"{t_mi * 1e3:.1f}" if np.isfinite(t_mi) else "n/a"
+            print(f"| {res}² | ssm, {passes} pass{'es' if passes > 1 else ''} | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s}{note} | {ratio} |")
+        for k, err, t in mi:
+            print(f"| {res}² | Mitsuba ray_test | {k} | {t * 1e3:.1f} | {err:.4f} | | |")
+
+
+if __name__ == "__main__":
+    main()

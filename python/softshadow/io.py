@@ -1,0 +1,77 @@
+"""Writing maps to EXR (OpenEXR, optional) and PNG (no dependency)."""
+
+from __future__ import annotations
+
+import os
+import struct
+import zlib
+from typing import Any
+
+import numpy as np
+
+
+def _as_map(name: str, a: Any) -> np.ndarray:
+    arr = np.asarray(a)
+    if arr.ndim != 2:
+        raise ValueError(f"{name}: must be a 2-D map, got shape {arr.shape}")
+    return arr
+
+
+def write_exr(path: str | os.PathLike[str], channels: dict[str, Any] | Any) -> None:
+    """Writes one or more (H, W) maps as float32 channels of an EXR file.
+
+    ``channels`` is a map (written as channel ``"Y"``) or a dict of name -> map.
+    Needs the ``OpenEXR`` package (``pip install softshadow[io]``).
+    """
+    try:
+        import OpenEXR
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("write_exr needs OpenEXR: pip install softshadow[io]") from e
+    if not isinstance(channels, dict):
+        channels = {"Y": channels}
+    data = {k: np.ascontiguousarray(_as_map(f"channels[{k!r}]", v), dtype=np.float32) for k, v in channels.items()}
+    shapes = {v.shape for v in data.values()}
+    if len(shapes) != 1:
+        raise ValueError(f"channels: all maps must share one shape, got {sorted(shapes)}")
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    OpenEXR.File(header, data).write(os.fspath(path))
+
+
+def read_exr(path: str | os.PathLike[str]) -> dict[str, np.ndarray]:
+    """Reads every channel of an EXR file as arrays."""
+    import OpenEXR
+
+    with OpenEXR.File(os.fspath(path)) as f:
+        return {k: np.array(c.pixels) for k, c in f.channels().items()}
+
+
+def to_uint8(a: Any, *, lo: float = 0.0, hi: float = 1.0) -> np.ndarray:
+    """Maps [lo, hi] to [0, 255] (clipped); non-finite values become 0."""
+    x = np.asarray(a, dtype=np.float64)
+    x = np.where(np.isfinite(x), (x - lo) / (hi - lo), 0.0)
+    return (np.clip(x, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+
+
+def write_png(path: str | os.PathLike[str], image: Any) -> None:
+    """Writes an 8-bit grey (H, W) or RGB (H, W, 3) uint8 image as PNG."""
+    img = np.ascontiguousarray(image)
+    if img.dtype != np.uint8:
+        raise TypeError(f"image: must be uint8 (see to_uint8), got {img.dtype}")
+    if img.ndim == 2:
+        color = 0
+    elif img.ndim == 3 and img.shape[2] == 3:
+        color = 2
+    else:
+        raise ValueError(f"image: must be (H, W) or (H, W, 3), got {img.shape}")
+    h, w = img.shape[:2]
+    raw = b"".join(b"\x00" + img[j].tobytes() for j in range(h))
+
+    def chunk(tag: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + tag + body + struct.pack(">I", zlib.crc32(tag + body) & 0xFFFFFFFF)
+
+    png = b"\x89PNG\r\n\x1a\n"
+    png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, color, 0, 0, 0))
+    png += chunk(b"IDAT", zlib.compress(raw, 6))
+    png += chunk(b"IEND", b"")
+    with open(path, "wb") as f:
+        f.write(png)

@@ -1,0 +1,85 @@
+"""The rectangular area light."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from . import _validate as check
+
+
+@dataclass(frozen=True, init=False)
+class RectLight:
+    """A rectangular area light that emits uniformly over its whole rectangle.
+
+    Frame: ``n = normalize(normal)`` points from the light into the scene,
+    ``v = normalize(up - (up . n) n)`` and ``u = n x v``. ``size`` is the full
+    width along ``u`` and the full height along ``v``.
+
+    Raises ValueError for a non-finite center, a zero-length ``normal`` or
+    ``up``, an ``up`` parallel to ``normal``, or a size that is not finite and > 0.
+    """
+
+    center: tuple[float, float, float]
+    normal: tuple[float, float, float]
+    up: tuple[float, float, float]
+    size: tuple[float, float]
+    _frame: tuple[Any, Any, Any] = field(repr=False, compare=False)
+
+    def __init__(
+        self,
+        center: Any,
+        normal: Any,
+        up: Any,
+        size: Any = (1.0, 1.0),
+    ) -> None:
+        c = check.vector("center", center, 3)
+        n = check.vector("normal", normal, 3)
+        u = check.vector("up", up, 3)
+        if np.isscalar(size):
+            size = (size, size)
+        s = check.vector("size", size, 2)
+        frame = _core.light_frame((c, n, u, s))
+        object.__setattr__(self, "center", c)
+        object.__setattr__(self, "normal", n)
+        object.__setattr__(self, "up", u)
+        object.__setattr__(self, "size", s)
+        object.__setattr__(self, "_frame", tuple(np.array(a) for a in frame))
+
+    @classmethod
+    def canonical(cls, size: Any) -> RectLight:
+        """The light that depth-map input is expressed in: center at the origin,
+        ``n = +z``, ``v = +y`` (so ``u = -x``)."""
+        return cls(center=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0), size=size)
+
+    @property
+    def u(self) -> np.ndarray:
+        """Unit vector along the light's width (map columns grow along it)."""
+        return self._frame[0].copy()
+
+    @property
+    def v(self) -> np.ndarray:
+        """Unit vector along the light's height (map rows grow against it)."""
+        return self._frame[1].copy()
+
+    @property
+    def n(self) -> np.ndarray:
+        """Unit normal, from the light into the scene."""
+        return self._frame[2].copy()
+
+    @property
+    def area(self) -> float:
+        return self.size[0] * self.size[1]
+
+    def corners(self) -> np.ndarray:
+        """The four corners (4, 3): (-u,-v), (+u,-v), (+u,+v), (-u,+v)."""
+        c = np.asarray(self.center)
+        hu = 0.5 * self.size[0] * self._frame[0]
+        hv = 0.5 * self.size[1] * self._frame[1]
+        return np.array([c - hu - hv, c + hu - hv, c + hu + hv, c - hu + hv])
+
+    def _core_args(self) -> tuple[Any, ...]:
+        return (self.center, self.normal, self.up, self.size)

@@ -1,0 +1,106 @@
+"""Scenes: occluders cast shadows, receivers catch them (the paper's split)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+
+Mesh = tuple[np.ndarray, np.ndarray]
+
+
+def as_mesh(obj: Any, name: str) -> Mesh:
+    """(vertices float64 (n, 3), faces uint32 (m, 3)) from a trimesh.Trimesh,
+    any object with ``vertices`` and ``faces``, or a (vertices, faces) pair."""
+    if hasattr(obj, "vertices") and hasattr(obj, "faces"):
+        verts, faces = obj.vertices, obj.faces
+    elif isinstance(obj, (tuple, list)) and len(obj) == 2:
+        verts, faces = obj
+    else:
+        raise TypeError(
+            f"{name}: must be a trimesh.Trimesh or a (vertices, faces) pair, "
+            f"got {type(obj).__name__}"
+        )
+    v = np.asarray(verts)
+    f = np.asarray(faces)
+    if v.dtype.kind not in "fiu":
+        raise TypeError(f"{name}: vertices must be numbers, got dtype {v.dtype}")
+    if f.dtype.kind not in "iu":
+        raise TypeError(f"{name}: faces must be integers, got dtype {f.dtype}")
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"{name}: vertices must have shape (n, 3), got {v.shape}")
+    if f.ndim != 2 or f.shape[1] != 3:
+        raise ValueError(f"{name}: faces must have shape (m, 3), got {f.shape}")
+    v = np.ascontiguousarray(v, dtype=np.float64)
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(f"{name}: vertex {k} is not finite: {v[k].tolist()}")
+    if f.size and (f.min() < 0 or f.max() >= len(v)):
+        raise ValueError(
+            f"{name}: face indices must lie in [0, {len(v)}), got [{f.min()}, {f.max()}]"
+        )
+    return v, np.ascontiguousarray(f, dtype=np.uint32)
+
+
+def _concat(meshes: list[Mesh]) -> Mesh:
+    if not meshes:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.uint32)
+    offsets = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
+    verts = np.concatenate([v for v, _ in meshes])
+    faces = np.concatenate([f + np.uint32(o) for (_, f), o in zip(meshes, offsets)])
+    return np.ascontiguousarray(verts), np.ascontiguousarray(faces, dtype=np.uint32)
+
+
+class Scene:
+    """Occluder and receiver meshes.
+
+    Each argument is one mesh or an iterable of meshes; a mesh is a
+    ``trimesh.Trimesh`` (or anything with ``vertices`` and ``faces``) or a
+    ``(vertices (n, 3), faces (m, 3))`` pair. Occluders shadow receivers; neither
+    shadows itself (the split of Atty et al. 2005).
+    """
+
+    def __init__(self, occluders: Any, receivers: Any) -> None:
+        self.occluders: list[Mesh] = self._meshes(occluders, "occluders")
+        self.receivers: list[Mesh] = self._meshes(receivers, "receivers")
+        if not any(len(f) for _, f in self.occluders):
+            raise ValueError("occluders: the scene has no occluder triangles")
+        if not any(len(f) for _, f in self.receivers):
+            raise ValueError("receivers: the scene has no receiver triangles")
+        self._occ = _concat(self.occluders)
+        self._rec = _concat(self.receivers)
+
+    @staticmethod
+    def _meshes(value: Any, name: str) -> list[Mesh]:
+        if value is None:
+            return []
+        single = hasattr(value, "vertices") or (
+            isinstance(value, tuple) and len(value) == 2 and hasattr(value[0], "shape")
+        )
+        if single:
+            return [as_mesh(value, name)]
+        if not isinstance(value, Iterable):
+            raise TypeError(f"{name}: must be a mesh or a list of meshes, got {type(value).__name__}")
+        return [as_mesh(m, f"{name}[{k}]") for k, m in enumerate(value)]
+
+    @property
+    def occluder_mesh(self) -> Mesh:
+        """All occluders as one (vertices, faces) mesh."""
+        return self._occ
+
+    @property
+    def receiver_mesh(self) -> Mesh:
+        """All receivers as one (vertices, faces) mesh."""
+        return self._rec
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self._occ[1]) + len(self._rec[1])
+
+    def __repr__(self) -> str:
+        return (
+            f"Scene({len(self.occluders)} occluder meshes / {len(self._occ[1])} triangles, "
+            f"{len(self.receivers)} receiver meshes / {len(self._rec[1])} triangles)"
+        )

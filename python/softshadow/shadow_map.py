@@ -1,0 +1,201 @@
+"""The result type and the two entry points."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from . import _validate as check
+from .light import RectLight
+from .scene import Scene
+
+METHODS = ("ssm",)
+BACKENDS = ("cpu",)
+LATER_BACKENDS = ("gpu", "auto")
+
+
+@dataclass(frozen=True, eq=False)
+class ShadowMap:
+    """A soft shadow map and the light-view maps it was computed from.
+
+    All maps have shape (H, W), seen from the light's center along its normal:
+    texel ``[j, i]`` has center direction ``n + x u + y v`` with
+    ``x = (-1 + 2(i + 1/2)/W) tx`` and ``y = (1 - 2(j + 1/2)/H) ty``. Depths are
+    planar (distance from the light's plane along n), float32, ``inf`` where
+    nothing is hit.
+    """
+
+    visibility: np.ndarray
+    """(H, W) float32 in [0, 1]: fraction of the light's area seen from the
+    receiver point of each texel; 1 where there is no receiver."""
+    receiver_depth: np.ndarray
+    occluder_depth: np.ndarray
+    """Front (nearest) occluder depth."""
+    occluder_depth_back: np.ndarray | None
+    """Back (farthest) occluder depth; None with one pass."""
+    light: RectLight
+    extent: tuple[float, float]
+    """Tangent half-extents (tx, ty)."""
+    method: str
+    passes: int
+    extent_fitted: bool
+    """True when ``extent`` was fitted to the shadows (``extent=None``)."""
+    timings: dict[str, float] = field(default_factory=dict)
+    """Seconds per stage, in the order the stages ran."""
+
+    @property
+    def resolution(self) -> tuple[int, int]:
+        """(W, H)."""
+        h, w = self.visibility.shape
+        return w, h
+
+    def sample(self, points: Any, *, outside: float | None = None) -> np.ndarray:
+        """Visibility (N,) float32 at world points lying on receivers.
+
+        Each point is shaded with the same method as the map, at its own exact
+        position and depth (no interpolation between texels): the occluder maps
+        are the occluders. Points outside the map's extent (or at/behind the
+        light's plane) get ``outside``; by default that is 1.0 when the extent
+        was fitted (no shadow can fall there) and a ValueError otherwise.
+        """
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 3:
+            raise ValueError(f"points: must have shape (N, 3), got {pts.shape}")
+        if not np.isfinite(pts).all():
+            raise ValueError("points: must be finite")
+        vis, inside = _core.sample_points(
+            self.occluder_depth,
+            self.occluder_depth_back,
+            self.light._core_args(),
+            self.extent,
+            np.ascontiguousarray(pts),
+            self.method,
+        )
+        if not inside.all():
+            if outside is None and not self.extent_fitted:
+                k = int(np.argmin(inside))
+                raise ValueError(
+                    f"points: point {k} {pts[k].tolist()} lies outside the map's extent "
+                    f"{self.extent}; pass outside= to give such points a value"
+                )
+            vis[~inside] = 1.0 if outside is None else float(outside)
+        return vis
+
+    def receiver_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """World points (M, 3) float64 of the texels that have a receiver, and
+        their flat texel indices (M,) into ``visibility.ravel()``."""
+        return _core.receiver_points(self.receiver_depth, self.light._core_args(), self.extent)
+
+
+def soft_shadow_map(
+    scene: Scene,
+    light: RectLight,
+    *,
+    resolution: int | tuple[int, int] = 256,
+    extent: float | tuple[float, float] | None = None,
+    passes: int = 2,
+    method: str = "ssm",
+    backend: str = "cpu",
+) -> ShadowMap:
+    """Soft shadow map of ``scene``'s occluders on its receivers.
+
+    Parameters
+    ----------
+    scene, light
+        The geometry and the rectangular area light.
+    resolution
+        ``int`` for a square map or ``(W, H)``. The occluder and receiver maps
+        share it.
+    extent
+        Tangent half-extents ``(tx, ty)`` of the map (a number means both).
+        ``None`` fits them to where the occluders' shadows (umbra and penumbra)
+        can fall on the receivers: an occluder point at tangent ``x`` and depth
+        ``z`` shadows at most ``|x| + (Lx/2)(1/z - 1/z_far)`` away from the
+        light's axis, ``z_far`` being the farthest receiver depth; the extent is
+        the largest such bound over occluder vertices (exact for triangles), cut
+        to the receivers' own extent. Fitting needs every occluder vertex in
+        front of the light's plane.
+    passes
+        1: the front occluder layer; 2: front and back layers, merged by the
+        larger occlusion (§3.5 of the paper).
+    method
+        ``"ssm"``: soft shadow maps as published (Atty et al. 2005).
+    backend
+        ``"cpu"`` (all cores).
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
+    if not isinstance(light, RectLight):
+        raise TypeError(f"light: must be a softshadow.RectLight, got {type(light).__name__}")
+    w, h = check.resolution(resolution)
+    ext = None if extent is None else check.extent(extent)
+    passes = check.integer("passes", passes)
+    if passes not in (1, 2):
+        raise ValueError(f"passes: must be 1 or 2, got {passes}")
+    method = check.choice("method", method, METHODS)
+    check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
+    (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
+    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method)
+    return ShadowMap(
+        visibility=r["visibility"],
+        receiver_depth=r["receiver_depth"],
+        occluder_depth=r["occluder_depth"],
+        occluder_depth_back=r["occluder_depth_back"],
+        light=light,
+        extent=tuple(r["extent"]),
+        method=method,
+        passes=passes,
+        extent_fitted=extent is None,
+        timings=dict(r["timings"]),
+    )
+
+
+def soft_shadow_map_from_depth(
+    occluder_depth: np.ndarray,
+    receiver_depth: np.ndarray,
+    *,
+    light_size: Any,
+    extent: Any,
+    occluder_depth_back: np.ndarray | None = None,
+    method: str = "ssm",
+    backend: str = "cpu",
+) -> ShadowMap:
+    """Soft shadow map from light-view depth maps rendered by the caller.
+
+    The maps follow the package's conventions (see :class:`ShadowMap`): planar
+    depth, float, ``inf`` where empty, all of one shape (H, W). With
+    ``occluder_depth_back`` the result is the two-pass one. ``light_size`` is the
+    light's (width, height) in the depth's units; ``extent`` the maps' tangent
+    half-extents. The result's ``light`` is the canonical light of that size
+    (center at the origin, normal +z, up +y), so ``sample`` takes points in that
+    frame.
+    """
+    rec = check.depth_map("receiver_depth", receiver_depth)
+    front = check.depth_map("occluder_depth", occluder_depth, rec.shape)
+    back = None
+    if occluder_depth_back is not None:
+        back = check.depth_map("occluder_depth_back", occluder_depth_back, rec.shape)
+    if np.isscalar(light_size):
+        light_size = (light_size, light_size)
+    size = check.vector("light_size", light_size, 2)
+    if not all(s > 0 for s in size):
+        raise ValueError(f"light_size: must be > 0, got {list(size)}")
+    ext = check.extent(extent)
+    method = check.choice("method", method, METHODS)
+    check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
+    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method)
+    return ShadowMap(
+        visibility=r["visibility"],
+        receiver_depth=rec,
+        occluder_depth=front,
+        occluder_depth_back=back,
+        light=RectLight.canonical(size),
+        extent=ext,
+        method=method,
+        passes=1 if back is None else 2,
+        extent_fitted=False,
+        timings=dict(r["timings"]),
+    )

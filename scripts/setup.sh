@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs everything softshadow needs on a fresh Debian machine (run as root):
+# Debian's libLLVM 19 (Mitsuba's llvm variants need LLVM >= 16; Debian's 15
+# crashes Dr.Jit), a virtual environment in .venv, and the package built from
+# source (Rust, through maturin) with the extras given as arguments.
+#   scripts/setup.sh            -> the package only
+#   scripts/setup.sh test       -> the package, Mitsuba, trimesh, OpenEXR, pytest
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need=()
+for pkg in libllvm19; do
+    dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
+done
+if [ ${#need[@]} -gt 0 ]; then
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need[@]}" >/dev/null
+fi
+command -v cargo >/dev/null || { echo "setup.sh: cargo (Rust) is required" >&2; exit 1; }
+
+[ -x .venv/bin/python ] || python3 -m venv .venv
+.venv/bin/python -m pip install -q --upgrade pip
+extras="${1:-}"
+spec="."
+[ -n "$extras" ] && spec=".[$extras]"
+.venv/bin/python -m pip install -q "$spec"

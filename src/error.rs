@@ -1,0 +1,42 @@
+//! The one error type of the core. The Python bindings map it to exceptions in
+//! one place (`python/errors.rs`); nothing else in the core knows about Python.
+
+use thiserror::Error;
+
+/// Every way a core call can refuse its input.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum Error {
+    /// An argument has a wrong value (NaN, non-positive size, bad index...).
+    /// `arg` names the argument as the user spelled it.
+    #[error("{arg}: {msg}")]
+    InvalidArgument { arg: String, msg: String },
+    /// Arrays that must agree in shape do not.
+    #[error("{arg}: {msg}")]
+    ShapeMismatch { arg: String, msg: String },
+    /// The request would allocate more than we are willing to before starting.
+    #[error("{arg}: {msg}")]
+    TooLarge { arg: String, msg: String },
+}
+
+impl Error {
+    pub fn invalid(arg: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::InvalidArgument {
+            arg: arg.into(),
+            msg: msg.into(),
+        }
+    }
+    pub fn shape(arg: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::ShapeMismatch {
+            arg: arg.into(),
+            msg: msg.into(),
+        }
+    }
+    pub fn too_large(arg: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::TooLarge {
+            arg: arg.into(),
+            msg: msg.into(),
+        }
+    }
+}
+
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,81 @@
+//! Fitting the light-view map to where shadows can fall (`extent=None`).
+//!
+//! A light point at tangent offset X_L (|X_L| <= Lx/2, on the light's plane)
+//! and an occluder point at tangent x_O, depth Z_O cast a shadow on depth z_R
+//! at tangent  x_O + X_L (1/z_R - 1/Z_O)  (seen from the light's center). So
+//! every shadow point lies within  |x| <= |x_O| + Lx/2 (1/Z_O - 1/z_far)  where
+//! z_far is the farthest receiver depth. Over a triangle |x| is convex and 1/Z
+//! is linear in the map's plane, so the bound's maximum is at a vertex: the
+//! extent is the largest bound over occluder vertices (and likewise in y). It
+//! is then cut to the receivers' own tangent extent when every receiver vertex
+//! lies in front of the light (shadows land on receivers only).
+
+use crate::error::{Error, Result};
+use glam::DVec3;
+
+/// The smallest extent we return (a scene whose shadow shrinks to the axis).
+const MIN_EXTENT: f64 = 1e-9;
+
+/// Tangent half-extents (tx, ty) that contain every umbra and penumbra the
+/// occluders can cast on the receivers.
+pub fn fit_extent(occluders: &[DVec3], receivers: &[DVec3], light_size: [f64; 2]) -> Result<[f64; 2]> {
+    if let Some(q) = occluders.iter().find(|q| !(q.z > 0.0)) {
+        return Err(Error::invalid(
+            "occluders",
+            format!(
+                "a vertex lies at or behind the light's plane (depth {}), so no finite map holds \
+                 its shadow; pass extent=(tx, ty) explicitly",
+                q.z
+            ),
+        ));
+    }
+    let in_front = receivers.iter().filter(|q| q.z > 0.0);
+    let z_far = in_front.clone().fold(f64::NEG_INFINITY, |m, q| m.max(q.z));
+    if !z_far.is_finite() {
+        return Err(Error::invalid(
+            "receivers",
+            "no receiver vertex lies in front of the light",
+        ));
+    }
+    let inv_far = 1.0 / z_far;
+    let mut ext = [0f64; 2];
+    for q in occluders {
+        let pen = (1.0 / q.z - inv_far).max(0.0);
+        ext[0] = ext[0].max((q.x / q.z).abs() + 0.5 * light_size[0] * pen);
+        ext[1] = ext[1].max((q.y / q.z).abs() + 0.5 * light_size[1] * pen);
+    }
+    if receivers.iter().all(|q| q.z > 0.0) {
+        let rx = in_front.clone().fold(0f64, |m, q| m.max((q.x / q.z).abs()));
+        let ry = in_front.fold(0f64, |m, q| m.max((q.y / q.z).abs()));
+        ext[0] = ext[0].min(rx);
+        ext[1] = ext[1].min(ry);
+    }
+    Ok([ext[0].max(MIN_EXTENT), ext[1].max(MIN_EXTENT)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plate_extent_matches_the_hand_computation() {
+        // Plate of half-size 0.25 at depth 2, receivers at depth 4 reaching far.
+        let occ = [DVec3::new(0.25, -0.25, 2.0), DVec3::new(-0.25, 0.25, 2.0)];
+        let rec = [DVec3::new(-40.0, -40.0, 4.0), DVec3::new(40.0, 40.0, 4.0)];
+        let e = fit_extent(&occ, &rec, [1.0, 0.5]).unwrap();
+        // |x| = 0.125; penumbra 0.5 * (1/2 - 1/4) = 0.125 -> 0.25; y: 0.125 + 0.0625.
+        assert!((e[0] - 0.25).abs() < 1e-15 && (e[1] - 0.1875).abs() < 1e-15);
+        // Small receivers cut it.
+        let rec = [DVec3::new(-0.4, -0.4, 4.0), DVec3::new(0.4, 0.4, 4.0)];
+        let e = fit_extent(&occ, &rec, [1.0, 0.5]).unwrap();
+        assert!((e[0] - 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn occluders_behind_the_light_need_an_explicit_extent() {
+        let occ = [DVec3::new(0.0, 0.0, -1.0)];
+        let rec = [DVec3::new(0.0, 0.0, 4.0)];
+        assert!(fit_extent(&occ, &rec, [1.0, 1.0]).is_err());
+        assert!(fit_extent(&[DVec3::new(0.0, 0.0, 1.0)], &[DVec3::new(0.0, 0.0, -4.0)], [1.0, 1.0]).is_err());
+    }
+}

@@ -1,0 +1,18 @@
+//! softshadow: soft shadows cast by rectangular area lights.
+//!
+//! The core (everything but `python`) has no Python in it: the pyo3 bindings
+//! are one thin layer behind the `python` feature.
+
+pub mod error;
+pub mod extent;
+pub mod light;
+pub mod mesh;
+pub mod methods;
+pub mod pipeline;
+pub mod raster;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use error::{Error, Result};
+pub use light::{MapGrid, RectLight};

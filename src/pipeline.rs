@@ -1,0 +1,241 @@
+//! The end-to-end pipelines: meshes -> light-view maps -> visibility, and
+//! depth maps -> visibility. Timings are kept per stage.
+
+use crate::error::{Error, Result};
+use crate::extent::fit_extent;
+use crate::light::{check_light_size, MapGrid, RectLight};
+use crate::mesh::MeshRef;
+use crate::methods::{LightPoint, Method, ShadowInputs};
+use crate::raster::rasterize;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// How many occluder depth layers are taken (1: front; 2: front and back, §3.5).
+pub fn check_passes(passes: u32) -> Result<u32> {
+    match passes {
+        1 | 2 => Ok(passes),
+        p => Err(Error::invalid(
+            "passes",
+            format!("must be 1 (front layer) or 2 (front and back layers), got {p}"),
+        )),
+    }
+}
+
+/// Named stage durations in seconds, in the order they ran.
+pub type Timings = Vec<(&'static str, f64)>;
+
+/// What the mesh pipeline returns.
+#[derive(Debug, Clone)]
+pub struct ShadowResult {
+    pub grid: MapGrid,
+    pub visibility: Vec<f32>,
+    pub receiver: Vec<f32>,
+    pub occluder_front: Vec<f32>,
+    pub occluder_back: Option<Vec<f32>>,
+    pub timings: Timings,
+}
+
+/// Settings of the mesh pipeline.
+#[derive(Debug, Clone, Copy)]
+pub struct MapSettings {
+    pub width: usize,
+    pub height: usize,
+    /// Tangent half-extents, or `None` to fit them (see `extent.rs`).
+    pub extent: Option<[f64; 2]>,
+    pub passes: u32,
+    pub method: Method,
+}
+
+struct Stopwatch {
+    t: Instant,
+    timings: Timings,
+}
+
+impl Stopwatch {
+    fn new() -> Self {
+        Stopwatch {
+            t: Instant::now(),
+            timings: Vec::new(),
+        }
+    }
+    fn lap(&mut self, name: &'static str) {
+        let now = Instant::now();
+        self.timings.push((name, (now - self.t).as_secs_f64()));
+        self.t = now;
+    }
+}
+
+/// Clip distance for rasterization: a tiny fraction of the scene's depth range,
+/// so that geometry touching the light's plane keeps finite 1/Z.
+fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
+    let far = occ
+        .iter()
+        .chain(rec)
+        .fold(0f64, |m, q| m.max(q.z.abs()));
+    (far * 1e-9).max(f64::MIN_POSITIVE)
+}
+
+/// Soft shadow map from meshes.
+pub fn from_meshes(
+    occluders: MeshRef,
+    receivers: MeshRef,
+    light: &RectLight,
+    s: &MapSettings,
+) -> Result<ShadowResult> {
+    check_passes(s.passes)?;
+    if occluders.is_empty() {
+        return Err(Error::invalid("occluders", "the scene has no occluder triangles"));
+    }
+    if receivers.is_empty() {
+        return Err(Error::invalid("receivers", "the scene has no receiver triangles"));
+    }
+    // Refuse an absurd resolution before touching the meshes.
+    MapGrid::new(s.width, s.height, s.extent.unwrap_or([1.0, 1.0]))?;
+    occluders.validate("occluders")?;
+    receivers.validate("receivers")?;
+
+    let mut sw = Stopwatch::new();
+    let occ_ls = occluders.to_light_space(light);
+    let rec_ls = receivers.to_light_space(light);
+    sw.lap("transform");
+    let extent = match s.extent {
+        Some(e) => e,
+        None => fit_extent(&occ_ls, &rec_ls, light.size)?,
+    };
+    let grid = MapGrid::new(s.width, s.height, extent)?;
+    sw.lap("extent");
+    let near = near_plane(&occ_ls, &rec_ls);
+    let receiver = rasterize(&grid, &rec_ls, receivers.faces, near, false).nearest;
+    sw.lap("raster_receivers");
+    let occ = rasterize(&grid, &occ_ls, occluders.faces, near, s.passes == 2);
+    sw.lap("raster_occluders");
+    let mut layers: Vec<&[f32]> = vec![&occ.nearest];
+    if let Some(back) = occ.farthest.as_deref() {
+        layers.push(back);
+    }
+    let inputs = ShadowInputs {
+        grid,
+        light_size: light.size,
+        receiver: &receiver,
+        occluder_layers: layers,
+    };
+    let visibility = s.method.implementation().visibility_map(&inputs);
+    sw.lap("shadow");
+    Ok(ShadowResult {
+        grid,
+        visibility,
+        receiver,
+        occluder_front: occ.nearest,
+        occluder_back: occ.farthest,
+        timings: sw.timings,
+    })
+}
+
+/// Checks a user depth map: finite and > 0, or +inf for "nothing here".
+pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
+    if let Some(k) = depth.par_iter().position_any(|&z| !(z > 0.0)) {
+        return Err(Error::invalid(
+            arg,
+            format!(
+                "depths must be > 0 (planar distance from the light) or +inf where empty; \
+                 texel {k} holds {}",
+                depth[k]
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Soft shadow map from depth maps the user rendered.
+pub fn from_depth(
+    grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> Result<(Vec<f32>, Timings)> {
+    let light_size = check_light_size("light_size", light_size)?;
+    for (arg, d) in [("occluder_depth", Some(front)), ("occluder_depth_back", back), ("receiver_depth", Some(receiver))] {
+        if let Some(d) = d {
+            if d.len() != grid.len() {
+                return Err(Error::shape(
+                    arg,
+                    format!("has {} texels, expected {}x{}", d.len(), grid.height, grid.width),
+                ));
+            }
+            check_depth(arg, d)?;
+        }
+    }
+    let mut sw = Stopwatch::new();
+    let mut layers = vec![front];
+    if let Some(b) = back {
+        layers.push(b);
+    }
+    let inputs = ShadowInputs {
+        grid: *grid,
+        light_size,
+        receiver,
+        occluder_layers: layers,
+    };
+    let v = method.implementation().visibility_map(&inputs);
+    sw.lap("shadow");
+    Ok((v, sw.timings))
+}
+
+/// Visibility at world points, from the occluder maps of a shadow map.
+/// Returns the visibility and whether each point fell inside the map (points
+/// outside it or at/behind the light's plane get visibility 1 and `false`).
+pub fn sample_points(
+    grid: &MapGrid,
+    light: &RectLight,
+    front: &[f32],
+    back: Option<&[f32]>,
+    points: &[[f64; 3]],
+    method: Method,
+) -> Result<(Vec<f32>, Vec<bool>)> {
+    if let Some(k) = points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(Error::invalid("points", format!("point {k} is not finite: {:?}", points[k])));
+    }
+    let (ls, inside): (Vec<LightPoint>, Vec<bool>) = points
+        .par_iter()
+        .map(|p| {
+            let q = light.to_light(DVec3::from_array(*p));
+            if !(q.z > 0.0) {
+                return (LightPoint { x: 0.0, y: 0.0, z: f32::INFINITY }, false);
+            }
+            let (x, y) = (q.x / q.z, q.y / q.z);
+            let inside = x.abs() <= grid.tx && y.abs() <= grid.ty;
+            let z = if inside { q.z as f32 } else { f32::INFINITY };
+            (LightPoint { x: x as f32, y: y as f32, z }, inside)
+        })
+        .unzip();
+    let mut layers = vec![front];
+    if let Some(b) = back {
+        layers.push(b);
+    }
+    // The receiver map is not read when shading points.
+    let inputs = ShadowInputs {
+        grid: *grid,
+        light_size: light.size,
+        receiver: &[],
+        occluder_layers: layers,
+    };
+    Ok((method.implementation().visibility_points(&inputs, &ls), inside))
+}
+
+/// World points of the receiver texels (texel centers at their receiver
+/// depth) and their flat texel indices, in f64.
+pub fn receiver_points(grid: &MapGrid, light: &RectLight, receiver: &[f32]) -> (Vec<[f64; 3]>, Vec<u64>) {
+    let w = grid.width;
+    receiver
+        .par_iter()
+        .enumerate()
+        .filter(|(_, z)| z.is_finite())
+        .map(|(k, &z)| {
+            let p = light.point_at(grid.x_of(k % w), grid.y_of(k / w), z as f64);
+            (p.to_array(), k as u64)
+        })
+        .unzip()
+}

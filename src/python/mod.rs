@@ -1,0 +1,197 @@
+//! The pyo3 bindings: validate, borrow the arrays, release the GIL around the
+//! work, return arrays without copies. Argument checks about Python types and
+//! dtypes live in the Python package; value checks live in the core.
+
+mod errors;
+
+use crate::light::{MapGrid, RectLight};
+use crate::mesh::MeshRef;
+use crate::methods::Method;
+use crate::pipeline::{self, MapSettings, Timings};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+type Light = ([f64; 3], [f64; 3], [f64; 3], [f64; 2]);
+
+fn light_of(l: Light) -> PyResult<RectLight> {
+    Ok(RectLight::new(l.0, l.1, l.2, l.3)?)
+}
+
+/// Borrows a C-contiguous array as a slice, naming the argument if it is not.
+fn slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    arg: &str,
+    a: &'a numpy::PyReadonlyArray<'_, T, D>,
+) -> PyResult<&'a [T]> {
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{arg}: must be a C-contiguous array")))
+}
+
+/// Reinterprets a (n, 3) array's buffer as n triples.
+fn triples<'a, T: numpy::Element>(arg: &str, a: &'a PyReadonlyArray2<'_, T>) -> PyResult<&'a [[T; 3]]> {
+    if a.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{arg}: must have shape (n, 3), got {:?}",
+            a.shape()
+        )));
+    }
+    let s = slice(arg, a)?;
+    // SAFETY: [T; 3] has T's alignment and no padding; the buffer is
+    // contiguous with a multiple of 3 elements, and it outlives the borrow.
+    Ok(unsafe { std::slice::from_raw_parts(s.as_ptr() as *const [T; 3], s.len() / 3) })
+}
+
+fn timings_dict<'py>(py: Python<'py>, t: &Timings) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in t {
+        d.set_item(*k, *v)?;
+    }
+    Ok(d)
+}
+
+fn map<'py>(py: Python<'py>, grid: &MapGrid, v: Vec<f32>) -> PyResult<Bound<'py, PyAny>> {
+    let a = Array2::from_shape_vec((grid.height, grid.width), v)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any())
+}
+
+/// Validates a light and returns its frame (u, v, n).
+#[pyfunction]
+fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
+    let l = light_of(light)?;
+    Ok((l.u.to_array(), l.v.to_array(), l.n.to_array()))
+}
+
+/// Meshes -> light-view maps -> visibility.
+#[pyfunction]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method))]
+#[allow(clippy::too_many_arguments)]
+fn shadow_map_from_meshes<'py>(
+    py: Python<'py>,
+    occ_vertices: PyReadonlyArray2<'py, f64>,
+    occ_faces: PyReadonlyArray2<'py, u32>,
+    rec_vertices: PyReadonlyArray2<'py, f64>,
+    rec_faces: PyReadonlyArray2<'py, u32>,
+    light: Light,
+    width: usize,
+    height: usize,
+    extent: Option<(f64, f64)>,
+    passes: u32,
+    method: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let light = light_of(light)?;
+    let method = Method::parse(method)?;
+    let occ = MeshRef {
+        vertices: triples("occluders", &occ_vertices)?,
+        faces: triples("occluders", &occ_faces)?,
+    };
+    let rec = MeshRef {
+        vertices: triples("receivers", &rec_vertices)?,
+        faces: triples("receivers", &rec_faces)?,
+    };
+    let settings = MapSettings {
+        width,
+        height,
+        extent: extent.map(|e| [e.0, e.1]),
+        passes,
+        method,
+    };
+    let r = py.detach(|| pipeline::from_meshes(occ, rec, &light, &settings))?;
+    let d = PyDict::new(py);
+    d.set_item("extent", (r.grid.tx, r.grid.ty))?;
+    d.set_item("timings", timings_dict(py, &r.timings)?)?;
+    d.set_item("visibility", map(py, &r.grid, r.visibility)?)?;
+    d.set_item("receiver_depth", map(py, &r.grid, r.receiver)?)?;
+    d.set_item("occluder_depth", map(py, &r.grid, r.occluder_front)?)?;
+    match r.occluder_back {
+        Some(b) => d.set_item("occluder_depth_back", map(py, &r.grid, b)?)?,
+        None => d.set_item("occluder_depth_back", py.None())?,
+    }
+    Ok(d)
+}
+
+/// Depth maps -> visibility.
+#[pyfunction]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method))]
+fn shadow_map_from_depth<'py>(
+    py: Python<'py>,
+    occluder_depth: PyReadonlyArray2<'py, f32>,
+    occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
+    receiver_depth: PyReadonlyArray2<'py, f32>,
+    light_size: [f64; 2],
+    extent: (f64, f64),
+    method: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let method = Method::parse(method)?;
+    let shape = receiver_depth.shape();
+    let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+    let front = slice("occluder_depth", &occluder_depth)?;
+    let back = match &occluder_depth_back {
+        Some(b) => Some(slice("occluder_depth_back", b)?),
+        None => None,
+    };
+    let receiver = slice("receiver_depth", &receiver_depth)?;
+    let (v, t) = py.detach(|| pipeline::from_depth(&grid, light_size, front, back, receiver, method))?;
+    let d = PyDict::new(py);
+    d.set_item("timings", timings_dict(py, &t)?)?;
+    d.set_item("visibility", map(py, &grid, v)?)?;
+    Ok(d)
+}
+
+/// Visibility at world points from a shadow map's occluder maps.
+#[pyfunction]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, light, extent, points, method))]
+fn sample_points<'py>(
+    py: Python<'py>,
+    occluder_depth: PyReadonlyArray2<'py, f32>,
+    occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
+    light: Light,
+    extent: (f64, f64),
+    points: PyReadonlyArray2<'py, f64>,
+    method: &str,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let light = light_of(light)?;
+    let method = Method::parse(method)?;
+    let shape = occluder_depth.shape();
+    let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+    let front = slice("occluder_depth", &occluder_depth)?;
+    let back = match &occluder_depth_back {
+        Some(b) => Some(slice("occluder_depth_back", b)?),
+        None => None,
+    };
+    let pts = triples("points", &points)?;
+    let (v, inside) = py.detach(|| pipeline::sample_points(&grid, &light, front, back, pts, method))?;
+    Ok((v.into_pyarray(py).into_any(), inside.into_pyarray(py).into_any()))
+}
+
+/// World points of the receiver texels and their flat indices.
+#[pyfunction]
+fn receiver_points<'py>(
+    py: Python<'py>,
+    receiver_depth: PyReadonlyArray2<'py, f32>,
+    light: Light,
+    extent: (f64, f64),
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let light = light_of(light)?;
+    let shape = receiver_depth.shape();
+    let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+    let rec = slice("receiver_depth", &receiver_depth)?;
+    let (pts, idx) = py.detach(|| pipeline::receiver_points(&grid, &light, rec));
+    let n = pts.len();
+    let flat: Vec<f64> = pts.into_iter().flatten().collect();
+    let pts = Array2::from_shape_vec((n, 3), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((pts.into_pyarray(py).into_any(), idx.into_pyarray(py).into_any()))
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(light_frame, m)?)?;
+    m.add_function(wrap_pyfunction!(shadow_map_from_meshes, m)?)?;
+    m.add_function(wrap_pyfunction!(shadow_map_from_depth, m)?)?;
+    m.add_function(wrap_pyfunction!(sample_points, m)?)?;
+    m.add_function(wrap_pyfunction!(receiver_points, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
