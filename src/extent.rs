@@ -18,7 +18,11 @@ const MIN_EXTENT: f64 = 1e-9;
 
 /// Tangent half-extents (tx, ty) that contain every umbra and penumbra the
 /// occluders can cast on the receivers.
-pub fn fit_extent(occluders: &[DVec3], receivers: &[DVec3], light_size: [f64; 2]) -> Result<[f64; 2]> {
+pub fn fit_extent(
+    occluders: &[DVec3],
+    receivers: &[DVec3],
+    light_size: [f64; 2],
+) -> Result<[f64; 2]> {
     if let Some(q) = occluders.iter().find(|q| !(q.z > 0.0)) {
         return Err(Error::invalid(
             "occluders",
@@ -76,6 +80,11 @@ mod tests {
         let occ = [DVec3::new(0.0, 0.0, -1.0)];
         let rec = [DVec3::new(0.0, 0.0, 4.0)];
         assert!(fit_extent(&occ, &rec, [1.0, 1.0]).is_err());
-        assert!(fit_extent(&[DVec3::new(0.0, 0.0, 1.0)], &[DVec3::new(0.0, 0.0, -4.0)], [1.0, 1.0]).is_err());
+        assert!(fit_extent(
+            &[DVec3::new(0.0, 0.0, 1.0)],
+            &[DVec3::new(0.0, 0.0, -4.0)],
+            [1.0, 1.0]
+        )
+        .is_err());
     }
 }

@@ -205,7 +205,13 @@ mod tests {
 
     #[test]
     fn frame_is_orthonormal_and_follows_the_convention() {
-        let l = RectLight::new([0.0, 4.0, 0.0], [0.0, -2.0, 0.0], [0.0, 0.3, 1.0], [1.0, 2.0]).unwrap();
+        let l = RectLight::new(
+            [0.0, 4.0, 0.0],
+            [0.0, -2.0, 0.0],
+            [0.0, 0.3, 1.0],
+            [1.0, 2.0],
+        )
+        .unwrap();
         assert!((l.n - DVec3::new(0.0, -1.0, 0.0)).length() < 1e-15);
         assert!((l.v - DVec3::new(0.0, 0.0, 1.0)).length() < 1e-15);
         // u = n x v = (0,-1,0) x (0,0,1) = (-1, 0, 0)

@@ -69,10 +69,7 @@ impl Stopwatch {
 /// Clip distance for rasterization: a tiny fraction of the scene's depth range,
 /// so that geometry touching the light's plane keeps finite 1/Z.
 fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
-    let far = occ
-        .iter()
-        .chain(rec)
-        .fold(0f64, |m, q| m.max(q.z.abs()));
+    let far = occ.iter().chain(rec).fold(0f64, |m, q| m.max(q.z.abs()));
     (far * 1e-9).max(f64::MIN_POSITIVE)
 }
 
@@ -85,10 +82,16 @@ pub fn from_meshes(
 ) -> Result<ShadowResult> {
     check_passes(s.passes)?;
     if occluders.is_empty() {
-        return Err(Error::invalid("occluders", "the scene has no occluder triangles"));
+        return Err(Error::invalid(
+            "occluders",
+            "the scene has no occluder triangles",
+        ));
     }
     if receivers.is_empty() {
-        return Err(Error::invalid("receivers", "the scene has no receiver triangles"));
+        return Err(Error::invalid(
+            "receivers",
+            "the scene has no receiver triangles",
+        ));
     }
     // Refuse an absurd resolution before touching the meshes.
     MapGrid::new(s.width, s.height, s.extent.unwrap_or([1.0, 1.0]))?;
@@ -157,12 +160,21 @@ pub fn from_depth(
     method: Method,
 ) -> Result<(Vec<f32>, Timings)> {
     let light_size = check_light_size("light_size", light_size)?;
-    for (arg, d) in [("occluder_depth", Some(front)), ("occluder_depth_back", back), ("receiver_depth", Some(receiver))] {
+    for (arg, d) in [
+        ("occluder_depth", Some(front)),
+        ("occluder_depth_back", back),
+        ("receiver_depth", Some(receiver)),
+    ] {
         if let Some(d) = d {
             if d.len() != grid.len() {
                 return Err(Error::shape(
                     arg,
-                    format!("has {} texels, expected {}x{}", d.len(), grid.height, grid.width),
+                    format!(
+                        "has {} texels, expected {}x{}",
+                        d.len(),
+                        grid.height,
+                        grid.width
+                    ),
                 ));
             }
             check_depth(arg, d)?;
@@ -196,19 +208,36 @@ pub fn sample_points(
     method: Method,
 ) -> Result<(Vec<f32>, Vec<bool>)> {
     if let Some(k) = points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-        return Err(Error::invalid("points", format!("point {k} is not finite: {:?}", points[k])));
+        return Err(Error::invalid(
+            "points",
+            format!("point {k} is not finite: {:?}", points[k]),
+        ));
     }
     let (ls, inside): (Vec<LightPoint>, Vec<bool>) = points
         .par_iter()
         .map(|p| {
             let q = light.to_light(DVec3::from_array(*p));
             if !(q.z > 0.0) {
-                return (LightPoint { x: 0.0, y: 0.0, z: f32::INFINITY }, false);
+                return (
+                    LightPoint {
+                        x: 0.0,
+                        y: 0.0,
+                        z: f32::INFINITY,
+                    },
+                    false,
+                );
             }
             let (x, y) = (q.x / q.z, q.y / q.z);
             let inside = x.abs() <= grid.tx && y.abs() <= grid.ty;
             let z = if inside { q.z as f32 } else { f32::INFINITY };
-            (LightPoint { x: x as f32, y: y as f32, z }, inside)
+            (
+                LightPoint {
+                    x: x as f32,
+                    y: y as f32,
+                    z,
+                },
+                inside,
+            )
         })
         .unzip();
     let mut layers = vec![front];
@@ -222,12 +251,19 @@ pub fn sample_points(
         receiver: &[],
         occluder_layers: layers,
     };
-    Ok((method.implementation().visibility_points(&inputs, &ls), inside))
+    Ok((
+        method.implementation().visibility_points(&inputs, &ls),
+        inside,
+    ))
 }
 
 /// World points of the receiver texels (texel centers at their receiver
 /// depth) and their flat texel indices, in f64.
-pub fn receiver_points(grid: &MapGrid, light: &RectLight, receiver: &[f32]) -> (Vec<[f64; 3]>, Vec<u64>) {
+pub fn receiver_points(
+    grid: &MapGrid,
+    light: &RectLight,
+    receiver: &[f32],
+) -> (Vec<[f64; 3]>, Vec<u64>) {
     let w = grid.width;
     receiver
         .par_iter()

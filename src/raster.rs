@@ -47,6 +47,15 @@ struct SetupTri {
     j1: u32,
 }
 
+/// A vertex snapped to the fixed-point grid, with its 1/Z.
+#[derive(Debug, Clone, Copy)]
+struct Snapped {
+    x: i64,
+    y: i64,
+    w: f64,
+    inside: bool,
+}
+
 /// A clip plane in light space: keep points where a.X + b.Y + c.Z + d >= 0.
 type Plane = [f64; 4];
 
@@ -132,10 +141,32 @@ impl Projector {
         px >= self.px_lo && px <= self.px_hi && py >= self.py_lo && py <= self.py_hi
     }
 
-    /// Appends the rasterizable pieces of triangle (a, b, c) to `out`.
-    fn setup(&self, tri: [DVec3; 3], out: &mut Vec<SetupTri>) {
-        if tri.iter().all(|&q| self.in_guard(q)) {
-            self.push_projected(tri, out);
+    /// Snaps a light-space point to the fixed-point grid; `inside` tells whether
+    /// it lies in front of the near plane and within the guard band (so that
+    /// a triangle of such vertices needs no clipping).
+    fn snap(&self, q: DVec3) -> Snapped {
+        let inside = self.in_guard(q);
+        let (px, py, w) = if q.z > 0.0 {
+            self.project(q)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        // Clipping may leave a vertex a hair outside the guard band: clamp.
+        let px = px.clamp(self.px_lo, self.px_hi);
+        let py = py.clamp(self.py_lo, self.py_hi);
+        Snapped {
+            x: (px * ONE as f64).round() as i64,
+            y: (py * ONE as f64).round() as i64,
+            w,
+            inside,
+        }
+    }
+
+    /// Appends the rasterizable pieces of triangle (a, b, c) to `out`; `snapped`
+    /// are the three vertices already snapped.
+    fn setup(&self, tri: [DVec3; 3], snapped: [Snapped; 3], out: &mut Vec<SetupTri>) {
+        if snapped.iter().all(|s| s.inside) {
+            self.push_snapped(snapped, out);
             return;
         }
         // Trivially outside one plane: nothing to draw.
@@ -155,24 +186,21 @@ impl Projector {
                 return;
             }
         }
+        let s0 = self.snap(poly[0]);
         for k in 1..poly.len() - 1 {
-            self.push_projected([poly[0], poly[k], poly[k + 1]], out);
+            self.push_snapped([s0, self.snap(poly[k]), self.snap(poly[k + 1])], out);
         }
     }
 
-    fn push_projected(&self, tri: [DVec3; 3], out: &mut Vec<SetupTri>) {
-        let mut x = [0i64; 3];
-        let mut y = [0i64; 3];
-        let mut w = [0f64; 3];
-        for k in 0..3 {
-            let (px, py, wk) = self.project(tri[k]);
-            // Clipping may leave a vertex a hair outside the guard band: clamp.
-            let px = px.clamp(self.px_lo, self.px_hi);
-            let py = py.clamp(self.py_lo, self.py_hi);
-            x[k] = (px * ONE as f64).round() as i64;
-            y[k] = (py * ONE as f64).round() as i64;
-            w[k] = wk;
-        }
+    #[cfg(test)]
+    fn setup_unsnapped(&self, tri: [DVec3; 3], out: &mut Vec<SetupTri>) {
+        self.setup(tri, tri.map(|q| self.snap(q)), out)
+    }
+
+    fn push_snapped(&self, v: [Snapped; 3], out: &mut Vec<SetupTri>) {
+        let mut x = [v[0].x, v[1].x, v[2].x];
+        let mut y = [v[0].y, v[1].y, v[2].y];
+        let mut w = [v[0].w, v[1].w, v[2].w];
         let mut area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
         if area == 0 {
             return;
@@ -297,6 +325,8 @@ pub fn rasterize(
     want_farthest: bool,
 ) -> DepthLayers {
     let proj = Projector::new(grid, near);
+    // Each vertex is projected and snapped once, however many faces share it.
+    let snapped: Vec<Snapped> = verts.par_iter().map(|&q| proj.snap(q)).collect();
     let tris: Vec<SetupTri> = faces
         .par_chunks(4096)
         .flat_map_iter(|chunk| {
@@ -307,7 +337,12 @@ pub fn rasterize(
                     verts[f[1] as usize],
                     verts[f[2] as usize],
                 ];
-                proj.setup(tri, &mut out);
+                let sn = [
+                    snapped[f[0] as usize],
+                    snapped[f[1] as usize],
+                    snapped[f[2] as usize],
+                ];
+                proj.setup(tri, sn, &mut out);
             }
             out
         })
@@ -402,7 +437,7 @@ mod tests {
         let proj = Projector::new(&g, 1e-9);
         let mut tris = Vec::new();
         for f in &faces {
-            proj.setup(
+            proj.setup_unsnapped(
                 [
                     verts[f[0] as usize],
                     verts[f[1] as usize],
@@ -441,7 +476,7 @@ mod tests {
         let mut hits = vec![0u32; g.len()];
         for f in &faces {
             let mut tris = Vec::new();
-            proj.setup(
+            proj.setup_unsnapped(
                 [
                     verts[f[0] as usize],
                     verts[f[1] as usize],
@@ -485,7 +520,10 @@ mod tests {
                 let expect = 2.0 / (1.0 - 0.5 * x);
                 let got = d.nearest[j * 32 + i] as f64;
                 assert!((got - expect).abs() < 1e-5 * expect, "{got} vs {expect}");
-                assert_eq!(d.nearest[j * 32 + i], d.farthest.as_ref().unwrap()[j * 32 + i]);
+                assert_eq!(
+                    d.nearest[j * 32 + i],
+                    d.farthest.as_ref().unwrap()[j * 32 + i]
+                );
             }
         }
     }
@@ -522,7 +560,10 @@ mod tests {
             DVec3::new(0.0, 2.0, 3.0),
         ];
         let d = rasterize(&g, &v, &[[0, 1, 2]], 1e-6, false);
-        assert!(d.nearest.iter().all(|z| z.is_infinite() || (*z > 0.0 && z.is_finite())));
+        assert!(d
+            .nearest
+            .iter()
+            .all(|z| z.is_infinite() || (*z > 0.0 && z.is_finite())));
         assert!(d.nearest.iter().any(|z| z.is_finite()));
     }
 }

@@ -9,9 +9,9 @@ impl From<Error> for PyErr {
         match e {
             // All three are about an argument's value (or the size it asks for),
             // and the message starts with the argument's name.
-            Error::InvalidArgument { .. } | Error::ShapeMismatch { .. } | Error::TooLarge { .. } => {
-                PyValueError::new_err(e.to_string())
-            }
+            Error::InvalidArgument { .. }
+            | Error::ShapeMismatch { .. }
+            | Error::TooLarge { .. } => PyValueError::new_err(e.to_string()),
         }
     }
 }

@@ -30,7 +30,10 @@ fn slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
 }
 
 /// Reinterprets a (n, 3) array's buffer as n triples.
-fn triples<'a, T: numpy::Element>(arg: &str, a: &'a PyReadonlyArray2<'_, T>) -> PyResult<&'a [[T; 3]]> {
+fn triples<'a, T: numpy::Element>(
+    arg: &str,
+    a: &'a PyReadonlyArray2<'_, T>,
+) -> PyResult<&'a [[T; 3]]> {
     if a.shape()[1] != 3 {
         return Err(PyValueError::new_err(format!(
             "{arg}: must have shape (n, 3), got {:?}",
@@ -133,7 +136,8 @@ fn shadow_map_from_depth<'py>(
         None => None,
     };
     let receiver = slice("receiver_depth", &receiver_depth)?;
-    let (v, t) = py.detach(|| pipeline::from_depth(&grid, light_size, front, back, receiver, method))?;
+    let (v, t) =
+        py.detach(|| pipeline::from_depth(&grid, light_size, front, back, receiver, method))?;
     let d = PyDict::new(py);
     d.set_item("timings", timings_dict(py, &t)?)?;
     d.set_item("visibility", map(py, &grid, v)?)?;
@@ -162,8 +166,12 @@ fn sample_points<'py>(
         None => None,
     };
     let pts = triples("points", &points)?;
-    let (v, inside) = py.detach(|| pipeline::sample_points(&grid, &light, front, back, pts, method))?;
-    Ok((v.into_pyarray(py).into_any(), inside.into_pyarray(py).into_any()))
+    let (v, inside) =
+        py.detach(|| pipeline::sample_points(&grid, &light, front, back, pts, method))?;
+    Ok((
+        v.into_pyarray(py).into_any(),
+        inside.into_pyarray(py).into_any(),
+    ))
 }
 
 /// World points of the receiver texels and their flat indices.
@@ -181,8 +189,12 @@ fn receiver_points<'py>(
     let (pts, idx) = py.detach(|| pipeline::receiver_points(&grid, &light, rec));
     let n = pts.len();
     let flat: Vec<f64> = pts.into_iter().flatten().collect();
-    let pts = Array2::from_shape_vec((n, 3), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok((pts.into_pyarray(py).into_any(), idx.into_pyarray(py).into_any()))
+    let pts =
+        Array2::from_shape_vec((n, 3), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((
+        pts.into_pyarray(py).into_any(),
+        idx.into_pyarray(py).into_any(),
+    ))
 }
 
 #[pymodule]
