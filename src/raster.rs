@@ -133,27 +133,32 @@ impl Projector {
         (px, py, 1.0 / q.z)
     }
 
-    fn in_guard(&self, q: DVec3) -> bool {
-        if !(q.z >= self.near) {
-            return false;
-        }
-        let (px, py, _) = self.project(q);
-        px >= self.px_lo && px <= self.px_hi && py >= self.py_lo && py <= self.py_hi
-    }
-
     /// Snaps a light-space point to the fixed-point grid; `inside` tells whether
     /// it lies in front of the near plane and within the guard band (so that
     /// a triangle of such vertices needs no clipping).
     fn snap(&self, q: DVec3) -> Snapped {
-        let inside = self.in_guard(q);
         let (px, py, w) = if q.z > 0.0 {
             self.project(q)
         } else {
-            (0.0, 0.0, 0.0)
+            (f64::NAN, f64::NAN, 0.0)
         };
+        let inside = q.z >= self.near
+            && px >= self.px_lo
+            && px <= self.px_hi
+            && py >= self.py_lo
+            && py <= self.py_hi;
         // Clipping may leave a vertex a hair outside the guard band: clamp.
-        let px = px.clamp(self.px_lo, self.px_hi);
-        let py = py.clamp(self.py_lo, self.py_hi);
+        // (A vertex at or behind the light is never used unclipped.)
+        let px = if px.is_nan() {
+            0.0
+        } else {
+            px.clamp(self.px_lo, self.px_hi)
+        };
+        let py = if py.is_nan() {
+            0.0
+        } else {
+            py.clamp(self.py_lo, self.py_hi)
+        };
         Snapped {
             x: (px * ONE as f64).round() as i64,
             y: (py * ONE as f64).round() as i64,
@@ -565,5 +570,43 @@ mod tests {
             .iter()
             .all(|z| z.is_infinite() || (*z > 0.0 && z.is_finite())));
         assert!(d.nearest.iter().any(|z| z.is_finite()));
+    }
+}
+
+#[cfg(test)]
+mod bench {
+    use super::*;
+
+    /// Times the rasterizer on a mesh dumped to /tmp (a development aid):
+    /// cargo test --release --lib bench_raster -- --ignored --nocapture
+    #[test]
+    #[ignore]
+    fn bench_raster() {
+        let v: Vec<DVec3> = std::fs::read("/tmp/bv.f64")
+            .unwrap()
+            .chunks_exact(24)
+            .map(|b| {
+                let f = |k: usize| f64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap());
+                DVec3::new(f(0), f(1), f(2))
+            })
+            .collect();
+        let f: Vec<[u32; 3]> = std::fs::read("/tmp/bf.u32")
+            .unwrap()
+            .chunks_exact(12)
+            .map(|b| {
+                let u = |k: usize| u32::from_le_bytes(b[4 * k..4 * k + 4].try_into().unwrap());
+                [u(0), u(1), u(2)]
+            })
+            .collect();
+        let g = MapGrid::new(256, 256, [0.31, 0.31]).unwrap();
+        let mut ts = vec![];
+        for _ in 0..50 {
+            let t = std::time::Instant::now();
+            let d = rasterize(&g, &v, &f, 1e-9, true);
+            ts.push(t.elapsed().as_secs_f64());
+            assert!(d.nearest.iter().any(|z| z.is_finite()));
+        }
+        ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        println!("raster median {:.3} ms", ts[25] * 1e3);
     }
 }
