@@ -218,8 +218,9 @@ impl Projector {
         }
         // Texels whose center (i + 1/2) lies in [min, max].
         let span = |lo: i64, hi: i64, n: usize| -> Option<(u32, u32)> {
-            let first = (lo - ONE / 2 + ONE - 1).div_euclid(ONE).max(0);
-            let last = (hi - ONE / 2).div_euclid(ONE).min(n as i64 - 1);
+            // Arithmetic shifts: floor division by ONE, a power of two.
+            let first = ((lo - ONE / 2 + ONE - 1) >> SUBPIXEL_BITS).max(0);
+            let last = ((hi - ONE / 2) >> SUBPIXEL_BITS).min(n as i64 - 1);
             (first <= last).then_some((first as u32, last as u32))
         };
         let Some((i0, i1)) = span(

@@ -10,7 +10,6 @@ error far past them (see test_mutations_are_caught).
 
 import numpy as np
 import pytest
-
 import softshadow as ss
 from softshadow import metrics, scenes
 
@@ -21,14 +20,22 @@ pytest.importorskip("mitsuba")
 # 0.0394/0.0311 at 128 and 0.0396/0.0317 at 256 (1/2 passes); bunny on floor
 # 0.0546/0.0286 and 0.0543/0.0280; torus 0.0387/0.0330 and 0.0386/0.0319.
 THRESHOLDS = {
-    ("square_plate", 128, 1): 0.008, ("square_plate", 128, 2): 0.008,
-    ("square_plate", 256, 1): 0.0042, ("square_plate", 256, 2): 0.0042,
-    ("bunny_floating", 128, 1): 0.044, ("bunny_floating", 128, 2): 0.035,
-    ("bunny_floating", 256, 1): 0.044, ("bunny_floating", 256, 2): 0.0355,
-    ("bunny_on_floor", 128, 1): 0.061, ("bunny_on_floor", 128, 2): 0.032,
-    ("bunny_on_floor", 256, 1): 0.061, ("bunny_on_floor", 256, 2): 0.0315,
-    ("torus", 128, 1): 0.043, ("torus", 128, 2): 0.037,
-    ("torus", 256, 1): 0.043, ("torus", 256, 2): 0.036,
+    ("square_plate", 128, 1): 0.008,
+    ("square_plate", 128, 2): 0.008,
+    ("square_plate", 256, 1): 0.0042,
+    ("square_plate", 256, 2): 0.0042,
+    ("bunny_floating", 128, 1): 0.044,
+    ("bunny_floating", 128, 2): 0.035,
+    ("bunny_floating", 256, 1): 0.044,
+    ("bunny_floating", 256, 2): 0.0355,
+    ("bunny_on_floor", 128, 1): 0.061,
+    ("bunny_on_floor", 128, 2): 0.032,
+    ("bunny_on_floor", 256, 1): 0.061,
+    ("bunny_on_floor", 256, 2): 0.0315,
+    ("torus", 128, 1): 0.043,
+    ("torus", 128, 2): 0.037,
+    ("torus", 256, 1): 0.043,
+    ("torus", 256, 2): 0.036,
 }
 
 

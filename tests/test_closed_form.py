@@ -18,7 +18,6 @@ the four edges: |V_ssm - V_exact| <= 2 k (hw / Lx + hh / Ly).
 
 import numpy as np
 import pytest
-
 import softshadow as ss
 from softshadow import scenes
 
@@ -55,7 +54,9 @@ def test_plate_stays_within_the_half_texel_bound(resolution, passes, light_size)
     assert err.max() <= bound + 1e-5, (err.max(), bound)
     # The fitted extent is the hand-computed one: |x| + Lx/2 (1/zO - 1/zR),
     # where the exact penumbra ends.
-    np.testing.assert_allclose(sm.extent, [a + light_size[0] / 2 * (1 / zo - 1 / zr), a + light_size[1] / 2 * (1 / zo - 1 / zr)], rtol=1e-12)
+    np.testing.assert_allclose(
+        sm.extent, [a + light_size[0] / 2 * (1 / zo - 1 / zr), a + light_size[1] / 2 * (1 / zo - 1 / zr)], rtol=1e-12
+    )
 
 
 def test_plate_aligned_with_texels_is_exact():

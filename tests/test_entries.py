@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 import softshadow as ss
 from softshadow import scenes
 
@@ -112,7 +111,9 @@ def test_scene_accepts_trimesh_and_pairs():
     box.apply_translation((0, 2, 0))
     light = scenes.default_light()
     a = ss.soft_shadow_map(ss.Scene(occluders=box, receivers=[scenes.floor()]), light, resolution=64)
-    b = ss.soft_shadow_map(ss.Scene(occluders=[(box.vertices, box.faces)], receivers=scenes.floor()), light, resolution=64)
+    b = ss.soft_shadow_map(
+        ss.Scene(occluders=[(box.vertices, box.faces)], receivers=scenes.floor()), light, resolution=64
+    )
     np.testing.assert_array_equal(a.visibility, b.visibility)
 
 
@@ -124,7 +125,10 @@ def test_gil_is_released_during_the_work(bunny):
     scene, light = bunny
     ref = ss.soft_shadow_map(scene, light, resolution=64).visibility
     out = []
-    threads = [threading.Thread(target=lambda: out.append(ss.soft_shadow_map(scene, light, resolution=64).visibility)) for _ in range(4)]
+    threads = [
+        threading.Thread(target=lambda: out.append(ss.soft_shadow_map(scene, light, resolution=64).visibility))
+        for _ in range(4)
+    ]
     for t in threads:
         t.start()
     for t in threads:

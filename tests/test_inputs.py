@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 import softshadow as ss
 from softshadow import scenes
 
@@ -60,7 +59,12 @@ def test_bad_scene_and_light_types(plate):
         ([], [scenes.floor()], ValueError, "occluders.*no occluder"),
         ([scenes.quad((0, 2, 0), 0.5)], [], ValueError, "receivers.*no receiver"),
         ([], [], ValueError, "occluders"),
-        ([(np.array([[0, 0, np.nan], [1, 0, 0], [0, 1, 0]]), [[0, 1, 2]])], [scenes.floor()], ValueError, r"occluders\[0\].*vertex 0"),
+        (
+            [(np.array([[0, 0, np.nan], [1, 0, 0], [0, 1, 0]]), [[0, 1, 2]])],
+            [scenes.floor()],
+            ValueError,
+            r"occluders\[0\].*vertex 0",
+        ),
         ([(np.zeros((3, 3)), [[0, 1, 3]])], [scenes.floor()], ValueError, r"occluders\[0\].*indices"),
         ([(np.zeros((3, 3)), [[0, 1, -1]])], [scenes.floor()], ValueError, r"occluders\[0\].*indices"),
         ([(np.zeros((3, 2)), [[0, 1, 2]])], [scenes.floor()], ValueError, r"occluders\[0\].*vertices"),
@@ -145,15 +149,33 @@ def test_the_core_refuses_bad_values_even_past_the_python_checks():
     v = np.zeros((3, 3))
     with pytest.raises(ValueError, match="occluders.*face 0"):
         _core.shadow_map_from_meshes(
-            v, np.array([[0, 1, 7]], np.uint32), v, np.array([[0, 1, 2]], np.uint32),
-            ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)), 8, 8, (0.5, 0.5), 1, "ssm",
+            v,
+            np.array([[0, 1, 7]], np.uint32),
+            v,
+            np.array([[0, 1, 2]], np.uint32),
+            ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)),
+            8,
+            8,
+            (0.5, 0.5),
+            1,
+            "ssm",
         )
     with pytest.raises(ValueError, match="resolution"):
         _core.shadow_map_from_meshes(
-            v, np.array([[0, 1, 2]], np.uint32), v, np.array([[0, 1, 2]], np.uint32),
-            ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)), 1 << 20, 1 << 20, None, 1, "ssm",
+            v,
+            np.array([[0, 1, 2]], np.uint32),
+            v,
+            np.array([[0, 1, 2]], np.uint32),
+            ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)),
+            1 << 20,
+            1 << 20,
+            None,
+            1,
+            "ssm",
         )
     with pytest.raises(ValueError, match="up"):
         _core.light_frame(((0, 0, 0), (0, 0, 1), (0, 0, 2), (1, 1)))
     with pytest.raises(ValueError, match="C-contiguous"):
-        _core.shadow_map_from_depth(good_depth()[0][:, ::2], None, good_depth()[1][:, ::2], (1.0, 1.0), (0.5, 0.5), "ssm")
+        _core.shadow_map_from_depth(
+            good_depth()[0][:, ::2], None, good_depth()[1][:, ::2], (1.0, 1.0), (0.5, 0.5), "ssm"
+        )

@@ -5,7 +5,6 @@ import zlib
 
 import numpy as np
 import pytest
-
 from softshadow import io
 from softshadow.demo import main
 

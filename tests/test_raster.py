@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 import softshadow as ss
 from softshadow import scenes
 
@@ -48,7 +47,7 @@ def test_sphere_depth_maps_are_watertight_and_exact(segments, res):
     assert np.all(np.isfinite(sm.occluder_depth[inside]))
     assert np.all(np.isfinite(sm.occluder_depth_back[inside]))
     outside = ~np.isfinite(near) | (disc < 0)
-    assert np.all(np.isinf(sm.occluder_depth[outside & (disc < -0.05**2 * 4)]))
+    assert np.all(np.isinf(sm.occluder_depth[outside & (disc < -(0.05**2) * 4)]))
     # Depths match the analytic sphere to the tessellation's gap: the facets
     # lie within two sagittas of the sphere, seen along a ray at angle theta
     # to the normal: 2 sag / cos(theta).

@@ -19,7 +19,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-
 from softshadow import metrics, reference
 
 # --------------------------------------------------------------------------
@@ -74,12 +73,8 @@ def exact_visibility(points, light_size, plate_depth, a_range, b_range):
     pa, pb, depth = rel @ U, rel @ V, rel @ N
     scale = depth / (depth - plate_depth)
     sx, sy = light_size
-    overlap_a = interval_overlap(
-        pa + scale * (a_range[0] - pa), pa + scale * (a_range[1] - pa), sx / 2
-    )
-    overlap_b = interval_overlap(
-        pb + scale * (b_range[0] - pb), pb + scale * (b_range[1] - pb), sy / 2
-    )
+    overlap_a = interval_overlap(pa + scale * (a_range[0] - pa), pa + scale * (a_range[1] - pa), sx / 2)
+    overlap_b = interval_overlap(pb + scale * (b_range[0] - pb), pb + scale * (b_range[1] - pb), sy / 2)
     return 1.0 - overlap_a * overlap_b / (sx * sy)
 
 
@@ -101,16 +96,12 @@ PLATE_CASES = {
     # The paper-like set-up: plate of side 0.5 half-way to the floor. Its
     # back-projection from any floor point is exactly as large as the light,
     # so the umbra shrinks to the point under the centre.
-    "square-light-half-way": (
-        (1.0, 1.0), 2.0, (-0.25, 0.25), (-0.25, 0.25), ((-1.5, 1.5), (-1.5, 1.5))
-    ),
+    "square-light-half-way": ((1.0, 1.0), 2.0, (-0.25, 0.25), (-0.25, 0.25), ((-1.5, 1.5), (-1.5, 1.5))),
     # Non-square light and a plate nearer the floor, off-centre: a real umbra,
     # and a swap of the u and v extents would change the penumbrae.
     # Umbra: a in [0.18, 0.35], b in [-0.38, 0.12]; penumbra up to
     # a in (-0.32, 0.85), b in (-0.55, 0.28).
-    "wide-light-low-plate": (
-        (1.5, 0.5), 3.0, (-0.05, 0.45), (-0.35, 0.15), ((-0.5, 1.0), (-0.7, 0.45))
-    ),
+    "wide-light-low-plate": ((1.5, 0.5), 3.0, (-0.05, 0.45), (-0.35, 0.15), ((-0.5, 1.0), (-0.7, 0.45))),
 }
 
 
@@ -163,9 +154,7 @@ def test_non_square_sample_counts(mitsuba_reference):
     points = floor_points([0.0, 0.5, 3.0], [0.0])
     exact = exact_visibility(points, (1.0, 1.0), 2.0, (-0.25, 0.25), (-0.25, 0.25))
     for samples in (7, 12, 1000):  # prime (1 x 7 strips), 4 x 3, 40 x 25
-        estimate = mitsuba_reference.visibility_at_points(
-            occluders, make_light(), points, samples=samples
-        )
+        estimate = mitsuba_reference.visibility_at_points(occluders, make_light(), points, samples=samples)
         # Visibility is a count of unblocked samples over K.
         np.testing.assert_allclose(estimate * samples, np.round(estimate * samples), atol=1e-3)
         assert estimate[2] == 1.0
@@ -180,9 +169,7 @@ def test_seed_determinism_and_batching(mitsuba_reference, monkeypatch):
     points = floor_points(np.linspace(-1, 1, 9) + 0.03, np.linspace(-1, 1, 9) + 0.01)
 
     def run(seed):
-        return mitsuba_reference.visibility_at_points(
-            occluders, make_light(), points, samples=64, seed=seed
-        )
+        return mitsuba_reference.visibility_at_points(occluders, make_light(), points, samples=64, seed=seed)
 
     first = run(7)
     np.testing.assert_array_equal(first, run(7))
@@ -197,9 +184,7 @@ def test_mesh_inputs(mitsuba_reference):
     vertices, faces = plate(2.0, (-0.25, 0.25), (-0.25, 0.25))
     points = floor_points(np.linspace(-1, 1, 7), [0.0, 0.3])
     light = make_light()
-    as_pair = mitsuba_reference.visibility_at_points(
-        [(vertices, faces)], light, points, samples=64
-    )
+    as_pair = mitsuba_reference.visibility_at_points([(vertices, faces)], light, points, samples=64)
     as_trimesh = mitsuba_reference.visibility_at_points(
         [trimesh.Trimesh(vertices, faces, process=False)], light, points, samples=64
     )
@@ -232,9 +217,7 @@ def test_reference_scene_reuse_and_stats(mitsuba_reference):
     shadow_map = light_view_map(make_light(), size=8)
     np.testing.assert_array_equal(
         mitsuba_reference.reference_map(shadow_map, scene, samples=16),
-        mitsuba_reference.reference_map(
-            shadow_map, [plate(2.0, (-0.25, 0.25), (-0.25, 0.25))], samples=16
-        ),
+        mitsuba_reference.reference_map(shadow_map, [plate(2.0, (-0.25, 0.25), (-0.25, 0.25))], samples=16),
     )
 
 
@@ -262,12 +245,8 @@ def test_scalar_variant_agrees(mitsuba_reference):
         """
     )
     env = dict(os.environ, SOFTSHADOW_MITSUBA_VARIANT="scalar_rgb")
-    env["PYTHONPATH"] = os.pathsep.join(
-        [str(Path(reference.__file__).parent.parent)] + sys.path
-    )
-    result = subprocess.run(
-        [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120
-    )
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(reference.__file__).parent.parent)] + sys.path)
+    result = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     name, *values = result.stdout.split()
     assert name == "scalar_rgb"
@@ -306,9 +285,7 @@ def test_reference_map_matches_closed_form(mitsuba_reference):
     shadow_map = light_view_map(make_light(light_size))
     points = texel_points(shadow_map).reshape(-1, 3)
     exact = exact_visibility(points, light_size, depth, a_range, b_range).reshape(32, 32)
-    result = mitsuba_reference.reference_map(
-        shadow_map, [plate(depth, a_range, b_range)], samples=1024
-    )
+    result = mitsuba_reference.reference_map(shadow_map, [plate(depth, a_range, b_range)], samples=1024)
     assert result.shape == (32, 32) and result.dtype == np.float32
     assert np.abs(result - exact).max() < 0.02  # bound justified above
 
@@ -319,13 +296,9 @@ def test_reference_map_orientation(mitsuba_reference, axis):
     offset, centred = (0.5, 0.8), (-0.25, 0.25)
     a_range, b_range = (offset, centred) if axis == "u" else (centred, offset)
     shadow_map = light_view_map(make_light())
-    result = mitsuba_reference.reference_map(
-        shadow_map, [plate(2.0, a_range, b_range)], samples=64
-    )
+    result = mitsuba_reference.reference_map(shadow_map, [plate(2.0, a_range, b_range)], samples=64)
     # x > 0 is the right half of the columns; y > 0 is the top half of rows.
-    positive, negative = (
-        (result[:, 16:], result[:, :16]) if axis == "u" else (result[:16], result[16:])
-    )
+    positive, negative = (result[:, 16:], result[:, :16]) if axis == "u" else (result[:16], result[16:])
     assert np.all(negative == 1.0)
     # The back-projected plate is 0.6 wide along u: at most 60% occluded.
     assert positive.min() < 0.6
@@ -335,9 +308,7 @@ def test_reference_map_skips_texels_without_receiver(mitsuba_reference):
     shadow_map = light_view_map(make_light(), size=8, extent=(0.1, 0.1))
     shadow_map.receiver_depth[:, :4] = np.inf
     # A plate covering the whole view: every receiver texel is in umbra.
-    result = mitsuba_reference.reference_map(
-        shadow_map, [plate(2.0, (-2, 2), (-2, 2))], samples=16
-    )
+    result = mitsuba_reference.reference_map(shadow_map, [plate(2.0, (-2, 2), (-2, 2))], samples=16)
     np.testing.assert_array_equal(result[:, :4], 1.0)
     np.testing.assert_array_equal(result[:, 4:], 0.0)
 
@@ -406,9 +377,7 @@ def test_importing_softshadow_does_not_import_mitsuba():
         "import sys, softshadow, softshadow.metrics, softshadow.reference; "
         "assert 'mitsuba' not in sys.modules and 'drjit' not in sys.modules"
     )
-    result = subprocess.run(
-        [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=60
-    )
+    result = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
 
 
@@ -476,9 +445,7 @@ def test_shadow_error_hand_computed():
     assert metrics.shadow_error(V_EST, V_REF, threshold=0.0) == pytest.approx(0.6995 / 4)
     assert metrics.shadow_error(V_EST, V_REF, threshold=0.6) == pytest.approx(0.1 / 2)
     assert metrics.shadow_error(V_REF, V_REF) == 0.0
-    np.testing.assert_array_equal(
-        metrics.shadow_mask(V_REF), [[False, False, True], [True, False, True]]
-    )
+    np.testing.assert_array_equal(metrics.shadow_mask(V_REF), [[False, False, True], [True, False, True]])
 
 
 def test_shadow_error_empty_shadow_is_zero():
@@ -508,9 +475,7 @@ def test_compare():
     assert result["shadow_texels"] == 3 and isinstance(result["shadow_texels"], int)
 
 
-@pytest.mark.parametrize(
-    "function", [metrics.shadow_error, metrics.rmse, metrics.max_error, metrics.compare]
-)
+@pytest.mark.parametrize("function", [metrics.shadow_error, metrics.rmse, metrics.max_error, metrics.compare])
 def test_metrics_reject_bad_input(function):
     with_nan = V_EST.copy()
     with_nan[0, 1] = np.nan

@@ -45,10 +45,7 @@ def resolution(value: Any) -> tuple[int, int]:
     if w < 1 or h < 1:
         raise ValueError(f"resolution: must be at least 1x1, got {w}x{h}")
     if w * h > MAX_TEXELS:
-        raise ValueError(
-            f"resolution: {w}x{h} would need {w * h * 4} bytes per map "
-            f"(limit {MAX_TEXELS} texels)"
-        )
+        raise ValueError(f"resolution: {w}x{h} would need {w * h * 4} bytes per map (limit {MAX_TEXELS} texels)")
     return w, h
 
 
@@ -93,7 +90,5 @@ def depth_map(name: str, value: Any, shape: tuple[int, ...] | None = None) -> np
         raise ValueError(f"{name}: contains NaN; use +inf where there is no surface")
     a = np.ascontiguousarray(value, dtype=np.float32)
     if not (a > 0).all():
-        raise ValueError(
-            f"{name}: depths must be > 0 (planar distance from the light) or +inf where empty"
-        )
+        raise ValueError(f"{name}: depths must be > 0 (planar distance from the light) or +inf where empty")
     return a

@@ -84,9 +84,7 @@ def shadow_mask(v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD) -> np.ndarr
     return (1.0 - reference) > _threshold(threshold)
 
 
-def shadow_error(
-    v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD
-) -> float:
+def shadow_error(v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD) -> float:
     """Mean absolute visibility error over the reference soft shadow.
 
     The error metric of Atty et al. 2005, §4.2.1: ``sum |v - v_ref|`` over
@@ -168,9 +166,7 @@ def max_error(v: Any, v_ref: Any, *, mask: Any = None) -> float:
     return float(np.max(np.abs(a[selected] - b[selected])))
 
 
-def compare(
-    v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD
-) -> dict[str, float | int]:
+def compare(v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD) -> dict[str, float | int]:
     """All metrics at once.
 
     Parameters

@@ -33,8 +33,9 @@ import os
 import re
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -108,8 +109,7 @@ def _import_mitsuba() -> tuple[Any, Any]:
         import mitsuba as mi
     except ImportError as exc:
         raise ImportError(
-            "softshadow.reference needs Mitsuba 3 and Dr.Jit; install them with "
-            f"`{_INSTALL_HINT}`"
+            f"softshadow.reference needs Mitsuba 3 and Dr.Jit; install them with `{_INSTALL_HINT}`"
         ) from exc
     return mi, dr
 
@@ -131,13 +131,10 @@ def _choose_variant(mi: Any, dr: Any) -> str:
     forced = os.environ.get(VARIANT_ENV)
     if forced:
         if forced not in _SUPPORTED_VARIANTS:
-            raise ValueError(
-                f"{VARIANT_ENV}={forced!r}: expected one of {_SUPPORTED_VARIANTS}"
-            )
+            raise ValueError(f"{VARIANT_ENV}={forced!r}: expected one of {_SUPPORTED_VARIANTS}")
         if forced == "llvm_ad_rgb" and not _llvm_usable(mi, dr):
             raise RuntimeError(
-                f"{VARIANT_ENV}=llvm_ad_rgb but Dr.Jit cannot use libLLVM >= "
-                f"{_MIN_LLVM_MAJOR}; set DRJIT_LIBLLVM_PATH"
+                f"{VARIANT_ENV}=llvm_ad_rgb but Dr.Jit cannot use libLLVM >= {_MIN_LLVM_MAJOR}; set DRJIT_LIBLLVM_PATH"
             )
         return forced
     # Respect a supported variant the user already selected in this process.
@@ -279,10 +276,7 @@ def _mesh_arrays(meshes: Any, name: str) -> list[tuple[np.ndarray, np.ndarray]]:
         elif isinstance(mesh, (tuple, list)) and len(mesh) == 2:
             vertices, faces = mesh
         else:
-            raise TypeError(
-                f"{label} must be a (vertices, faces) pair or have "
-                ".vertices and .faces"
-            )
+            raise TypeError(f"{label} must be a (vertices, faces) pair or have .vertices and .faces")
         vertices = np.asarray(vertices, dtype=np.float64)
         faces = np.asarray(faces)
         if vertices.ndim != 2 or vertices.shape[1] != 3:
@@ -311,9 +305,7 @@ def _mesh_arrays(meshes: Any, name: str) -> list[tuple[np.ndarray, np.ndarray]]:
 # --------------------------------------------------------------------------
 
 
-def _mitsuba_mesh(
-    mi: Any, name: str, vertices: np.ndarray, faces: np.ndarray, bsdf: Any = None
-) -> Any:
+def _mitsuba_mesh(mi: Any, name: str, vertices: np.ndarray, faces: np.ndarray, bsdf: Any = None) -> Any:
     """Build a ``mi.Mesh`` from float32 vertices and uint32 faces (no files)."""
     props = mi.Properties()
     if bsdf is not None:
@@ -488,9 +480,7 @@ class ReferenceScene:
         """The Mitsuba variant the scene was built with."""
         return self._variant
 
-    def visibility(
-        self, light: Any, points: Any, *, samples: int = 1024, seed: int = 0
-    ) -> np.ndarray:
+    def visibility(self, light: Any, points: Any, *, samples: int = 1024, seed: int = 0) -> np.ndarray:
         """Fraction of the light's area visible from each point.
 
         Parameters
@@ -542,9 +532,7 @@ class ReferenceScene:
         )
         return visibility
 
-    def _trace(
-        self, mi: Any, origins: np.ndarray, directions: np.ndarray, maxt: np.ndarray
-    ) -> np.ndarray:
+    def _trace(self, mi: Any, origins: np.ndarray, directions: np.ndarray, maxt: np.ndarray) -> np.ndarray:
         """Run ``ray_test`` on a batch of rays; return the hit flags (bool)."""
         if self._variant.startswith("scalar"):
             return self._trace_scalar(mi, origins, directions, maxt)
@@ -558,9 +546,7 @@ class ReferenceScene:
         hits = self._scene.ray_test(ray, coherent=False)
         return np.asarray(hits.numpy(), dtype=bool)
 
-    def _trace_scalar(
-        self, mi: Any, origins: np.ndarray, directions: np.ndarray, maxt: np.ndarray
-    ) -> np.ndarray:
+    def _trace_scalar(self, mi: Any, origins: np.ndarray, directions: np.ndarray, maxt: np.ndarray) -> np.ndarray:
         """Scalar-variant fallback: one Python call per ray (~1e6 rays/s)."""
         hits = np.empty(len(maxt), dtype=bool)
         for index in range(len(maxt)):
@@ -617,9 +603,7 @@ def visibility_at_points(
     return occluders.visibility(light, points, samples=samples, seed=seed)
 
 
-def _texel_world_points(
-    light: Any, extent: Any, depth: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def _texel_world_points(light: Any, extent: Any, depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """World points of receiver texels of a light-view map.
 
     Texel [j, i] of an (H, W) map looks along ``n + x u + y v`` with
@@ -656,15 +640,11 @@ def _receiver_depth(shadow_map: Any) -> np.ndarray:
     """Validate ``shadow_map.receiver_depth``: (H, W), positive or +inf."""
     depth = np.asarray(shadow_map.receiver_depth, dtype=np.float64)
     if depth.ndim != 2:
-        raise ValueError(
-            f"shadow_map.receiver_depth must be 2-D (H, W), got {depth.shape}"
-        )
+        raise ValueError(f"shadow_map.receiver_depth must be 2-D (H, W), got {depth.shape}")
     if np.any(np.isnan(depth)):
         raise ValueError("shadow_map.receiver_depth contains NaN")
     if np.any(depth <= 0):  # also rejects -inf
-        raise ValueError(
-            "shadow_map.receiver_depth must be positive (inf where no receiver)"
-        )
+        raise ValueError("shadow_map.receiver_depth must be positive (inf where no receiver)")
     return depth
 
 
@@ -702,9 +682,7 @@ def reference_map(
     points, mask = _texel_world_points(shadow_map.light, shadow_map.extent, depth)
     result = np.ones(depth.shape, dtype=np.float32)
     if len(points):
-        result[mask] = visibility_at_points(
-            occluders, shadow_map.light, points, samples=samples, seed=seed
-        )
+        result[mask] = visibility_at_points(occluders, shadow_map.light, points, samples=samples, seed=seed)
     return result
 
 
@@ -793,9 +771,7 @@ def render_image(
             "type": "perspective",
             "fov": float(fov),
             "fov_axis": "x",
-            "to_world": mi.ScalarTransform4f().look_at(
-                origin=origin.tolist(), target=target.tolist(), up=up.tolist()
-            ),
+            "to_world": mi.ScalarTransform4f().look_at(origin=origin.tolist(), target=target.tolist(), up=up.tolist()),
             "sampler": {"type": "independent", "sample_count": spp},
             "film": {
                 "type": "hdrfilm",

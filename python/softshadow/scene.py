@@ -18,10 +18,7 @@ def as_mesh(obj: Any, name: str) -> Mesh:
     elif isinstance(obj, (tuple, list)) and len(obj) == 2:
         verts, faces = obj
     else:
-        raise TypeError(
-            f"{name}: must be a trimesh.Trimesh or a (vertices, faces) pair, "
-            f"got {type(obj).__name__}"
-        )
+        raise TypeError(f"{name}: must be a trimesh.Trimesh or a (vertices, faces) pair, got {type(obj).__name__}")
     v = np.asarray(verts)
     f = np.asarray(faces)
     if v.dtype.kind not in "fiu":
@@ -38,9 +35,7 @@ def as_mesh(obj: Any, name: str) -> Mesh:
         k = int(np.argmax(bad))
         raise ValueError(f"{name}: vertex {k} is not finite: {v[k].tolist()}")
     if f.size and (f.min() < 0 or f.max() >= len(v)):
-        raise ValueError(
-            f"{name}: face indices must lie in [0, {len(v)}), got [{f.min()}, {f.max()}]"
-        )
+        raise ValueError(f"{name}: face indices must lie in [0, {len(v)}), got [{f.min()}, {f.max()}]")
     return v, np.ascontiguousarray(f, dtype=np.uint32)
 
 
@@ -49,7 +44,7 @@ def _concat(meshes: list[Mesh]) -> Mesh:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.uint32)
     offsets = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
     verts = np.concatenate([v for v, _ in meshes])
-    faces = np.concatenate([f + np.uint32(o) for (_, f), o in zip(meshes, offsets)])
+    faces = np.concatenate([f + np.uint32(o) for (_, f), o in zip(meshes, offsets, strict=True)])
     return np.ascontiguousarray(verts), np.ascontiguousarray(faces, dtype=np.uint32)
 
 
