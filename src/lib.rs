@@ -3,6 +3,10 @@
 //! The core (everything but `python`) has no Python in it: the pyo3 bindings
 //! are one thin layer behind the `python` feature.
 
+// `!(x > 0.0)` is how the core says "not positive, or NaN": the negated
+// comparison is the point, not an accident.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod error;
 pub mod extent;
 pub mod light;

@@ -130,7 +130,7 @@ impl MapGrid {
                 format!("must be at least 1x1, got {width}x{height}"),
             ));
         }
-        let texels = width.checked_mul(height).unwrap_or(usize::MAX);
+        let texels = width.saturating_mul(height);
         if texels > MAX_TEXELS {
             return Err(Error::too_large(
                 "resolution",

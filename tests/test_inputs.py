@@ -179,3 +179,16 @@ def test_the_core_refuses_bad_values_even_past_the_python_checks():
         _core.shadow_map_from_depth(
             good_depth()[0][:, ::2], None, good_depth()[1][:, ::2], (1.0, 1.0), (0.5, 0.5), "ssm"
         )
+
+
+def test_the_core_checks_shapes_not_just_sizes():
+    from softshadow import _core
+
+    occ = np.full((8, 16), 2.0, np.float32)
+    rec = np.full((16, 8), 4.0, np.float32)
+    with pytest.raises(ValueError, match="occluder_depth.*shape"):
+        _core.shadow_map_from_depth(occ, None, rec, (1.0, 1.0), (0.5, 0.5), "ssm")
+    with pytest.raises(ValueError, match="occluder_depth_back.*shape"):
+        _core.sample_points(
+            rec, occ, ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)), (0.5, 0.5), np.zeros((1, 3)), "ssm"
+        )

@@ -62,3 +62,18 @@ def test_demo_writes_maps_and_reports_the_error(tmp_path, capsys):
     np.testing.assert_array_equal(png, io.to_uint8(exr))
     err = float(out.split("§4.2.1): ")[1].split(";")[0])
     assert 0.0 < err < 0.08
+
+
+def test_shadow_map_writes_all_its_maps(tmp_path):
+    pytest.importorskip("OpenEXR")
+    import softshadow as ss
+    from softshadow import scenes
+
+    scene, light = scenes.square_plate()
+    sm = ss.soft_shadow_map(scene, light, resolution=(24, 16))
+    sm.write_exr(tmp_path / "sm.exr")
+    back = io.read_exr(tmp_path / "sm.exr")
+    assert set(back) == {"V", "receiver", "occluder", "occluder_back"}
+    np.testing.assert_array_equal(back["V"], sm.visibility)
+    np.testing.assert_array_equal(back["occluder"], sm.occluder_depth)  # inf survives
+    assert "24x16" in repr(sm) and "passes=2" in repr(sm)

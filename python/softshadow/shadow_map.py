@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -17,7 +18,7 @@ BACKENDS = ("cpu",)
 LATER_BACKENDS = ("gpu", "auto")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class ShadowMap:
     """A soft shadow map and the light-view maps it was computed from.
 
@@ -51,6 +52,27 @@ class ShadowMap:
         """(W, H)."""
         h, w = self.visibility.shape
         return w, h
+
+    def __repr__(self) -> str:
+        w, h = self.resolution
+        total = sum(self.timings.values()) * 1e3
+        return (
+            f"ShadowMap({w}x{h}, method={self.method!r}, passes={self.passes}, "
+            f"extent=({self.extent[0]:.4g}, {self.extent[1]:.4g}), "
+            f"visibility in [{float(self.visibility.min()):.3f}, {float(self.visibility.max()):.3f}], "
+            f"{total:.1f} ms)"
+        )
+
+    def write_exr(self, path: str | os.PathLike[str]) -> None:
+        """Writes the visibility (channel ``V``) and the depth maps (``receiver``,
+        ``occluder``, ``occluder_back`` with two passes) as one float32 EXR file.
+        Needs ``OpenEXR`` (``pip install softshadow[io]``)."""
+        from .io import write_exr
+
+        channels = {"V": self.visibility, "receiver": self.receiver_depth, "occluder": self.occluder_depth}
+        if self.occluder_depth_back is not None:
+            channels["occluder_back"] = self.occluder_depth_back
+        write_exr(path, channels)
 
     def sample(self, points: Any, *, outside: float | None = None) -> np.ndarray:
         """Visibility (N,) float32 at world points lying on receivers.

@@ -46,6 +46,16 @@ fn triples<'a, T: numpy::Element>(
     Ok(unsafe { std::slice::from_raw_parts(s.as_ptr() as *const [T; 3], s.len() / 3) })
 }
 
+fn same_shape(arg: &str, got: &[usize], want: &[usize]) -> PyResult<()> {
+    if got == want {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{arg}: shape {got:?} differs from {want:?}"
+        )))
+    }
+}
+
 fn timings_dict<'py>(py: Python<'py>, t: &Timings) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     for (k, v) in t {
@@ -129,6 +139,10 @@ fn shadow_map_from_depth<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::parse(method)?;
     let shape = receiver_depth.shape();
+    same_shape("occluder_depth", occluder_depth.shape(), shape)?;
+    if let Some(b) = &occluder_depth_back {
+        same_shape("occluder_depth_back", b.shape(), shape)?;
+    }
     let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
     let front = slice("occluder_depth", &occluder_depth)?;
     let back = match &occluder_depth_back {
@@ -159,6 +173,9 @@ fn sample_points<'py>(
     let light = light_of(light)?;
     let method = Method::parse(method)?;
     let shape = occluder_depth.shape();
+    if let Some(b) = &occluder_depth_back {
+        same_shape("occluder_depth_back", b.shape(), shape)?;
+    }
     let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
     let front = slice("occluder_depth", &occluder_depth)?;
     let back = match &occluder_depth_back {
