@@ -189,6 +189,4 @@ def test_the_core_checks_shapes_not_just_sizes():
     with pytest.raises(ValueError, match="occluder_depth.*shape"):
         _core.shadow_map_from_depth(occ, None, rec, (1.0, 1.0), (0.5, 0.5), "ssm")
     with pytest.raises(ValueError, match="occluder_depth_back.*shape"):
-        _core.sample_points(
-            rec, occ, ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)), (0.5, 0.5), np.zeros((1, 3)), "ssm"
-        )
+        _core.sample_points(rec, occ, ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)), (0.5, 0.5), np.zeros((1, 3)), "ssm")
