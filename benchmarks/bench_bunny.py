@@ -30,6 +30,7 @@ import softshadow as ss  # noqa: E402
 from softshadow import metrics, reference, scenes  # noqa: E402
 
 MITSUBA_SAMPLES = (4, 16, 64, 256)
+EXACT_SAMPLES = (16, 64, 256)
 
 
 def median_time(fn, repeats):
@@ -95,6 +96,14 @@ def main() -> None:
             t_mi_s = f"{t_mi * 1e3:.1f}" if np.isfinite(t_mi) else "n/a"
             name = f"ssm, {passes} pass{'es' if passes > 1 else ''}"
             print(f"| {res}² | {name} | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s}{note} | {ratio} | |")
+        for k in EXACT_SAMPLES:
+
+            def run_exact(k=k, res=res):
+                return ss.soft_shadow_map(scene, light, resolution=res, method="exact", samples=k)
+
+            t = median_time(run_exact, max(3, a.repeats // 3))
+            err = metrics.shadow_error(run_exact().visibility, ref)
+            print(f"| {res}² | exact | {k} | {t * 1e3:.1f} | {err:.4f} | | | |")
         for k, err, t, whole in mi:
             print(f"| {res}² | Mitsuba ray_test | {k} | {t * 1e3:.1f} | {err:.4f} | | | {whole * 1e3:.1f} |")
 

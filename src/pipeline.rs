@@ -7,7 +7,7 @@ use crate::light::{check_light_size, MapGrid, RectLight};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
 use crate::raster::rasterize;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -31,7 +31,8 @@ pub struct ShadowResult {
     pub grid: MapGrid,
     pub visibility: Vec<f32>,
     pub receiver: Vec<f32>,
-    pub occluder_front: Vec<f32>,
+    /// The occluder maps; None for methods that trace triangles instead.
+    pub occluder_front: Option<Vec<f32>>,
     pub occluder_back: Option<Vec<f32>>,
     pub timings: Timings,
 }
@@ -111,28 +112,54 @@ pub fn from_meshes(
     let near = near_plane(&occ_ls, &rec_ls);
     let receiver = rasterize(&grid, &rec_ls, receivers.faces, near, false).nearest;
     sw.lap("raster_receivers");
-    let occ = rasterize(&grid, &occ_ls, occluders.faces, near, s.passes == 2);
-    sw.lap("raster_occluders");
-    let mut layers: Vec<&[f32]> = vec![&occ.nearest];
-    if let Some(back) = occ.farthest.as_deref() {
-        layers.push(back);
+    // Only what the method reads: occluder maps for the map methods, light-space
+    // triangles for the ray-traced one.
+    let (occ, triangles) = if s.method.traces_triangles() {
+        let t = light_space_triangles(&occ_ls, occluders.faces);
+        sw.lap("triangles");
+        (None, Some(t))
+    } else {
+        let o = rasterize(&grid, &occ_ls, occluders.faces, near, s.passes == 2);
+        sw.lap("raster_occluders");
+        (Some(o), None)
+    };
+    let mut layers: Vec<&[f32]> = vec![];
+    if let Some(o) = &occ {
+        layers.push(&o.nearest);
+        if let Some(back) = o.farthest.as_deref() {
+            layers.push(back);
+        }
     }
     let inputs = ShadowInputs {
         grid,
         light_size: light.size,
         receiver: &receiver,
         occluder_layers: layers,
+        occluder_triangles: triangles.as_deref(),
     };
     let visibility = s.method.implementation().visibility_map(&inputs);
     sw.lap("shadow");
+    let (occluder_front, occluder_back) = match occ {
+        Some(o) => (Some(o.nearest), o.farthest),
+        None => (None, None),
+    };
     Ok(ShadowResult {
         grid,
         visibility,
         receiver,
-        occluder_front: occ.nearest,
-        occluder_back: occ.farthest,
+        occluder_front,
+        occluder_back,
         timings: sw.timings,
     })
+}
+
+/// Occluder triangles in light space, in f32 (relative to the light's center,
+/// so precision does not depend on where the scene sits in the world).
+pub fn light_space_triangles(verts: &[DVec3], faces: &[[u32; 3]]) -> Vec<[Vec3; 3]> {
+    faces
+        .par_iter()
+        .map(|f| f.map(|i| verts[i as usize].as_vec3()))
+        .collect()
 }
 
 /// Checks a user depth map: finite and > 0, or +inf for "nothing here".
@@ -160,6 +187,12 @@ pub fn from_depth(
     method: Method,
 ) -> Result<(Vec<f32>, Timings)> {
     let light_size = check_light_size("light_size", light_size)?;
+    if method.traces_triangles() {
+        return Err(Error::invalid(
+            "method",
+            "traces the occluder triangles, which depth maps do not have; use soft_shadow_map with meshes",
+        ));
+    }
     for (arg, d) in [
         ("occluder_depth", Some(front)),
         ("occluder_depth_back", back),
@@ -190,20 +223,32 @@ pub fn from_depth(
         light_size,
         receiver,
         occluder_layers: layers,
+        occluder_triangles: None,
     };
     let v = method.implementation().visibility_map(&inputs);
     sw.lap("shadow");
     Ok((v, sw.timings))
 }
 
-/// Visibility at world points, from the occluder maps of a shadow map.
+/// What a method reads of the occluders when shading points.
+#[derive(Debug, Clone, Copy)]
+pub enum OccluderSource<'a> {
+    /// The occluder maps of a shadow map (front, and back with two passes).
+    Maps {
+        front: &'a [f32],
+        back: Option<&'a [f32]>,
+    },
+    /// The occluder triangles (world space).
+    Mesh(MeshRef<'a>),
+}
+
+/// Visibility at world points, from the occluders of a shadow map.
 /// Returns the visibility and whether each point fell inside the map (points
 /// outside it or at/behind the light's plane get visibility 1 and `false`).
 pub fn sample_points(
     grid: &MapGrid,
     light: &RectLight,
-    front: &[f32],
-    back: Option<&[f32]>,
+    occluders: OccluderSource,
     points: &[[f64; 3]],
     method: Method,
 ) -> Result<(Vec<f32>, Vec<bool>)> {
@@ -240,16 +285,37 @@ pub fn sample_points(
             )
         })
         .unzip();
-    let mut layers = vec![front];
-    if let Some(b) = back {
-        layers.push(b);
-    }
+    let (layers, triangles) = match occluders {
+        OccluderSource::Maps { front, back } => {
+            if method.traces_triangles() {
+                return Err(Error::invalid(
+                    "method",
+                    "traces triangles: pass the occluder mesh",
+                ));
+            }
+            let mut layers = vec![front];
+            layers.extend(back);
+            (layers, None)
+        }
+        OccluderSource::Mesh(mesh) => {
+            if !method.traces_triangles() {
+                return Err(Error::invalid(
+                    "method",
+                    "reads occluder maps: pass them, not the mesh",
+                ));
+            }
+            mesh.validate("occluders")?;
+            let ls = mesh.to_light_space(light);
+            (vec![], Some(light_space_triangles(&ls, mesh.faces)))
+        }
+    };
     // The receiver map is not read when shading points.
     let inputs = ShadowInputs {
         grid: *grid,
         light_size: light.size,
         receiver: &[],
         occluder_layers: layers,
+        occluder_triangles: triangles.as_deref(),
     };
     Ok((
         method.implementation().visibility_points(&inputs, &ls),

@@ -188,5 +188,10 @@ def test_the_core_checks_shapes_not_just_sizes():
     rec = np.full((16, 8), 4.0, np.float32)
     with pytest.raises(ValueError, match="occluder_depth.*shape"):
         _core.shadow_map_from_depth(occ, None, rec, (1.0, 1.0), (0.5, 0.5), "ssm")
+    light = ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1))
     with pytest.raises(ValueError, match="occluder_depth_back.*shape"):
-        _core.sample_points(rec, occ, ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)), (0.5, 0.5), np.zeros((1, 3)), "ssm")
+        _core.sample_points(
+            light, (0.5, 0.5), 8, 16, np.zeros((1, 3)), "ssm", occluder_depth=rec, occluder_depth_back=occ
+        )
+    with pytest.raises(ValueError, match="occluders: pass either"):
+        _core.sample_points(light, (0.5, 0.5), 8, 16, np.zeros((1, 3)), "ssm")

@@ -13,7 +13,9 @@ from . import _validate as check
 from .light import RectLight
 from .scene import Scene
 
-METHODS = ("ssm",)
+METHODS = ("ssm", "exact")
+SAMPLING_METHODS = ("exact",)
+DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 BACKENDS = ("cpu",)
 LATER_BACKENDS = ("gpu", "auto")
 
@@ -33,10 +35,11 @@ class ShadowMap:
     """(H, W) float32 in [0, 1]: fraction of the light's area seen from the
     receiver point of each texel; 1 where there is no receiver."""
     receiver_depth: np.ndarray
-    occluder_depth: np.ndarray
-    """Front (nearest) occluder depth."""
+    occluder_depth: np.ndarray | None
+    """Front (nearest) occluder depth; None for ``method="exact"``, which traces
+    the occluder triangles instead of reading maps."""
     occluder_depth_back: np.ndarray | None
-    """Back (farthest) occluder depth; None with one pass."""
+    """Back (farthest) occluder depth; None with one pass or ``"exact"``."""
     light: RectLight
     extent: tuple[float, float]
     """Tangent half-extents (tx, ty)."""
@@ -46,6 +49,9 @@ class ShadowMap:
     """True when ``extent`` was fitted to the shadows (``extent=None``)."""
     timings: dict[str, float] = field(default_factory=dict)
     """Seconds per stage, in the order the stages ran."""
+    samples: int | None = None
+    """Light samples per receiver (sampling methods), else None."""
+    _occluder_mesh: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
     @property
     def resolution(self) -> tuple[int, int]:
@@ -69,7 +75,9 @@ class ShadowMap:
         Needs ``OpenEXR`` (``pip install softshadow[io]``)."""
         from .io import write_exr
 
-        channels = {"V": self.visibility, "receiver": self.receiver_depth, "occluder": self.occluder_depth}
+        channels = {"V": self.visibility, "receiver": self.receiver_depth}
+        if self.occluder_depth is not None:
+            channels["occluder"] = self.occluder_depth
         if self.occluder_depth_back is not None:
             channels["occluder_back"] = self.occluder_depth_back
         write_exr(path, channels)
@@ -88,13 +96,21 @@ class ShadowMap:
             raise ValueError(f"points: must have shape (N, 3), got {pts.shape}")
         if not np.isfinite(pts).all():
             raise ValueError("points: must be finite")
+        w, h = self.resolution
+        if self.method in SAMPLING_METHODS:
+            ov, of = self._occluder_mesh
+            occ = {"occ_vertices": ov, "occ_faces": of}
+        else:
+            occ = {"occluder_depth": self.occluder_depth, "occluder_depth_back": self.occluder_depth_back}
         vis, inside = _core.sample_points(
-            self.occluder_depth,
-            self.occluder_depth_back,
             self.light._core_args(),
             self.extent,
+            w,
+            h,
             np.ascontiguousarray(pts),
             self.method,
+            self.samples,
+            **occ,
         )
         if not inside.all():
             if outside is None and not self.extent_fitted:
@@ -120,6 +136,7 @@ def soft_shadow_map(
     extent: float | tuple[float, float] | None = None,
     passes: int = 2,
     method: str = "ssm",
+    samples: int | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map of ``scene``'s occluders on its receivers.
@@ -145,6 +162,14 @@ def soft_shadow_map(
         larger occlusion (§3.5 of the paper).
     method
         ``"ssm"``: soft shadow maps as published (Atty et al. 2005).
+        ``"exact"``: ray casting against the occluder triangles (a BVH) with
+        ``samples`` stratified light samples per receiver texel, jittered
+        deterministically; converges to the true visibility as the samples
+        grow. It reads no occluder maps (``occluder_depth`` is None, and
+        ``passes`` does not apply).
+    samples
+        Light samples per receiver for ``"exact"`` (default 256, a 16x16
+        stratification); refused for ``"ssm"``.
     backend
         ``"cpu"`` (all cores).
     """
@@ -158,9 +183,17 @@ def soft_shadow_map(
     if passes not in (1, 2):
         raise ValueError(f"passes: must be 1 or 2, got {passes}")
     method = check.choice("method", method, METHODS)
+    if samples is not None:
+        samples = check.integer("samples", samples)
+        if method not in SAMPLING_METHODS:
+            raise ValueError(f"samples: applies to the sampling methods {SAMPLING_METHODS}, not to {method!r}")
+        if samples < 1:
+            raise ValueError(f"samples: must be >= 1, got {samples}")
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
-    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method)
+    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples)
+    if method in SAMPLING_METHODS and samples is None:
+        samples = DEFAULT_SAMPLES
     return ShadowMap(
         visibility=r["visibility"],
         receiver_depth=r["receiver_depth"],
@@ -172,6 +205,8 @@ def soft_shadow_map(
         passes=passes,
         extent_fitted=extent is None,
         timings=dict(r["timings"]),
+        samples=samples,
+        _occluder_mesh=(ov, of) if method in SAMPLING_METHODS else None,
     )
 
 

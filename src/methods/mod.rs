@@ -2,10 +2,12 @@
 //! method reads the same inputs (the light-view maps) and writes the same
 //! outputs (visibility per receiver texel, or per receiver point).
 
+pub mod exact;
 pub mod ssm;
 
 use crate::error::{Error, Result};
 use crate::light::MapGrid;
+use glam::Vec3;
 
 /// What every method reads: the light-view maps and the light's size.
 #[derive(Debug, Clone)]
@@ -17,6 +19,8 @@ pub struct ShadowInputs<'a> {
     pub receiver: &'a [f32],
     /// Occluder depth layers: the front (nearest) map, then the back (farthest) one.
     pub occluder_layers: Vec<&'a [f32]>,
+    /// Occluder triangles in light space, for the methods that trace them.
+    pub occluder_triangles: Option<&'a [[Vec3; 3]]>,
 }
 
 /// A receiver point in light space: tangent coordinates and planar depth.
@@ -41,22 +45,54 @@ pub trait ShadowMethod: Sync {
 pub enum Method {
     /// Soft shadow maps, Atty et al. 2005, as published (additive micro-patches).
     Ssm,
+    /// Ray casting against the occluder triangles with stratified light samples.
+    Exact { samples: u32 },
 }
 
+/// Default light samples per receiver for the sampling methods.
+pub const DEFAULT_SAMPLES: u32 = 256;
+/// The most light samples per receiver we accept.
+pub const MAX_SAMPLES: u32 = 1 << 16;
+
 impl Method {
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "ssm" => Ok(Method::Ssm),
-            other => Err(Error::invalid(
-                "method",
-                format!("unknown method {other:?}; available: \"ssm\""),
+    /// The method named `name`; `samples` is for the sampling methods only.
+    pub fn parse(name: &str, samples: Option<u32>) -> Result<Self> {
+        let method = match name {
+            "ssm" => Method::Ssm,
+            "exact" => Method::Exact {
+                samples: samples.unwrap_or(DEFAULT_SAMPLES),
+            },
+            other => {
+                return Err(Error::invalid(
+                    "method",
+                    format!("unknown method {other:?}; available: \"ssm\", \"exact\""),
+                ))
+            }
+        };
+        match (method, samples) {
+            (Method::Ssm, Some(_)) => Err(Error::invalid(
+                "samples",
+                "applies to the sampling methods (\"exact\"), not to \"ssm\"",
             )),
+            (Method::Exact { samples }, _) if samples == 0 || samples > MAX_SAMPLES => {
+                Err(Error::invalid(
+                    "samples",
+                    format!("must be in [1, {MAX_SAMPLES}], got {samples}"),
+                ))
+            }
+            _ => Ok(method),
         }
     }
 
-    pub fn implementation(&self) -> &'static dyn ShadowMethod {
-        match self {
-            Method::Ssm => &ssm::Ssm,
+    /// Whether the method reads the occluder triangles (not the occluder maps).
+    pub fn traces_triangles(&self) -> bool {
+        matches!(self, Method::Exact { .. })
+    }
+
+    pub fn implementation(&self) -> Box<dyn ShadowMethod> {
+        match *self {
+            Method::Ssm => Box::new(ssm::Ssm),
+            Method::Exact { samples } => Box::new(exact::Exact { samples }),
         }
     }
 }

@@ -613,6 +613,7 @@ mod tests {
                     light_size: [1.0, 0.7],
                     receiver: &receiver,
                     occluder_layers: layers,
+                    occluder_triangles: None,
                 };
                 let fast = Ssm.visibility_map(&inputs);
                 let slow = brute_force(&inputs);
@@ -668,6 +669,7 @@ mod tests {
             light_size: [1.0, 1.0],
             receiver: &receiver,
             occluder_layers: vec![&front],
+            occluder_triangles: None,
         };
         let v = Ssm.visibility_map(&inputs);
         let k = zr * zo / (zr - zo);
@@ -715,6 +717,7 @@ mod bench {
             light_size: [1.0, 1.0],
             receiver: &rec,
             occluder_layers: vec![&front, &back],
+            occluder_triangles: None,
         };
         let mut ts = vec![];
         let mut sum = 0.0;

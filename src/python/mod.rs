@@ -7,7 +7,7 @@ mod errors;
 use crate::light::{MapGrid, RectLight};
 use crate::mesh::MeshRef;
 use crate::methods::Method;
-use crate::pipeline::{self, MapSettings, Timings};
+use crate::pipeline::{self, MapSettings, OccluderSource, Timings};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -79,7 +79,7 @@ fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -93,9 +93,10 @@ fn shadow_map_from_meshes<'py>(
     extent: Option<(f64, f64)>,
     passes: u32,
     method: &str,
+    samples: Option<u32>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let light = light_of(light)?;
-    let method = Method::parse(method)?;
+    let method = Method::parse(method, samples)?;
     let occ = MeshRef {
         vertices: triples("occluders", &occ_vertices)?,
         faces: triples("occluders", &occ_faces)?,
@@ -117,10 +118,14 @@ fn shadow_map_from_meshes<'py>(
     d.set_item("timings", timings_dict(py, &r.timings)?)?;
     d.set_item("visibility", map(py, &r.grid, r.visibility)?)?;
     d.set_item("receiver_depth", map(py, &r.grid, r.receiver)?)?;
-    d.set_item("occluder_depth", map(py, &r.grid, r.occluder_front)?)?;
-    match r.occluder_back {
-        Some(b) => d.set_item("occluder_depth_back", map(py, &r.grid, b)?)?,
-        None => d.set_item("occluder_depth_back", py.None())?,
+    for (key, m) in [
+        ("occluder_depth", r.occluder_front),
+        ("occluder_depth_back", r.occluder_back),
+    ] {
+        match m {
+            Some(m) => d.set_item(key, map(py, &r.grid, m)?)?,
+            None => d.set_item(key, py.None())?,
+        }
     }
     Ok(d)
 }
@@ -137,7 +142,7 @@ fn shadow_map_from_depth<'py>(
     extent: (f64, f64),
     method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = Method::parse(method)?;
+    let method = Method::parse(method, None)?;
     let shape = receiver_depth.shape();
     same_shape("occluder_depth", occluder_depth.shape(), shape)?;
     if let Some(b) = &occluder_depth_back {
@@ -158,33 +163,54 @@ fn shadow_map_from_depth<'py>(
     Ok(d)
 }
 
-/// Visibility at world points from a shadow map's occluder maps.
+/// Visibility at world points from a shadow map's occluders: its occluder maps
+/// (map methods) or the occluder mesh (ray-traced methods).
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, light, extent, points, method))]
+#[pyo3(signature = (light, extent, width, height, points, method, samples=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None))]
+#[allow(clippy::too_many_arguments)]
 fn sample_points<'py>(
     py: Python<'py>,
-    occluder_depth: PyReadonlyArray2<'py, f32>,
-    occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
     light: Light,
     extent: (f64, f64),
+    width: usize,
+    height: usize,
     points: PyReadonlyArray2<'py, f64>,
     method: &str,
+    samples: Option<u32>,
+    occluder_depth: Option<PyReadonlyArray2<'py, f32>>,
+    occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
+    occ_vertices: Option<PyReadonlyArray2<'py, f64>>,
+    occ_faces: Option<PyReadonlyArray2<'py, u32>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let light = light_of(light)?;
-    let method = Method::parse(method)?;
-    let shape = occluder_depth.shape();
-    if let Some(b) = &occluder_depth_back {
-        same_shape("occluder_depth_back", b.shape(), shape)?;
-    }
-    let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
-    let front = slice("occluder_depth", &occluder_depth)?;
-    let back = match &occluder_depth_back {
-        Some(b) => Some(slice("occluder_depth_back", b)?),
-        None => None,
+    let method = Method::parse(method, samples)?;
+    let grid = MapGrid::new(width, height, [extent.0, extent.1])?;
+    let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
+        (Some(front), None, None) => {
+            same_shape("occluder_depth", front.shape(), &[height, width])?;
+            if let Some(b) = &occluder_depth_back {
+                same_shape("occluder_depth_back", b.shape(), &[height, width])?;
+            }
+            OccluderSource::Maps {
+                front: slice("occluder_depth", front)?,
+                back: match &occluder_depth_back {
+                    Some(b) => Some(slice("occluder_depth_back", b)?),
+                    None => None,
+                },
+            }
+        }
+        (None, Some(v), Some(f)) => OccluderSource::Mesh(MeshRef {
+            vertices: triples("occluders", v)?,
+            faces: triples("occluders", f)?,
+        }),
+        _ => {
+            return Err(PyValueError::new_err(
+                "occluders: pass either occluder_depth (and occluder_depth_back) or occ_vertices and occ_faces",
+            ))
+        }
     };
     let pts = triples("points", &points)?;
-    let (v, inside) =
-        py.detach(|| pipeline::sample_points(&grid, &light, front, back, pts, method))?;
+    let (v, inside) = py.detach(|| pipeline::sample_points(&grid, &light, source, pts, method))?;
     Ok((
         v.into_pyarray(py).into_any(),
         inside.into_pyarray(py).into_any(),
