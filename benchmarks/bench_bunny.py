@@ -4,7 +4,8 @@
 
 For the bunny floating over the floor (light 1x1 at distance 4, bunny 1 unit
 tall), at each resolution: the SSM's time end to end from meshes (one and two
-passes; median of --repeats runs) and its error (the paper's §4.2.1 metric)
+passes, occluder maps at the output's resolution and at 1/2 and 1/4 of it;
+median of --repeats runs) and its error (the paper's §4.2.1 metric)
 against a 1024-sample Mitsuba reference; Mitsuba's ray_test time (median,
 rays already in Dr.Jit arrays: the tracing alone) and error at 4, 16, 64 and 256
 samples per texel, and the whole softshadow.reference call (numpy points to
@@ -71,30 +72,33 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|")
     for res in a.resolutions:
         maps = {}
-        for passes in (1, 2):
+        # (passes, occluder map resolution): the paper's setup shares the
+        # output's resolution; coarser occluder maps are the cheap variant.
+        variants = [(p, o) for p in (1, 2) for o in (res, res // 2, res // 4) if o >= 32]
+        for passes, occ in variants:
 
-            def run(passes=passes, res=res):
-                return ss.soft_shadow_map(scene, light, resolution=res, passes=passes)
+            def run(passes=passes, res=res, occ=occ):
+                return ss.soft_shadow_map(scene, light, resolution=res, passes=passes, occluder_resolution=occ)
 
             t = median_time(run, a.repeats)
-            maps[passes] = (run(), t)
-        ref = reference.reference_map(maps[2][0], rscene, samples=a.reference_samples, seed=12345)
+            maps[(passes, occ)] = (run(), t)
+        base = maps[(2, res)][0]
+        ref = reference.reference_map(base, rscene, samples=a.reference_samples, seed=12345)
         mi = []
         for k in MITSUBA_SAMPLES:
             ts, whole = [], []
             for rep in range(max(3, a.repeats // 3)):
-                v = reference.reference_map(maps[2][0], rscene, samples=k, seed=rep)
+                v = reference.reference_map(base, rscene, samples=k, seed=rep)
                 ts.append(rscene.last_stats.trace_seconds)
                 whole.append(rscene.last_stats.total_seconds)
             mi.append((k, metrics.shadow_error(v, ref), float(np.median(ts)), float(np.median(whole))))
-        for passes in (1, 2):
-            sm, t = maps[passes]
+        for (passes, occ), (sm, t) in maps.items():
             err = metrics.shadow_error(sm.visibility, ref)
             t_mi, extrapolated = mitsuba_at_equal_error(err, mi)
             note = " (outside the measured range)" if extrapolated else ""
             ratio = f"{t / t_mi:.2f}" if np.isfinite(t_mi) else "n/a"
             t_mi_s = f"{t_mi * 1e3:.1f}" if np.isfinite(t_mi) else "n/a"
-            name = f"ssm, {passes} pass{'es' if passes > 1 else ''}"
+            name = f"ssm, {passes} pass{'es' if passes > 1 else ''}, occluders {occ}²"
             print(f"| {res}² | {name} | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s}{note} | {ratio} | |")
         for k in EXACT_SAMPLES:
 

@@ -29,6 +29,7 @@ pub type Timings = Vec<(&'static str, f64)>;
 #[derive(Debug, Clone)]
 pub struct ShadowResult {
     pub grid: MapGrid,
+    pub occluder_grid: MapGrid,
     pub visibility: Vec<f32>,
     pub receiver: Vec<f32>,
     /// The occluder maps; None for methods that trace triangles instead.
@@ -44,6 +45,8 @@ pub struct MapSettings {
     pub height: usize,
     /// Tangent half-extents, or `None` to fit them (see `extent.rs`).
     pub extent: Option<[f64; 2]>,
+    /// Resolution of the occluder maps (same extent); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
     pub passes: u32,
     pub method: Method,
 }
@@ -96,6 +99,9 @@ pub fn from_meshes(
     }
     // Refuse an absurd resolution before touching the meshes.
     MapGrid::new(s.width, s.height, s.extent.unwrap_or([1.0, 1.0]))?;
+    let (ow, oh) = s.occluder_resolution.unwrap_or((s.width, s.height));
+    MapGrid::new(ow, oh, s.extent.unwrap_or([1.0, 1.0]))
+        .map_err(|e| Error::invalid("occluder_resolution", e.to_string()))?;
     occluders.validate("occluders")?;
     receivers.validate("receivers")?;
 
@@ -108,6 +114,7 @@ pub fn from_meshes(
         None => fit_extent(&occ_ls, &rec_ls, light.size)?,
     };
     let grid = MapGrid::new(s.width, s.height, extent)?;
+    let occluder_grid = MapGrid::new(ow, oh, extent)?;
     sw.lap("extent");
     let near = near_plane(&occ_ls, &rec_ls);
     let receiver = rasterize(&grid, &rec_ls, receivers.faces, near, false).nearest;
@@ -119,7 +126,13 @@ pub fn from_meshes(
         sw.lap("triangles");
         (None, Some(t))
     } else {
-        let o = rasterize(&grid, &occ_ls, occluders.faces, near, s.passes == 2);
+        let o = rasterize(
+            &occluder_grid,
+            &occ_ls,
+            occluders.faces,
+            near,
+            s.passes == 2,
+        );
         sw.lap("raster_occluders");
         (Some(o), None)
     };
@@ -132,6 +145,7 @@ pub fn from_meshes(
     }
     let inputs = ShadowInputs {
         grid,
+        occluder_grid,
         light_size: light.size,
         receiver: &receiver,
         occluder_layers: layers,
@@ -145,6 +159,7 @@ pub fn from_meshes(
     };
     Ok(ShadowResult {
         grid,
+        occluder_grid,
         visibility,
         receiver,
         occluder_front,
@@ -180,6 +195,7 @@ pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
 /// Soft shadow map from depth maps the user rendered.
 pub fn from_depth(
     grid: &MapGrid,
+    occluder_grid: &MapGrid,
     light_size: [f64; 2],
     front: &[f32],
     back: Option<&[f32]>,
@@ -193,21 +209,16 @@ pub fn from_depth(
             "traces the occluder triangles, which depth maps do not have; use soft_shadow_map with meshes",
         ));
     }
-    for (arg, d) in [
-        ("occluder_depth", Some(front)),
-        ("occluder_depth_back", back),
-        ("receiver_depth", Some(receiver)),
+    for (arg, d, g) in [
+        ("occluder_depth", Some(front), occluder_grid),
+        ("occluder_depth_back", back, occluder_grid),
+        ("receiver_depth", Some(receiver), grid),
     ] {
         if let Some(d) = d {
-            if d.len() != grid.len() {
+            if d.len() != g.len() {
                 return Err(Error::shape(
                     arg,
-                    format!(
-                        "has {} texels, expected {}x{}",
-                        d.len(),
-                        grid.height,
-                        grid.width
-                    ),
+                    format!("has {} texels, expected {}x{}", d.len(), g.height, g.width),
                 ));
             }
             check_depth(arg, d)?;
@@ -220,6 +231,7 @@ pub fn from_depth(
     }
     let inputs = ShadowInputs {
         grid: *grid,
+        occluder_grid: *occluder_grid,
         light_size,
         receiver,
         occluder_layers: layers,
@@ -233,8 +245,10 @@ pub fn from_depth(
 /// What a method reads of the occluders when shading points.
 #[derive(Debug, Clone, Copy)]
 pub enum OccluderSource<'a> {
-    /// The occluder maps of a shadow map (front, and back with two passes).
+    /// The occluder maps of a shadow map (front, and back with two passes) on
+    /// their grid.
     Maps {
+        grid: MapGrid,
         front: &'a [f32],
         back: Option<&'a [f32]>,
     },
@@ -285,8 +299,12 @@ pub fn sample_points(
             )
         })
         .unzip();
-    let (layers, triangles) = match occluders {
-        OccluderSource::Maps { front, back } => {
+    let (layers, triangles, occluder_grid) = match occluders {
+        OccluderSource::Maps {
+            grid: og,
+            front,
+            back,
+        } => {
             if method.traces_triangles() {
                 return Err(Error::invalid(
                     "method",
@@ -295,7 +313,7 @@ pub fn sample_points(
             }
             let mut layers = vec![front];
             layers.extend(back);
-            (layers, None)
+            (layers, None, og)
         }
         OccluderSource::Mesh(mesh) => {
             if !method.traces_triangles() {
@@ -306,12 +324,13 @@ pub fn sample_points(
             }
             mesh.validate("occluders")?;
             let ls = mesh.to_light_space(light);
-            (vec![], Some(light_space_triangles(&ls, mesh.faces)))
+            (vec![], Some(light_space_triangles(&ls, mesh.faces)), *grid)
         }
     };
     // The receiver map is not read when shading points.
     let inputs = ShadowInputs {
         grid: *grid,
+        occluder_grid,
         light_size: light.size,
         receiver: &[],
         occluder_layers: layers,

@@ -10,6 +10,7 @@ error far past them (see test_mutations_are_caught).
 
 import numpy as np
 import pytest
+
 import softshadow as ss
 from softshadow import metrics, scenes
 

@@ -18,6 +18,7 @@ the four edges: |V_ssm - V_exact| <= 2 k (hw / Lx + hh / Ly).
 
 import numpy as np
 import pytest
+
 import softshadow as ss
 from softshadow import scenes
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 import softshadow as ss
 from softshadow import scenes
 
@@ -24,6 +25,39 @@ def test_depth_entry_matches_mesh_entry(bunny, passes):
     )
     np.testing.assert_array_equal(again.visibility, sm.visibility)
     assert again.passes == passes
+
+
+@pytest.mark.parametrize("occ_res", [(48, 40), (200, 160)])
+def test_occluder_maps_at_their_own_resolution(bunny, occ_res):
+    scene, light = bunny
+    sm = ss.soft_shadow_map(scene, light, resolution=(96, 80), occluder_resolution=occ_res)
+    w, h = occ_res
+    assert sm.visibility.shape == sm.receiver_depth.shape == (80, 96)
+    assert sm.occluder_depth.shape == sm.occluder_depth_back.shape == (h, w)
+    again = ss.soft_shadow_map_from_depth(
+        sm.occluder_depth,
+        sm.receiver_depth,
+        light_size=light.size,
+        extent=sm.extent,
+        occluder_depth_back=sm.occluder_depth_back,
+    )
+    np.testing.assert_array_equal(again.visibility, sm.visibility)
+    pts, idx = sm.receiver_points()
+    np.testing.assert_allclose(sm.sample(pts), sm.visibility.ravel()[idx], atol=1e-5)
+    # Close to the map with full-resolution occluders, not equal to it.
+    full = ss.soft_shadow_map(scene, light, resolution=(96, 80)).visibility
+    d = np.abs(sm.visibility - full)
+    assert 0 < d.mean() < 0.03
+
+
+def test_bad_occluder_resolution(bunny):
+    scene, light = bunny
+    with pytest.raises(ValueError, match="occluder_resolution"):
+        ss.soft_shadow_map(scene, light, occluder_resolution=0)
+    with pytest.raises(TypeError, match="occluder_resolution"):
+        ss.soft_shadow_map(scene, light, occluder_resolution=1.5)
+    with pytest.raises(ValueError, match="occluder_resolution.*exact"):
+        ss.soft_shadow_map(scene, light, method="exact", occluder_resolution=64)
 
 
 def test_shadow_map_contents(bunny):

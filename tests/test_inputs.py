@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 import softshadow as ss
 from softshadow import scenes
 
@@ -94,7 +95,6 @@ def test_occluders_behind_the_light_need_an_explicit_extent():
     [
         (lambda o, r: (np.ones(o.shape, np.int32), r), TypeError, "occluder_depth.*float"),
         (lambda o, r: (o, r.tolist()), TypeError, "receiver_depth.*numpy"),
-        (lambda o, r: (o[:4], r), ValueError, "occluder_depth.*shape"),
         (lambda o, r: (o[None], r), ValueError, "occluder_depth.*2-D"),
         (lambda o, r: (o, r[:, :0]), ValueError, "receiver_depth.*empty"),
         (lambda o, r: (np.where(o == 2.0, np.nan, o).astype(np.float32), r), ValueError, "occluder_depth.*NaN"),
@@ -186,8 +186,8 @@ def test_the_core_checks_shapes_not_just_sizes():
 
     occ = np.full((8, 16), 2.0, np.float32)
     rec = np.full((16, 8), 4.0, np.float32)
-    with pytest.raises(ValueError, match="occluder_depth.*shape"):
-        _core.shadow_map_from_depth(occ, None, rec, (1.0, 1.0), (0.5, 0.5), "ssm")
+    with pytest.raises(ValueError, match="occluder_depth_back.*shape"):
+        _core.shadow_map_from_depth(occ, np.ascontiguousarray(occ.T), rec, (1.0, 1.0), (0.5, 0.5), "ssm")
     light = ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1))
     with pytest.raises(ValueError, match="occluder_depth_back.*shape"):
         _core.sample_points(

@@ -34,18 +34,18 @@ def integer(name: str, value: Any) -> int:
     return int(value)
 
 
-def resolution(value: Any) -> tuple[int, int]:
+def resolution(value: Any, name: str = "resolution") -> tuple[int, int]:
     """``int`` (square) or ``(W, H)``; returns (W, H)."""
     if isinstance(value, (tuple, list)):
         if len(value) != 2:
-            raise ValueError(f"resolution: must be an int or (W, H), got {value!r}")
-        w, h = (integer("resolution", v) for v in value)
+            raise ValueError(f"{name}: must be an int or (W, H), got {value!r}")
+        w, h = (integer(name, v) for v in value)
     else:
-        w = h = integer("resolution", value)
+        w = h = integer(name, value)
     if w < 1 or h < 1:
-        raise ValueError(f"resolution: must be at least 1x1, got {w}x{h}")
+        raise ValueError(f"{name}: must be at least 1x1, got {w}x{h}")
     if w * h > MAX_TEXELS:
-        raise ValueError(f"resolution: {w}x{h} would need {w * h * 4} bytes per map (limit {MAX_TEXELS} texels)")
+        raise ValueError(f"{name}: {w}x{h} would need {w * h * 4} bytes per map (limit {MAX_TEXELS} texels)")
     return w, h
 
 
@@ -74,7 +74,7 @@ def choice(name: str, value: Any, allowed: tuple[str, ...], later: tuple[str, ..
     return value
 
 
-def depth_map(name: str, value: Any, shape: tuple[int, ...] | None = None) -> np.ndarray:
+def depth_map(name: str, value: Any, shape: tuple[int, ...] | None = None, like: str = "receiver_depth") -> np.ndarray:
     """A 2-D float depth map as C-contiguous float32 (a view when it already is one)."""
     if not isinstance(value, np.ndarray):
         raise TypeError(f"{name}: must be a numpy array, got {type(value).__name__}")
@@ -85,7 +85,7 @@ def depth_map(name: str, value: Any, shape: tuple[int, ...] | None = None) -> np
     if value.size == 0:
         raise ValueError(f"{name}: must not be empty, got shape {value.shape}")
     if shape is not None and value.shape != shape:
-        raise ValueError(f"{name}: shape {value.shape} differs from receiver_depth's {shape}")
+        raise ValueError(f"{name}: shape {value.shape} differs from {like}'s {shape}")
     if np.isnan(value).any():
         raise ValueError(f"{name}: contains NaN; use +inf where there is no surface")
     a = np.ascontiguousarray(value, dtype=np.float32)

@@ -137,6 +137,7 @@ def soft_shadow_map(
     passes: int = 2,
     method: str = "ssm",
     samples: int | None = None,
+    occluder_resolution: int | tuple[int, int] | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map of ``scene``'s occluders on its receivers.
@@ -170,6 +171,12 @@ def soft_shadow_map(
     samples
         Light samples per receiver for ``"exact"`` (default 256, a 16x16
         stratification); refused for ``"ssm"``.
+    occluder_resolution
+        Resolution of the occluder maps, ``int`` or ``(W, H)`` (same extent as
+        the output); default: ``resolution``. The SSM's cost grows with the
+        square of the occluder texel count per penumbra, so a coarser occluder
+        map is much cheaper; its error is the discretization of §4.1.1 (the
+        paper notes that large lights need fewer occluder texels).
     backend
         ``"cpu"`` (all cores).
     """
@@ -178,6 +185,7 @@ def soft_shadow_map(
     if not isinstance(light, RectLight):
         raise TypeError(f"light: must be a softshadow.RectLight, got {type(light).__name__}")
     w, h = check.resolution(resolution)
+    occ_res = None if occluder_resolution is None else check.resolution(occluder_resolution, "occluder_resolution")
     ext = None if extent is None else check.extent(extent)
     passes = check.integer("passes", passes)
     if passes not in (1, 2):
@@ -191,7 +199,9 @@ def soft_shadow_map(
             raise ValueError(f"samples: must be >= 1, got {samples}")
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
-    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples)
+    if occ_res is not None and method in SAMPLING_METHODS:
+        raise ValueError(f"occluder_resolution: {method!r} reads no occluder maps")
+    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, occ_res)
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(
@@ -223,7 +233,9 @@ def soft_shadow_map_from_depth(
     """Soft shadow map from light-view depth maps rendered by the caller.
 
     The maps follow the package's conventions (see :class:`ShadowMap`): planar
-    depth, float, ``inf`` where empty, all of one shape (H, W). With
+    depth, float, ``inf`` where empty, over one extent. The occluder maps may
+    have their own resolution (both of one shape); the output has the
+    receiver map's. With
     ``occluder_depth_back`` the result is the two-pass one. ``light_size`` is the
     light's (width, height) in the depth's units; ``extent`` the maps' tangent
     half-extents. The result's ``light`` is the canonical light of that size
@@ -231,10 +243,10 @@ def soft_shadow_map_from_depth(
     frame.
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
-    front = check.depth_map("occluder_depth", occluder_depth, rec.shape)
+    front = check.depth_map("occluder_depth", occluder_depth)
     back = None
     if occluder_depth_back is not None:
-        back = check.depth_map("occluder_depth_back", occluder_depth_back, rec.shape)
+        back = check.depth_map("occluder_depth_back", occluder_depth_back, front.shape, "occluder_depth")
     if np.isscalar(light_size):
         light_size = (light_size, light_size)
     size = check.vector("light_size", light_size, 2)

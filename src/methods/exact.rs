@@ -327,6 +327,7 @@ mod tests {
         let receiver = vec![zr as f32; n * n];
         let inputs = ShadowInputs {
             grid,
+            occluder_grid: grid,
             light_size: [1.0, 1.0],
             receiver: &receiver,
             occluder_layers: vec![],
@@ -369,6 +370,7 @@ mod tests {
         let grid = MapGrid::new(1, 1, [1.0, 1.0]).unwrap();
         let mk = |t| ShadowInputs {
             grid,
+            occluder_grid: grid,
             light_size: [1.0, 1.0],
             receiver: &[],
             occluder_layers: vec![],

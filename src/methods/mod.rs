@@ -12,7 +12,11 @@ use glam::Vec3;
 /// What every method reads: the light-view maps and the light's size.
 #[derive(Debug, Clone)]
 pub struct ShadowInputs<'a> {
+    /// The output grid, which the receiver map shares.
     pub grid: MapGrid,
+    /// The occluder maps' grid: the same extent, its own resolution (coarser
+    /// occluder maps cost less; the paper notes large lights need fewer texels).
+    pub occluder_grid: MapGrid,
     /// Full light width along u and height along v (world units).
     pub light_size: [f64; 2],
     /// Receiver planar depth per texel, `inf` where there is no receiver.

@@ -186,14 +186,18 @@ fn max(a: f32, b: f32) -> f32 {
 
 /// Everything the per-group loop reads, prepared once per call.
 struct Kernel {
+    /// The output (receiver) grid: width, column and row centers.
+    rec_width: usize,
+    rec_col_x: Vec<f32>,
+    rec_row_y: Vec<f32>,
+    /// The occluder grid from here on.
     width: usize,
     height: usize,
     blocks_per_row: usize,
     tx: f32,
     ty: f32,
-    /// Center (tangent x) of every column, its left edge, and the left edge
-    /// in half-light units (2 x0 / Lx).
-    col_x: Vec<f32>,
+    /// Left edge (tangent x) of every occluder column, and the left edge in
+    /// half-light units (2 x0 / Lx).
     col_x0: Vec<f32>,
     col_x0_scaled: Vec<f32>,
     /// Center (tangent y) of every row.
@@ -210,15 +214,19 @@ struct Kernel {
 
 impl Kernel {
     fn new(inputs: &ShadowInputs) -> Kernel {
-        let g = &inputs.grid;
+        // Occluder texels live on the occluder grid; receivers on the output grid.
+        let g = &inputs.occluder_grid;
+        let r = &inputs.grid;
         let (hw, hh) = g.half_texel();
         Kernel {
+            rec_width: r.width,
+            rec_col_x: (0..r.width).map(|i| r.x_of(i) as f32).collect(),
+            rec_row_y: (0..r.height).map(|j| r.y_of(j) as f32).collect(),
             width: g.width,
             height: g.height,
             blocks_per_row: g.width.div_ceil(BLOCK),
             tx: g.tx as f32,
             ty: g.ty as f32,
-            col_x: (0..g.width).map(|i| g.x_of(i) as f32).collect(),
             col_x0: (0..g.width).map(|i| (g.x_of(i) - hw) as f32).collect(),
             row_y: (0..g.height).map(|j| g.y_of(j) as f32).collect(),
             hw: hw as f32,
@@ -390,7 +398,7 @@ impl Kernel {
     /// of TILE_W columns by ROWS_PER_GROUP rows, so that a visit of an
     /// occluder row serves both output rows.
     fn shade_row_generic(&self, j0: usize, receiver: &[f32], out: &mut [f32]) {
-        let w = self.width;
+        let w = self.rec_width;
         let rows = receiver.len() / w;
         for c in (0..w).step_by(TILE_W) {
             let e = (c + TILE_W).min(w);
@@ -398,7 +406,11 @@ impl Kernel {
                 (0..TILE_W).map(move |k| {
                     let i = c + k;
                     if r < rows && i < e {
-                        (self.col_x[i], self.row_y[j0 + r], receiver[r * w + i])
+                        (
+                            self.rec_col_x[i],
+                            self.rec_row_y[j0 + r],
+                            receiver[r * w + i],
+                        )
                     } else {
                         (0.0, 0.0, f32::INFINITY)
                     }
@@ -485,7 +497,7 @@ impl Kernel {
 impl ShadowMethod for Ssm {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         let k = Kernel::new(inputs);
-        let w = k.width;
+        let w = k.rec_width;
         let mut out = vec![1f32; inputs.grid.len()];
         out.par_chunks_mut(w * ROWS_PER_GROUP)
             .zip(inputs.receiver.par_chunks(w * ROWS_PER_GROUP))
@@ -531,7 +543,8 @@ mod tests {
     /// occluder texel against every receiver texel, no bounds, no early exit.
     fn brute_force(inputs: &ShadowInputs) -> Vec<f32> {
         let g = &inputs.grid;
-        let (hw, hh) = g.half_texel();
+        let og = &inputs.occluder_grid;
+        let (hw, hh) = og.half_texel();
         let [lx, ly] = inputs.light_size;
         let overlap = |a: f64, b: f64| (b.clamp(0.0, 1.0) - a.clamp(0.0, 1.0)).max(0.0);
         let mut out = vec![1f32; g.len()];
@@ -545,14 +558,14 @@ mod tests {
                 let mut occ = 0f64;
                 for layer in &inputs.occluder_layers {
                     let mut sum = 0f64;
-                    for jo in 0..g.height {
-                        for io in 0..g.width {
-                            let zo = layer[jo * g.width + io] as f64;
+                    for jo in 0..og.height {
+                        for io in 0..og.width {
+                            let zo = layer[jo * og.width + io] as f64;
                             if !(zo < zr) {
                                 continue;
                             }
                             let k = zr * zo / (zr - zo);
-                            let (xc, yc) = (g.x_of(io), g.y_of(jo));
+                            let (xc, yc) = (og.x_of(io), og.y_of(jo));
                             let ox = overlap(
                                 k * (xc - hw - xr) / lx + 0.5,
                                 k * (xc + hw - xr) / lx + 0.5,
@@ -610,6 +623,7 @@ mod tests {
             for layers in [vec![&front[..]], vec![&front[..], &back[..]]] {
                 let inputs = ShadowInputs {
                     grid,
+                    occluder_grid: grid,
                     light_size: [1.0, 0.7],
                     receiver: &receiver,
                     occluder_layers: layers,
@@ -645,6 +659,43 @@ mod tests {
     }
 
     #[test]
+    fn coarser_or_finer_occluder_grids_match_the_brute_force_sum() {
+        let mut seed = 11u64;
+        let grid = MapGrid::new(40, 24, [0.4, 0.3]).unwrap();
+        let receiver: Vec<f32> = (0..grid.len())
+            .map(|_| (3.2 + lcg(&mut seed)) as f32)
+            .collect();
+        for (ow, oh) in [(13, 9), (64, 50), (1, 1)] {
+            let og = MapGrid::new(ow, oh, [0.4, 0.3]).unwrap();
+            let front: Vec<f32> = (0..og.len())
+                .map(|_| {
+                    if lcg(&mut seed) < 0.5 {
+                        (2.0 + lcg(&mut seed)) as f32
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+                .collect();
+            let inputs = ShadowInputs {
+                grid,
+                occluder_grid: og,
+                light_size: [0.8, 1.1],
+                receiver: &receiver,
+                occluder_layers: vec![&front],
+                occluder_triangles: None,
+            };
+            let fast = Ssm.visibility_map(&inputs);
+            let slow = brute_force(&inputs);
+            let max = fast
+                .iter()
+                .zip(&slow)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0f32, f32::max);
+            assert!(max < 2e-5, "{ow}x{oh}: {max}");
+        }
+    }
+
+    #[test]
     fn plate_over_parallel_floor_matches_the_closed_form() {
         // Plate covering tangent [-a, a]^2 at depth zo, floor at depth zr: the
         // occlusion is the overlap of the back-projected square with the light.
@@ -666,6 +717,7 @@ mod tests {
         let receiver = vec![zr as f32; n * n];
         let inputs = ShadowInputs {
             grid,
+            occluder_grid: grid,
             light_size: [1.0, 1.0],
             receiver: &receiver,
             occluder_layers: vec![&front],
@@ -714,6 +766,7 @@ mod bench {
         let grid = MapGrid::new(256, 256, [0.3137646436112252, 0.3050549377029778]).unwrap();
         let inputs = ShadowInputs {
             grid,
+            occluder_grid: grid,
             light_size: [1.0, 1.0],
             receiver: &rec,
             occluder_layers: vec![&front, &back],

@@ -79,7 +79,7 @@ fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, occluder_resolution=None))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -94,6 +94,7 @@ fn shadow_map_from_meshes<'py>(
     passes: u32,
     method: &str,
     samples: Option<u32>,
+    occluder_resolution: Option<(usize, usize)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let light = light_of(light)?;
     let method = Method::parse(method, samples)?;
@@ -109,6 +110,7 @@ fn shadow_map_from_meshes<'py>(
         width,
         height,
         extent: extent.map(|e| [e.0, e.1]),
+        occluder_resolution,
         passes,
         method,
     };
@@ -123,7 +125,7 @@ fn shadow_map_from_meshes<'py>(
         ("occluder_depth_back", r.occluder_back),
     ] {
         match m {
-            Some(m) => d.set_item(key, map(py, &r.grid, m)?)?,
+            Some(m) => d.set_item(key, map(py, &r.occluder_grid, m)?)?,
             None => d.set_item(key, py.None())?,
         }
     }
@@ -144,19 +146,30 @@ fn shadow_map_from_depth<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::parse(method, None)?;
     let shape = receiver_depth.shape();
-    same_shape("occluder_depth", occluder_depth.shape(), shape)?;
+    // The occluder maps may be coarser or finer than the receiver map (same extent).
+    let oshape = occluder_depth.shape();
     if let Some(b) = &occluder_depth_back {
-        same_shape("occluder_depth_back", b.shape(), shape)?;
+        same_shape("occluder_depth_back", b.shape(), oshape)?;
     }
     let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+    let occluder_grid = MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?;
     let front = slice("occluder_depth", &occluder_depth)?;
     let back = match &occluder_depth_back {
         Some(b) => Some(slice("occluder_depth_back", b)?),
         None => None,
     };
     let receiver = slice("receiver_depth", &receiver_depth)?;
-    let (v, t) =
-        py.detach(|| pipeline::from_depth(&grid, light_size, front, back, receiver, method))?;
+    let (v, t) = py.detach(|| {
+        pipeline::from_depth(
+            &grid,
+            &occluder_grid,
+            light_size,
+            front,
+            back,
+            receiver,
+            method,
+        )
+    })?;
     let d = PyDict::new(py);
     d.set_item("timings", timings_dict(py, &t)?)?;
     d.set_item("visibility", map(py, &grid, v)?)?;
@@ -187,11 +200,12 @@ fn sample_points<'py>(
     let grid = MapGrid::new(width, height, [extent.0, extent.1])?;
     let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
         (Some(front), None, None) => {
-            same_shape("occluder_depth", front.shape(), &[height, width])?;
+            let oshape = front.shape();
             if let Some(b) = &occluder_depth_back {
-                same_shape("occluder_depth_back", b.shape(), &[height, width])?;
+                same_shape("occluder_depth_back", b.shape(), oshape)?;
             }
             OccluderSource::Maps {
+                grid: MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?,
                 front: slice("occluder_depth", front)?,
                 back: match &occluder_depth_back {
                     Some(b) => Some(slice("occluder_depth_back", b)?),
