@@ -1,0 +1,342 @@
+"""The study: what accuracy costs in time, and the paper's experiments.
+
+    python -m softshadow.study [--out study] [--resolution 256] [--quick]
+
+Against Mitsuba 3 references (1024 stratified light samples per texel), on
+2 cores, everything timed in one run:
+
+1. The accuracy-time plane, per scene (bunny floating, bunny on the floor, two
+   spheres at different heights, torus): error (the paper's §4.2.1 metric)
+   against time for ``ssm`` (1 and 2 passes, occluder maps at the output's
+   resolution and coarser), ``exact`` (several sample counts) and Mitsuba's
+   ``ray_test`` (several sample counts). SSM and exact times are end to end
+   from meshes; Mitsuba's are ``ray_test`` alone.
+2. The paper's §4.2 experiments (bunny floating): error against occluder-map
+   resolution, light size, the occluder's vertical position (its gap to the
+   floor) and its lateral position, for ``ssm`` (1 and 2 passes) and
+   ``exact`` (64 samples).
+3. The paper's §5 timings: time against polygon count (spheres of 1k to 1M
+   triangles), map size and light size.
+
+Writes PNG plots and ``study.md`` (markdown tables) into ``--out``. Needs the
+``reference`` and ``study`` extras (Mitsuba, matplotlib).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import metrics, scenes
+from .light import RectLight
+from .scene import Scene
+from .shadow_map import ShadowMap, soft_shadow_map
+
+PLANE_SCENES = ("bunny_floating", "bunny_on_floor", "two_spheres", "torus")
+
+
+@dataclass
+class Point:
+    """One measured setting: a method, its settings, time and error."""
+
+    scene: str
+    method: str
+    setting: str
+    seconds: float
+    error: float
+
+
+def median_seconds(fn: Callable[[], object], repeats: int) -> float:
+    fn()  # warm-up
+    ts = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t)
+    return float(np.median(ts))
+
+
+class Study:
+    def __init__(self, resolution: int, repeats: int, reference_samples: int, quick: bool) -> None:
+        from . import reference
+
+        self.reference = reference
+        self.res = resolution
+        self.repeats = repeats
+        self.ref_samples = reference_samples
+        self.quick = quick
+
+    def reference_map(self, sm: ShadowMap, scene: Scene) -> np.ndarray:
+        return self.reference.reference_map(sm, scene.occluders, samples=self.ref_samples, seed=12345)
+
+    # -- 1. the accuracy-time plane ------------------------------------------------
+
+    def plane(self, name: str) -> list[Point]:
+        scene, light = scenes.SCENES[name]()
+        res = self.res
+        base = soft_shadow_map(scene, light, resolution=res)
+        ref = self.reference_map(base, scene)
+        points: list[Point] = []
+
+        def measure(label: str, setting: str, **kw: object) -> None:
+            def run() -> ShadowMap:
+                return soft_shadow_map(scene, light, resolution=res, extent=base.extent, **kw)
+
+            t = median_seconds(run, self.repeats if label == "ssm" else max(1, self.repeats // 3))
+            points.append(Point(name, label, setting, t, metrics.shadow_error(run().visibility, ref)))
+
+        occ_levels = [res, res // 2, res // 4] if not self.quick else [res, res // 4]
+        for passes in (1, 2):
+            for occ in occ_levels:
+                measure(
+                    "ssm",
+                    f"{passes} pass{'es' if passes > 1 else ''}, occluders {occ}²",
+                    passes=passes,
+                    occluder_resolution=occ,
+                )
+        for k in (16, 64, 256) if not self.quick else (16, 64):
+            measure("exact", f"{k} samples", method="exact", samples=k)
+        rscene = self.reference.ReferenceScene(scene.occluders)
+        for k in (4, 16, 64, 256) if not self.quick else (4, 16, 64):
+            ts, err = [], 0.0
+            for rep in range(max(2, self.repeats // 3)):
+                v = self.reference.reference_map(base, rscene, samples=k, seed=rep)
+                ts.append(rscene.last_stats.trace_seconds)
+                err = metrics.shadow_error(v, ref)
+            points.append(Point(name, "mitsuba", f"{k} samples", float(np.median(ts)), err))
+        return points
+
+    # -- 2. the paper's §4.2 experiments -----------------------------------------
+
+    def experiment(
+        self,
+        label: str,
+        values: list[float],
+        make: Callable[[float], tuple[Scene, RectLight]],
+        res: int,
+        vary_occluder_res: bool = False,
+    ) -> dict[str, list[float]]:
+        curves: dict[str, list[float]] = {"ssm, 1 pass": [], "ssm, 2 passes": [], "exact, 64 samples": []}
+        for x in values:
+            scene, light = make(x)
+            occ = int(x) if vary_occluder_res else None
+            base = soft_shadow_map(scene, light, resolution=res)
+            ref = self.reference_map(base, scene)
+            for passes in (1, 2):
+                sm = soft_shadow_map(
+                    scene, light, resolution=res, extent=base.extent, passes=passes, occluder_resolution=occ
+                )
+                curves[f"ssm, {passes} pass{'es' if passes > 1 else ''}"].append(
+                    metrics.shadow_error(sm.visibility, ref)
+                )
+            ex = soft_shadow_map(scene, light, resolution=res, extent=base.extent, method="exact", samples=64)
+            curves["exact, 64 samples"].append(metrics.shadow_error(ex.visibility, ref))
+        return curves
+
+    # -- 3. the paper's §5 timings ------------------------------------------------
+
+    def timing(
+        self, values: list[float], make: Callable[[float], tuple[Scene, RectLight, int]]
+    ) -> dict[str, list[float]]:
+        curves: dict[str, list[float]] = {"ssm, 1 pass": [], "ssm, 2 passes": []}
+        for x in values:
+            scene, light, res = make(x)
+            for passes in (1, 2):
+
+                def run(scene=scene, light=light, res=res, passes=passes) -> ShadowMap:
+                    return soft_shadow_map(scene, light, resolution=res, passes=passes)
+
+                t = median_seconds(run, max(3, self.repeats // 2))
+                curves[f"ssm, {passes} pass{'es' if passes > 1 else ''}"].append(t)
+        return curves
+
+
+def bunny_with_light(size: float) -> tuple[Scene, RectLight]:
+    return scenes.bunny_floating(light_size=size)
+
+
+def bunny_at_gap(gap: float) -> tuple[Scene, RectLight]:
+    return scenes.bunny_floating(gap=gap)
+
+
+def bunny_shifted(dx: float) -> tuple[Scene, RectLight]:
+    v, f = scenes.bunny_mesh(1.0, 1.0)
+    v = v + np.array([dx, 0.0, 0.0])
+    return Scene(occluders=[(v, f)], receivers=[scenes.floor()]), scenes.default_light()
+
+
+def sphere_scene(segments: float) -> tuple[Scene, RectLight, int]:
+    mesh = scenes.sphere((0.0, 1.5, 0.0), 0.5, n=int(segments))
+    return Scene(occluders=[mesh], receivers=[scenes.floor()]), scenes.default_light(), 256
+
+
+def plot_plane(points: list[Point], path: str, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=110)
+    styles = {"ssm": ("o", "tab:blue"), "exact": ("s", "tab:green"), "mitsuba": ("^", "tab:red")}
+    for method, (marker, color) in styles.items():
+        pts = [p for p in points if p.method == method]
+        if not pts:
+            continue
+        ax.scatter(
+            [p.seconds * 1e3 for p in pts],
+            [p.error for p in pts],
+            marker=marker,
+            color=color,
+            label=method if method != "mitsuba" else "Mitsuba ray_test",
+        )
+        for p in pts:
+            ax.annotate(p.setting, (p.seconds * 1e3, p.error), fontsize=6, xytext=(3, 3), textcoords="offset points")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time (ms, 2 cores)")
+    ax.set_ylabel("error (mean |V - V_ref| over shadow texels)")
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def plot_curves(
+    x: list[float], curves: dict[str, list[float]], path: str, xlabel: str, ylabel: str, title: str, logy: bool = False
+) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.6, 3.8), dpi=110)
+    for name, ys in curves.items():
+        ax.plot(x, ys, marker="o", label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if logy:
+        ax.set_yscale("log")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def markdown_plane(points: list[Point]) -> str:
+    lines = ["| scene | method | setting | time (ms) | error |", "|---|---|---|---|---|"]
+    for p in points:
+        lines.append(f"| {p.scene} | {p.method} | {p.setting} | {p.seconds * 1e3:.1f} | {p.error:.4f} |")
+    return "\n".join(lines)
+
+
+def markdown_curves(xlabel: str, x: list[float], curves: dict[str, list[float]], fmt: str) -> str:
+    head = f"| {xlabel} | " + " | ".join(curves) + " |"
+    sep = "|---" * (len(curves) + 1) + "|"
+    rows = [f"| {xv:g} | " + " | ".join(format(c[i], fmt) for c in curves.values()) + " |" for i, xv in enumerate(x)]
+    return "\n".join([head, sep, *rows])
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m softshadow.study", description=__doc__.split("\n")[0])
+    p.add_argument("--out", default="study", help="output folder (default: study)")
+    p.add_argument("--resolution", type=int, default=256, help="map size for the accuracy-time plane")
+    p.add_argument("--repeats", type=int, default=7, help="timing repeats (medians are reported)")
+    p.add_argument("--reference-samples", type=int, default=1024)
+    p.add_argument("--quick", action="store_true", help="fewer settings, 128² experiments (a few minutes)")
+    p.add_argument("--scenes", nargs="+", default=list(PLANE_SCENES), choices=sorted(scenes.SCENES))
+    p.add_argument(
+        "--parts", nargs="+", default=["plane", "experiments", "timings"], choices=["plane", "experiments", "timings"]
+    )
+    a = p.parse_args(argv)
+    os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
+    os.makedirs(a.out, exist_ok=True)
+    st = Study(a.resolution, a.repeats, a.reference_samples, a.quick)
+    md = ["# softshadow study", "", f"Generated by `python -m softshadow.study {' '.join(argv or sys.argv[1:])}`.", ""]
+
+    if "plane" in a.parts:
+        md += ["## 1. Accuracy against time", ""]
+        all_points: list[Point] = []
+        for name in a.scenes:
+            pts = st.plane(name)
+            all_points += pts
+            plot_plane(pts, os.path.join(a.out, f"plane_{name}.png"), f"{name}, {a.resolution}²")
+            print(f"plane {name}: {len(pts)} settings", flush=True)
+        md += [markdown_plane(all_points), ""]
+        md += [f"![{n}](plane_{n}.png)" for n in a.scenes] + [""]
+
+    exp_res = 128 if a.quick else a.resolution // 2
+    if "experiments" in a.parts:
+        md += [f"## 2. Error against the paper's parameters (bunny floating, {exp_res}²)", ""]
+        experiments = [
+            (
+                "occluder map resolution",
+                [32, 64, 128, 256] if not a.quick else [32, 64, 128],
+                lambda x: scenes.bunny_floating(),
+                True,
+            ),
+            ("light size", [0.25, 0.5, 1.0, 1.5, 2.0], bunny_with_light, False),
+            ("gap to the floor", [0.1, 0.5, 1.0, 1.5, 2.0], bunny_at_gap, False),
+            ("lateral offset", [0.0, 0.5, 1.0, 1.5], bunny_shifted, False),
+        ]
+        for label, values, make, vary in experiments:
+            curves = st.experiment(label, values, make, exp_res, vary)
+            fname = "error_vs_" + label.replace(" ", "_") + ".png"
+            plot_curves(values, curves, os.path.join(a.out, fname), label, "error", f"error vs {label}")
+            md += [
+                f"### Error against {label}",
+                "",
+                markdown_curves(label, values, curves, ".4f"),
+                "",
+                f"![]({fname})",
+                "",
+            ]
+            print(f"experiment {label}: done", flush=True)
+
+    if "timings" in a.parts:
+        md += ["## 3. Time against polygon count, map size and light size (ssm)", ""]
+        timings = [
+            (
+                "sphere segments (triangles ~ segments²)",
+                [24, 64, 180, 500, 1000] if not a.quick else [24, 180, 500],
+                sphere_scene,
+            ),
+            (
+                "map size",
+                [64, 128, 256, 512] if not a.quick else [64, 128, 256],
+                lambda r: (*scenes.bunny_floating(), int(r)),
+            ),
+            ("light size", [0.25, 0.5, 1.0, 2.0], lambda s: (*scenes.bunny_floating(light_size=s), 256)),
+        ]
+        for label, values, make in timings:
+            curves = st.timing(values, make)
+            ms = {k: [v * 1e3 for v in vs] for k, vs in curves.items()}
+            fname = "time_vs_" + label.split(" (")[0].replace(" ", "_") + ".png"
+            plot_curves(values, ms, os.path.join(a.out, fname), label, "time (ms)", f"time vs {label}", logy=True)
+            md += [
+                f"### Time (ms) against {label}",
+                "",
+                markdown_curves(label, values, ms, ".1f"),
+                "",
+                f"![]({fname})",
+                "",
+            ]
+            print(f"timing {label}: done", flush=True)
+
+    with open(os.path.join(a.out, "study.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    print(f"wrote {a.out}/study.md and its plots")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,42 @@
+"""The study command runs end to end and writes its table and plots."""
+
+import pytest
+
+pytest.importorskip("matplotlib")
+pytest.importorskip("mitsuba")
+
+
+def test_study_plane_on_a_small_map(tmp_path):
+    from softshadow.study import main
+
+    out = tmp_path / "study"
+    assert (
+        main(
+            [
+                "--out",
+                str(out),
+                "--quick",
+                "--resolution",
+                "64",
+                "--repeats",
+                "1",
+                "--scenes",
+                "square_plate",
+                "--parts",
+                "plane",
+                "timings",
+                "--reference-samples",
+                "256",
+            ]
+        )
+        == 0
+    )
+    md = (out / "study.md").read_text()
+    assert "| square_plate | ssm | 2 passes, occluders 64² |" in md
+    assert "| square_plate | exact | 16 samples |" in md
+    assert "| square_plate | mitsuba | 16 samples |" in md
+    assert (out / "plane_square_plate.png").stat().st_size > 10_000
+    assert (out / "time_vs_map_size.png").exists()
+    # The plate is the paper's easy case: the SSM is nearly exact on it.
+    row = next(line for line in md.splitlines() if "| square_plate | ssm | 2 passes, occluders 64² |" in line)
+    assert float(row.split("|")[5]) < 0.02
