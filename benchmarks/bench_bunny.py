@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import time
 
 import numpy as np
 
@@ -29,19 +28,10 @@ os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-1
 
 import softshadow as ss  # noqa: E402
 from softshadow import metrics, reference, scenes  # noqa: E402
+from softshadow.study import median_seconds as median_time  # noqa: E402
 
 MITSUBA_SAMPLES = (4, 16, 64, 256)
 EXACT_SAMPLES = (16, 64, 256)
-
-
-def median_time(fn, repeats):
-    fn()  # warm-up
-    ts = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t)
-    return float(np.median(ts))
 
 
 def mitsuba_at_equal_error(err, mi):

@@ -31,11 +31,15 @@ def shadow_map_from_meshes(
     extent: tuple[float, float] | None,
     passes: int,
     method: str,
+    samples: int | None = None,
+    occluder_resolution: tuple[int, int] | None = None,
 ) -> dict[str, Any]:
-    """Rasterizes occluders and receivers into light-view maps and computes the
-    visibility. Returns a dict with ``visibility``, ``receiver_depth``,
-    ``occluder_depth``, ``occluder_depth_back`` (None with one pass): (H, W)
-    float32 arrays; ``extent``: (tx, ty); ``timings``: {stage: seconds}."""
+    """Rasterizes the receivers (and, for the map methods, the occluders) into
+    light-view maps and computes the visibility. Returns a dict with
+    ``visibility`` and ``receiver_depth`` ((H, W) float32), ``occluder_depth``
+    and ``occluder_depth_back`` (on the occluder grid; None with one pass, or
+    for methods that trace triangles), ``extent``: (tx, ty) and ``timings``:
+    {stage: seconds}. ``samples`` is for the sampling methods only."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
@@ -45,18 +49,26 @@ def shadow_map_from_depth(
     extent: tuple[float, float],
     method: str,
 ) -> dict[str, Any]:
-    """Visibility from depth maps. Returns ``visibility`` and ``timings``."""
+    """Visibility from depth maps (the occluder maps may have their own
+    resolution; the output has the receiver map's). Returns ``visibility`` and
+    ``timings``."""
 
 def sample_points(
-    occluder_depth: npt.NDArray[np.float32],
-    occluder_depth_back: npt.NDArray[np.float32] | None,
     light: Light,
     extent: tuple[float, float],
+    width: int,
+    height: int,
     points: npt.NDArray[np.float64],
     method: str,
+    samples: int | None = None,
+    occluder_depth: npt.NDArray[np.float32] | None = None,
+    occluder_depth_back: npt.NDArray[np.float32] | None = None,
+    occ_vertices: npt.NDArray[np.float64] | None = None,
+    occ_faces: npt.NDArray[np.uint32] | None = None,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.bool_]]:
     """Visibility at world points (N, 3), and whether each lies inside the map
-    (points outside, or at or behind the light's plane, get 1 and False)."""
+    (points outside, or at or behind the light's plane, get 1 and False). The
+    occluders are the occluder maps (map methods) or the mesh (``"exact"``)."""
 
 def receiver_points(
     receiver_depth: npt.NDArray[np.float32],
