@@ -192,7 +192,7 @@ fn unit(h: u64) -> f32 {
 /// the longer side of the light getting the larger count.
 pub fn sample_grid(samples: u32, light_size: [f64; 2]) -> (u32, u32) {
     let mut a = (samples as f64).sqrt() as u32;
-    while a > 1 && samples % a != 0 {
+    while a > 1 && !samples.is_multiple_of(a) {
         a -= 1;
     }
     let a = a.max(1);

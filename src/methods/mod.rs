@@ -3,6 +3,7 @@
 //! outputs (visibility per receiver texel, or per receiver point).
 
 pub mod exact;
+mod gather;
 pub mod ssm;
 
 use crate::error::{Error, Result};
