@@ -48,6 +48,7 @@ def shadow_map_from_depth(
     light_size: tuple[float, float],
     extent: tuple[float, float],
     method: str,
+    samples: int | None = None,
 ) -> dict[str, Any]:
     """Visibility from depth maps (the occluder maps may have their own
     resolution; the output has the receiver map's). Returns ``visibility`` and

@@ -13,8 +13,11 @@ from . import _validate as check
 from .light import RectLight
 from .scene import Scene
 
-METHODS = ("ssm", "exact")
-SAMPLING_METHODS = ("exact",)
+METHODS = ("ssm", "bitmask", "exact")
+# Methods that take `samples=`; of them, those that trace the occluder
+# triangles (and so make no occluder maps).
+SAMPLING_METHODS = ("bitmask", "exact")
+TRACING_METHODS = ("exact",)
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 BACKENDS = ("cpu",)
 LATER_BACKENDS = ("gpu", "auto")
@@ -97,7 +100,7 @@ class ShadowMap:
         if not np.isfinite(pts).all():
             raise ValueError("points: must be finite")
         w, h = self.resolution
-        if self.method in SAMPLING_METHODS:
+        if self.method in TRACING_METHODS:
             ov, of = self._occluder_mesh
             occ = {"occ_vertices": ov, "occ_faces": of}
         else:
@@ -126,6 +129,17 @@ class ShadowMap:
         """World points (M, 3) float64 of the texels that have a receiver, and
         their flat texel indices (M,) into ``visibility.ravel()``."""
         return _core.receiver_points(self.receiver_depth, self.light._core_args(), self.extent)
+
+
+def _check_samples(samples: Any, method: str) -> int | None:
+    if samples is None:
+        return None
+    samples = check.integer("samples", samples)
+    if method not in SAMPLING_METHODS:
+        raise ValueError(f"samples: applies to the sampling methods {SAMPLING_METHODS}, not to {method!r}")
+    if samples < 1:
+        raise ValueError(f"samples: must be >= 1, got {samples}")
+    return samples
 
 
 def soft_shadow_map(
@@ -163,14 +177,19 @@ def soft_shadow_map(
         larger occlusion (§3.5 of the paper).
     method
         ``"ssm"``: soft shadow maps as published (Atty et al. 2005).
+        ``"bitmask"``: the micro-patches of the occluder maps mark the light
+        samples they hide in a bit mask per receiver (``samples``: 16, 64 or
+        256, a multi-jittered pattern shared by all receivers); masks merge
+        by OR, so overlapping back-projections count once and the two layers
+        combine without double counting (Schwarz & Stamminger 2007).
         ``"exact"``: ray casting against the occluder triangles (a BVH) with
         ``samples`` stratified light samples per receiver texel, jittered
         deterministically; converges to the true visibility as the samples
         grow. It reads no occluder maps (``occluder_depth`` is None, and
         ``passes`` does not apply).
     samples
-        Light samples per receiver for ``"exact"`` (default 256, a 16x16
-        stratification); refused for ``"ssm"``.
+        Light samples per receiver for ``"bitmask"`` and ``"exact"``
+        (default 256, a 16x16 stratification); refused for ``"ssm"``.
     occluder_resolution
         Resolution of the occluder maps, ``int`` or ``(W, H)`` (same extent as
         the output); default: ``resolution``. The SSM's cost grows with the
@@ -191,15 +210,10 @@ def soft_shadow_map(
     if passes not in (1, 2):
         raise ValueError(f"passes: must be 1 or 2, got {passes}")
     method = check.choice("method", method, METHODS)
-    if samples is not None:
-        samples = check.integer("samples", samples)
-        if method not in SAMPLING_METHODS:
-            raise ValueError(f"samples: applies to the sampling methods {SAMPLING_METHODS}, not to {method!r}")
-        if samples < 1:
-            raise ValueError(f"samples: must be >= 1, got {samples}")
+    samples = _check_samples(samples, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
-    if occ_res is not None and method in SAMPLING_METHODS:
+    if occ_res is not None and method in TRACING_METHODS:
         raise ValueError(f"occluder_resolution: {method!r} reads no occluder maps")
     r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, occ_res)
     if method in SAMPLING_METHODS and samples is None:
@@ -216,7 +230,7 @@ def soft_shadow_map(
         extent_fitted=extent is None,
         timings=dict(r["timings"]),
         samples=samples,
-        _occluder_mesh=(ov, of) if method in SAMPLING_METHODS else None,
+        _occluder_mesh=(ov, of) if method in TRACING_METHODS else None,
     )
 
 
@@ -228,6 +242,7 @@ def soft_shadow_map_from_depth(
     extent: Any,
     occluder_depth_back: np.ndarray | None = None,
     method: str = "ssm",
+    samples: int | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map from light-view depth maps rendered by the caller.
@@ -254,8 +269,11 @@ def soft_shadow_map_from_depth(
         raise ValueError(f"light_size: must be > 0, got {list(size)}")
     ext = check.extent(extent)
     method = check.choice("method", method, METHODS)
+    samples = _check_samples(samples, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
-    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method)
+    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples)
+    if method in SAMPLING_METHODS and samples is None:
+        samples = DEFAULT_SAMPLES
     return ShadowMap(
         visibility=r["visibility"],
         receiver_depth=rec,
@@ -267,4 +285,5 @@ def soft_shadow_map_from_depth(
         passes=1 if back is None else 2,
         extent_fitted=False,
         timings=dict(r["timings"]),
+        samples=samples,
     )

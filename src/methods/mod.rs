@@ -2,6 +2,7 @@
 //! method reads the same inputs (the light-view maps) and writes the same
 //! outputs (visibility per receiver texel, or per receiver point).
 
+pub mod bitmask;
 pub mod exact;
 mod gather;
 pub mod ssm;
@@ -52,6 +53,8 @@ pub enum Method {
     Ssm,
     /// Ray casting against the occluder triangles with stratified light samples.
     Exact { samples: u32 },
+    /// Micro-patches marking light samples in a bit mask per receiver (OR).
+    Bitmask { samples: u32 },
 }
 
 /// Default light samples per receiver for the sampling methods.
@@ -67,22 +70,34 @@ impl Method {
             "exact" => Method::Exact {
                 samples: samples.unwrap_or(DEFAULT_SAMPLES),
             },
+            "bitmask" => Method::Bitmask {
+                samples: samples.unwrap_or(DEFAULT_SAMPLES),
+            },
             other => {
                 return Err(Error::invalid(
                     "method",
-                    format!("unknown method {other:?}; available: \"ssm\", \"exact\""),
+                    format!("unknown method {other:?}; available: \"ssm\", \"bitmask\", \"exact\""),
                 ))
             }
         };
         match (method, samples) {
             (Method::Ssm, Some(_)) => Err(Error::invalid(
                 "samples",
-                "applies to the sampling methods (\"exact\"), not to \"ssm\"",
+                "applies to the sampling methods (\"bitmask\", \"exact\"), not to \"ssm\"",
             )),
             (Method::Exact { samples }, _) if samples == 0 || samples > MAX_SAMPLES => {
                 Err(Error::invalid(
                     "samples",
                     format!("must be in [1, {MAX_SAMPLES}], got {samples}"),
+                ))
+            }
+            (Method::Bitmask { samples }, _) if !bitmask::SAMPLE_COUNTS.contains(&samples) => {
+                Err(Error::invalid(
+                    "samples",
+                    format!(
+                        "bitmask takes one of {:?} samples, got {samples}",
+                        bitmask::SAMPLE_COUNTS
+                    ),
                 ))
             }
             _ => Ok(method),
@@ -98,6 +113,7 @@ impl Method {
         match *self {
             Method::Ssm => Box::new(ssm::Ssm),
             Method::Exact { samples } => Box::new(exact::Exact { samples }),
+            Method::Bitmask { samples } => Box::new(bitmask::Bitmask::new(samples)),
         }
     }
 }

@@ -134,7 +134,7 @@ fn shadow_map_from_meshes<'py>(
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None))]
 fn shadow_map_from_depth<'py>(
     py: Python<'py>,
     occluder_depth: PyReadonlyArray2<'py, f32>,
@@ -143,8 +143,9 @@ fn shadow_map_from_depth<'py>(
     light_size: [f64; 2],
     extent: (f64, f64),
     method: &str,
+    samples: Option<u32>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = Method::parse(method, None)?;
+    let method = Method::parse(method, samples)?;
     let shape = receiver_depth.shape();
     // The occluder maps may be coarser or finer than the receiver map (same extent).
     let oshape = occluder_depth.shape();
