@@ -90,6 +90,21 @@ def main() -> None:
             t_mi_s = f"{t_mi * 1e3:.1f}" if np.isfinite(t_mi) else "n/a"
             name = f"ssm, {passes} pass{'es' if passes > 1 else ''}, occluders {occ}²"
             print(f"| {res}² | {name} | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s}{note} | {ratio} | |")
+        for occ in (res, res // 2):
+
+            def run_bitmask(res=res, occ=occ):
+                return ss.soft_shadow_map(
+                    scene, light, resolution=res, method="bitmask", samples=256, occluder_resolution=occ
+                )
+
+            t = median_time(run_bitmask, max(3, a.repeats // 3))
+            err = metrics.shadow_error(run_bitmask().visibility, ref)
+            t_mi, extrapolated = mitsuba_at_equal_error(err, mi)
+            ratio = f"{t / t_mi:.2f}" if np.isfinite(t_mi) else "n/a"
+            t_mi_s = f"{t_mi * 1e3:.1f}" if np.isfinite(t_mi) else "n/a"
+            print(
+                f"| {res}² | bitmask, 256 samples, occluders {occ}² | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s} | {ratio} | |"
+            )
         for k in EXACT_SAMPLES:
 
             def run_exact(k=k, res=res):

@@ -8,13 +8,14 @@ Against Mitsuba 3 references (1024 stratified light samples per texel), on
 1. The accuracy-time plane, per scene (bunny floating, bunny on the floor, two
    spheres at different heights, torus): error (the paper's §4.2.1 metric)
    against time for ``ssm`` (1 and 2 passes, occluder maps at the output's
-   resolution and coarser), ``exact`` (several sample counts) and Mitsuba's
+   resolution and coarser), ``bitmask`` (64 and 256 samples, two occluder
+   resolutions), ``exact`` (several sample counts) and Mitsuba's
    ``ray_test`` (several sample counts). SSM and exact times are end to end
    from meshes; Mitsuba's are ``ray_test`` alone.
 2. The paper's §4.2 experiments (bunny floating): error against occluder-map
    resolution, light size, the occluder's vertical position (its gap to the
-   floor) and its lateral position, for ``ssm`` (1 and 2 passes) and
-   ``exact`` (64 samples).
+   floor) and its lateral position, for ``ssm`` (1 and 2 passes),
+   ``bitmask`` (256 samples) and ``exact`` (64 samples).
 3. The paper's §5 timings: time against polygon count (spheres of 1k to 1M
    triangles), map size and light size.
 
@@ -100,6 +101,11 @@ class Study:
                     passes=passes,
                     occluder_resolution=occ,
                 )
+        for k in (64, 256) if not self.quick else (256,):
+            for occ in occ_levels[:2]:
+                measure(
+                    "bitmask", f"{k} samples, occluders {occ}²", method="bitmask", samples=k, occluder_resolution=occ
+                )
         for k in (16, 64, 256) if not self.quick else (16, 64):
             measure("exact", f"{k} samples", method="exact", samples=k)
         rscene = self.reference.ReferenceScene(scene.occluders)
@@ -122,7 +128,12 @@ class Study:
         res: int,
         vary_occluder_res: bool = False,
     ) -> dict[str, list[float]]:
-        curves: dict[str, list[float]] = {"ssm, 1 pass": [], "ssm, 2 passes": [], "exact, 64 samples": []}
+        curves: dict[str, list[float]] = {
+            "ssm, 1 pass": [],
+            "ssm, 2 passes": [],
+            "bitmask, 256 samples": [],
+            "exact, 64 samples": [],
+        }
         for x in values:
             scene, light = make(x)
             occ = int(x) if vary_occluder_res else None
@@ -135,6 +146,10 @@ class Study:
                 curves[f"ssm, {passes} pass{'es' if passes > 1 else ''}"].append(
                     metrics.shadow_error(sm.visibility, ref)
                 )
+            bm = soft_shadow_map(
+                scene, light, resolution=res, extent=base.extent, method="bitmask", samples=256, occluder_resolution=occ
+            )
+            curves["bitmask, 256 samples"].append(metrics.shadow_error(bm.visibility, ref))
             ex = soft_shadow_map(scene, light, resolution=res, extent=base.extent, method="exact", samples=64)
             curves["exact, 64 samples"].append(metrics.shadow_error(ex.visibility, ref))
         return curves
@@ -183,7 +198,12 @@ def plot_plane(points: list[Point], path: str, title: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=110)
-    styles = {"ssm": ("o", "tab:blue"), "exact": ("s", "tab:green"), "mitsuba": ("^", "tab:red")}
+    styles = {
+        "ssm": ("o", "tab:blue"),
+        "bitmask": ("D", "tab:purple"),
+        "exact": ("s", "tab:green"),
+        "mitsuba": ("^", "tab:red"),
+    }
     for method, (marker, color) in styles.items():
         pts = [p for p in points if p.method == method]
         if not pts:
