@@ -102,9 +102,8 @@ def main() -> None:
             t_mi, extrapolated = mitsuba_at_equal_error(err, mi)
             ratio = f"{t / t_mi:.2f}" if np.isfinite(t_mi) else "n/a"
             t_mi_s = f"{t_mi * 1e3:.1f}" if np.isfinite(t_mi) else "n/a"
-            print(
-                f"| {res}² | bitmask, 256 samples, occluders {occ}² | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s} | {ratio} | |"
-            )
+            name = f"bitmask, 256 samples, occluders {occ}²"
+            print(f"| {res}² | {name} | - | {t * 1e3:.1f} | {err:.4f} | {t_mi_s} | {ratio} | |")
         for k in EXACT_SAMPLES:
 
             def run_exact(k=k, res=res):
