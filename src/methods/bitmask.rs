@@ -272,3 +272,48 @@ mod tests {
         assert!(v.iter().all(|&x| x == 0.0), "{v:?}");
     }
 }
+
+#[cfg(test)]
+mod bench {
+    use super::*;
+    use crate::light::MapGrid;
+
+    /// Times the kernel on the maps dumped by the SSM bench (a development
+    /// aid): cargo test --release --lib bench_bitmask -- --ignored --nocapture
+    #[test]
+    #[ignore]
+    fn bench_bitmask() {
+        let read = |p: &str| -> Vec<f32> {
+            std::fs::read(p)
+                .unwrap()
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect()
+        };
+        let (front, back, rec) = (
+            read("/tmp/front.f32"),
+            read("/tmp/back.f32"),
+            read("/tmp/rec.f32"),
+        );
+        let grid = MapGrid::new(256, 256, [0.3137646436112252, 0.3050549377029778]).unwrap();
+        let inputs = ShadowInputs {
+            grid,
+            occluder_grid: grid,
+            light_size: [1.0, 1.0],
+            receiver: &rec,
+            occluder_layers: vec![&front, &back],
+            occluder_triangles: None,
+        };
+        let b = Bitmask::new(256);
+        let mut ts = vec![];
+        let mut sum = 0.0;
+        for _ in 0..5 {
+            let t = std::time::Instant::now();
+            let v = b.visibility_map(&inputs);
+            ts.push(t.elapsed().as_secs_f64());
+            sum += v.iter().map(|&x| x as f64).sum::<f64>();
+        }
+        ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        println!("bitmask median {:.1} ms (checksum {sum:.3})", ts[2] * 1e3);
+    }
+}
