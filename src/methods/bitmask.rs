@@ -139,11 +139,10 @@ impl Accumulator for Bitmask {
                 hi(r.ay1[l]),
             ];
         }
+        // No branch on empty ranges: with kb <= ka, x_ge[ka] is a subset of
+        // x_ge[kb] and the band is empty anyway (and the branch mispredicts).
         for l in 0..LANES {
             let [ka, kb, kc, kd] = k[l].map(|v| v as usize);
-            if kb <= ka || kd <= kc {
-                continue;
-            }
             let (xa, xb, yc, yd) = (&p.x_ge[ka], &p.x_ge[kb], &p.y_ge[kc], &p.y_ge[kd]);
             for q in 0..4 {
                 acc[l][q] |= xa[q] & !xb[q] & yc[q] & !yd[q];
