@@ -139,7 +139,11 @@ impl Bvh {
                         return true;
                     }
                 }
-            } else if sp + 2 <= stack.len() {
+            } else {
+                // Median splits halve the triangles at each level, so the tree
+                // is at most ~log2(n) deep and the stack holds at most one
+                // pending sibling per level: 64 entries cover any u32 count.
+                debug_assert!(sp + 2 <= stack.len());
                 stack[sp] = node.start;
                 stack[sp + 1] = node.start + 1;
                 sp += 2;
