@@ -578,7 +578,7 @@ mod tests {
 mod bench {
     use super::*;
 
-    /// Times the rasterizer on a mesh dumped to /tmp (a development aid):
+    /// Times the rasterizer on the mesh `benchmarks/dump_maps.py` writes to /tmp (a development aid):
     /// cargo test --release --lib bench_raster -- --ignored --nocapture
     #[test]
     #[ignore]

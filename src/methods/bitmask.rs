@@ -277,7 +277,7 @@ mod bench {
     use super::*;
     use crate::light::MapGrid;
 
-    /// Times the kernel on the maps dumped by the SSM bench (a development
+    /// Times the kernel on the maps `benchmarks/dump_maps.py` writes (a development
     /// aid): cargo test --release --lib bench_bitmask -- --ignored --nocapture
     #[test]
     #[ignore]

@@ -293,7 +293,7 @@ mod bench {
     use super::*;
     use crate::light::MapGrid;
 
-    /// Times the kernel on maps dumped to /tmp (a development aid, ignored by
+    /// Times the kernel on the maps `benchmarks/dump_maps.py` writes to /tmp (a development aid, ignored by
     /// default): cargo test --release bench_dumped -- --ignored --nocapture
     #[test]
     #[ignore]
