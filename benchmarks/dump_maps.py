@@ -2,7 +2,7 @@
 to /tmp, for the Rust kernel benches (ignored tests):
 
     python benchmarks/dump_maps.py
-    cargo test --release --lib bench_ -- --ignored --nocapture
+    cargo test --release --lib bench_ -- --ignored --nocapture --test-threads=1
 """
 
 import numpy as np
