@@ -471,7 +471,7 @@ mod tests {
         let g = grid(n);
         let z = 1.0;
         let c = |i: usize| g.x_of(i);
-        let verts = vec![
+        let verts = [
             DVec3::new(c(2), c(2), z),
             DVec3::new(c(12), c(2), z),
             DVec3::new(c(12), c(12), z),

@@ -117,3 +117,47 @@ impl Method {
         }
     }
 }
+
+/// The bunny's maps that `benchmarks/dump_maps.py` writes to /tmp, timed by
+/// the kernels' ignored bench tests.
+#[cfg(test)]
+pub(crate) mod bench_data {
+    use super::{MapGrid, ShadowInputs, ShadowMethod};
+
+    fn read(p: &str) -> Vec<f32> {
+        std::fs::read(p)
+            .unwrap_or_else(|e| panic!("{p}: {e}; run python benchmarks/dump_maps.py first"))
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect()
+    }
+
+    /// Median seconds of `runs` runs of `method` on the dumped maps, and a
+    /// checksum of the result.
+    pub fn time(method: &dyn ShadowMethod, runs: usize) -> (f64, f64) {
+        let (front, back, rec) = (
+            read("/tmp/front.f32"),
+            read("/tmp/back.f32"),
+            read("/tmp/rec.f32"),
+        );
+        let grid = MapGrid::new(256, 256, [0.3137646436112252, 0.3050549377029778]).unwrap();
+        let inputs = ShadowInputs {
+            grid,
+            occluder_grid: grid,
+            light_size: [1.0, 1.0],
+            receiver: &rec,
+            occluder_layers: vec![&front, &back],
+            occluder_triangles: None,
+        };
+        let mut ts = vec![];
+        let mut sum = 0.0;
+        for _ in 0..runs {
+            let t = std::time::Instant::now();
+            let v = method.visibility_map(&inputs);
+            ts.push(t.elapsed().as_secs_f64());
+            sum = v.iter().map(|&x| x as f64).sum::<f64>();
+        }
+        ts.sort_by(|a, b| a.total_cmp(b));
+        (ts[runs / 2], sum)
+    }
+}

@@ -291,43 +291,13 @@ mod tests {
 #[cfg(test)]
 mod bench {
     use super::*;
-    use crate::light::MapGrid;
 
-    /// Times the kernel on the maps `benchmarks/dump_maps.py` writes to /tmp (a development aid, ignored by
-    /// default): cargo test --release bench_dumped -- --ignored --nocapture
+    /// Times the kernel on the maps `benchmarks/dump_maps.py` writes (a
+    /// development aid): cargo test --release --lib bench_dumped -- --ignored --nocapture
     #[test]
     #[ignore]
     fn bench_dumped() {
-        let read = |p: &str| -> Vec<f32> {
-            std::fs::read(p)
-                .unwrap()
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .collect()
-        };
-        let (front, back, rec) = (
-            read("/tmp/front.f32"),
-            read("/tmp/back.f32"),
-            read("/tmp/rec.f32"),
-        );
-        let grid = MapGrid::new(256, 256, [0.3137646436112252, 0.3050549377029778]).unwrap();
-        let inputs = ShadowInputs {
-            grid,
-            occluder_grid: grid,
-            light_size: [1.0, 1.0],
-            receiver: &rec,
-            occluder_layers: vec![&front, &back],
-            occluder_triangles: None,
-        };
-        let mut ts = vec![];
-        let mut sum = 0.0;
-        for _ in 0..30 {
-            let t = std::time::Instant::now();
-            let v = Ssm.visibility_map(&inputs);
-            ts.push(t.elapsed().as_secs_f64());
-            sum += v.iter().map(|&x| x as f64).sum::<f64>();
-        }
-        ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
-        println!("median {:.2} ms (checksum {sum:.3})", ts[15] * 1e3);
+        let (t, sum) = crate::methods::bench_data::time(&Ssm, 30);
+        println!("median {:.2} ms (checksum {sum:.3})", t * 1e3);
     }
 }

@@ -135,6 +135,7 @@ fn shadow_map_from_meshes<'py>(
 /// Depth maps -> visibility.
 #[pyfunction]
 #[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None))]
+#[allow(clippy::too_many_arguments)]
 fn shadow_map_from_depth<'py>(
     py: Python<'py>,
     occluder_depth: PyReadonlyArray2<'py, f32>,
