@@ -6,19 +6,26 @@ use crate::extent::fit_extent;
 use crate::light::{check_light_size, MapGrid, RectLight};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
-use crate::raster::rasterize;
+use crate::raster::{rasterize, Prepared};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// How many occluder depth layers are taken (1: front; 2: front and back, §3.5).
+/// The most occluder depth layers we peel.
+pub const MAX_PASSES: u32 = 8;
+
+/// How many occluder depth layers are taken: 1, the front; 2, front and back
+/// (§3.5); more, front, the next layers by depth peeling, and back.
 pub fn check_passes(passes: u32) -> Result<u32> {
-    match passes {
-        1 | 2 => Ok(passes),
-        p => Err(Error::invalid(
+    if (1..=MAX_PASSES).contains(&passes) {
+        Ok(passes)
+    } else {
+        Err(Error::invalid(
             "passes",
-            format!("must be 1 (front layer) or 2 (front and back layers), got {p}"),
-        )),
+            format!(
+                "must be 1 (front layer), 2 (front and back) or up to {MAX_PASSES} (front, peeled layers, back), got {passes}"
+            ),
+        ))
     }
 }
 
@@ -34,6 +41,8 @@ pub struct ShadowResult {
     pub receiver: Vec<f32>,
     /// The occluder maps; None for methods that trace triangles instead.
     pub occluder_front: Option<Vec<f32>>,
+    /// Peeled layers between front and back (passes >= 3), nearest first.
+    pub occluder_middle: Vec<Vec<f32>>,
     pub occluder_back: Option<Vec<f32>>,
     pub timings: Timings,
 }
@@ -121,24 +130,27 @@ pub fn from_meshes(
     sw.lap("raster_receivers");
     // Only what the method reads: occluder maps for the map methods, light-space
     // triangles for the ray-traced one.
+    let mut middle: Vec<Vec<f32>> = vec![];
     let (occ, triangles) = if s.method.traces_triangles() {
         let t = light_space_triangles(&occ_ls, occluders.faces);
         sw.lap("triangles");
         (None, Some(t))
     } else {
-        let o = rasterize(
-            &occluder_grid,
-            &occ_ls,
-            occluders.faces,
-            near,
-            s.passes == 2,
-        );
+        // One set-up serves every layer: front and back in one traversal,
+        // then one traversal per peeled layer (passes >= 3).
+        let prepared = Prepared::new(&occluder_grid, &occ_ls, occluders.faces, near);
+        let o = prepared.nearest_farthest(s.passes >= 2);
+        for k in 0..s.passes.saturating_sub(2) as usize {
+            let next = prepared.peel(if k == 0 { &o.nearest } else { &middle[k - 1] });
+            middle.push(next);
+        }
         sw.lap("raster_occluders");
         (Some(o), None)
     };
     let mut layers: Vec<&[f32]> = vec![];
     if let Some(o) = &occ {
         layers.push(&o.nearest);
+        layers.extend(middle.iter().map(|m| m.as_slice()));
         if let Some(back) = o.farthest.as_deref() {
             layers.push(back);
         }
@@ -163,6 +175,7 @@ pub fn from_meshes(
         visibility,
         receiver,
         occluder_front,
+        occluder_middle: middle,
         occluder_back,
         timings: sw.timings,
     })
@@ -243,14 +256,14 @@ pub fn from_depth(
 }
 
 /// What a method reads of the occluders when shading points.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub enum OccluderSource<'a> {
     /// The occluder maps of a shadow map (front, and back with two passes) on
     /// their grid.
     Maps {
         grid: MapGrid,
-        front: &'a [f32],
-        back: Option<&'a [f32]>,
+        /// Front first, back last.
+        layers: Vec<&'a [f32]>,
     },
     /// The occluder triangles (world space).
     Mesh(MeshRef<'a>),
@@ -300,19 +313,13 @@ pub fn sample_points(
         })
         .unzip();
     let (layers, triangles, occluder_grid) = match occluders {
-        OccluderSource::Maps {
-            grid: og,
-            front,
-            back,
-        } => {
+        OccluderSource::Maps { grid: og, layers } => {
             if method.traces_triangles() {
                 return Err(Error::invalid(
                     "method",
                     "traces triangles: pass the occluder mesh",
                 ));
             }
-            let mut layers = vec![front];
-            layers.extend(back);
             (layers, None, og)
         }
         OccluderSource::Mesh(mesh) => {

@@ -264,12 +264,14 @@ fn owns_ties(dx: i64, dy: i64) -> bool {
     dy < 0 || (dy == 0 && dx > 0)
 }
 
+/// Visits the texel centers covered by triangle `t` within `rows`, calling
+/// `write(index within the band, depth)` for each.
+#[inline(always)]
 fn raster_tri(
     t: &SetupTri,
     grid: &MapGrid,
     rows: std::ops::Range<usize>,
-    near: &mut [f32],
-    mut far: Option<&mut [f32]>,
+    mut write: impl FnMut(usize, f32),
 ) {
     let j_lo = (t.j0 as usize).max(rows.start);
     let j_hi = (t.j1 as usize + 1).min(rows.end);
@@ -301,16 +303,7 @@ fn raster_tri(
             if e[0] + bias[0] > 0 && e[1] + bias[1] > 0 && e[2] + bias[2] > 0 {
                 let inv_z = (e[0] as f64 * t.w[0] + e[1] as f64 * t.w[1] + e[2] as f64 * t.w[2])
                     * t.inv_area;
-                let z = (1.0 / inv_z) as f32;
-                let idx = row + i;
-                if z < near[idx] {
-                    near[idx] = z;
-                }
-                if let Some(f) = far.as_deref_mut() {
-                    if !(f[idx] < f32::INFINITY) || z > f[idx] {
-                        f[idx] = z;
-                    }
-                }
+                write(row + i, (1.0 / inv_z) as f32);
             }
             e[0] += a[0];
             e[1] += a[1];
@@ -319,10 +312,142 @@ fn raster_tri(
     }
 }
 
-/// Rasterizes a mesh whose vertices are already in light space.
-///
-/// `near` is the clip distance from the light's plane: geometry closer than it
-/// (or behind the light) is cut away.
+/// A mesh set up for rasterization: triangles snapped and binned by band.
+pub struct Prepared<'g> {
+    grid: &'g MapGrid,
+    tris: Vec<SetupTri>,
+    /// Triangle indices of band b: binned[counts[b]..counts[b + 1]].
+    binned: Vec<u32>,
+    counts: Vec<u32>,
+    rows_per_band: usize,
+}
+
+/// Relative depth gap under which a surface counts as the layer already peeled
+/// (interpolated depths of one surface differ by a few f32 ulps).
+const PEEL_GAP: f32 = 1e-5;
+
+impl<'g> Prepared<'g> {
+    /// Sets up a mesh whose vertices are already in light space. `near` is
+    /// the clip distance from the light's plane: geometry closer than it (or
+    /// behind the light) is cut away.
+    pub fn new(grid: &'g MapGrid, verts: &[DVec3], faces: &[[u32; 3]], near: f64) -> Prepared<'g> {
+        let proj = Projector::new(grid, near);
+        // Each vertex is projected and snapped once, however many faces share it.
+        let snapped: Vec<Snapped> = verts.par_iter().map(|&q| proj.snap(q)).collect();
+        let tris: Vec<SetupTri> = faces
+            .par_chunks(4096)
+            .flat_map_iter(|chunk| {
+                let mut out = Vec::with_capacity(chunk.len());
+                for f in chunk {
+                    let tri = f.map(|i| verts[i as usize]);
+                    let sn = f.map(|i| snapped[i as usize]);
+                    proj.setup(tri, sn, &mut out);
+                }
+                out
+            })
+            .collect();
+
+        // Bin triangle indices by band (counting sort).
+        let rows_per_band = band_rows(grid.height);
+        let n_bands = grid.height.div_ceil(rows_per_band);
+        let mut counts = vec![0u32; n_bands + 1];
+        for t in &tris {
+            for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
+                counts[b + 1] += 1;
+            }
+        }
+        for b in 0..n_bands {
+            counts[b + 1] += counts[b];
+        }
+        let mut fill = counts.clone();
+        let mut binned = vec![0u32; counts[n_bands] as usize];
+        for (k, t) in tris.iter().enumerate() {
+            for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
+                binned[fill[b] as usize] = k as u32;
+                fill[b] += 1;
+            }
+        }
+        Prepared {
+            grid,
+            tris,
+            binned,
+            counts,
+            rows_per_band,
+        }
+    }
+
+    /// Runs `visit(band's rows, band's slice of each output, triangle)` for every
+    /// band in parallel, each band owning its rows of the outputs.
+    fn bands(
+        &self,
+        outputs: &mut [Vec<f32>],
+        visit: impl Fn(&SetupTri, std::ops::Range<usize>, &mut [&mut [f32]]) + Sync,
+    ) {
+        let band_len = self.rows_per_band * self.grid.width;
+        let mut per_band: Vec<Vec<&mut [f32]>> =
+            (0..self.counts.len() - 1).map(|_| Vec::new()).collect();
+        for out in outputs.iter_mut() {
+            for (b, chunk) in out.chunks_mut(band_len).enumerate() {
+                per_band[b].push(chunk);
+            }
+        }
+        per_band
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(b, mut slices)| {
+                let rows =
+                    b * self.rows_per_band..((b + 1) * self.rows_per_band).min(self.grid.height);
+                for &k in &self.binned[self.counts[b] as usize..self.counts[b + 1] as usize] {
+                    visit(&self.tris[k as usize], rows.clone(), &mut slices);
+                }
+            });
+    }
+
+    /// The nearest depth per texel, and the farthest when asked for.
+    pub fn nearest_farthest(&self, want_farthest: bool) -> DepthLayers {
+        let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
+        if want_farthest {
+            outs.push(vec![f32::INFINITY; self.grid.len()]);
+        }
+        self.bands(&mut outs, |t, rows, o| {
+            raster_tri(t, self.grid, rows, |idx, z| {
+                if z < o[0][idx] {
+                    o[0][idx] = z;
+                }
+                if let Some(f) = o.get_mut(1) {
+                    if !(f[idx] < f32::INFINITY) || z > f[idx] {
+                        f[idx] = z;
+                    }
+                }
+            })
+        });
+        let farthest = want_farthest.then(|| outs.pop().unwrap());
+        DepthLayers {
+            nearest: outs.pop().unwrap(),
+            farthest,
+        }
+    }
+
+    /// Depth peeling: per texel, the nearest depth strictly beyond `previous`
+    /// (by more than PEEL_GAP relative), `inf` where there is none.
+    pub fn peel(&self, previous: &[f32]) -> Vec<f32> {
+        let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
+        let band_len = self.rows_per_band * self.grid.width;
+        self.bands(&mut outs, |t, rows, o| {
+            let base = rows.start / self.rows_per_band * band_len;
+            raster_tri(t, self.grid, rows, |idx, z| {
+                let floor = previous[base + idx];
+                if z > floor * (1.0 + PEEL_GAP) && z < o[0][idx] {
+                    o[0][idx] = z;
+                }
+            })
+        });
+        outs.pop().unwrap()
+    }
+}
+
+/// Rasterizes a mesh whose vertices are already in light space into its
+/// nearest (and farthest) depth maps.
 pub fn rasterize(
     grid: &MapGrid,
     verts: &[DVec3],
@@ -330,79 +455,7 @@ pub fn rasterize(
     near: f64,
     want_farthest: bool,
 ) -> DepthLayers {
-    let proj = Projector::new(grid, near);
-    // Each vertex is projected and snapped once, however many faces share it.
-    let snapped: Vec<Snapped> = verts.par_iter().map(|&q| proj.snap(q)).collect();
-    let tris: Vec<SetupTri> = faces
-        .par_chunks(4096)
-        .flat_map_iter(|chunk| {
-            let mut out = Vec::with_capacity(chunk.len());
-            for f in chunk {
-                let tri = [
-                    verts[f[0] as usize],
-                    verts[f[1] as usize],
-                    verts[f[2] as usize],
-                ];
-                let sn = [
-                    snapped[f[0] as usize],
-                    snapped[f[1] as usize],
-                    snapped[f[2] as usize],
-                ];
-                proj.setup(tri, sn, &mut out);
-            }
-            out
-        })
-        .collect();
-
-    // Bin triangle indices by band (counting sort).
-    let rows_per_band = band_rows(grid.height);
-    let n_bands = grid.height.div_ceil(rows_per_band);
-    let mut counts = vec![0u32; n_bands + 1];
-    for t in &tris {
-        for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
-            counts[b + 1] += 1;
-        }
-    }
-    for b in 0..n_bands {
-        counts[b + 1] += counts[b];
-    }
-    let mut fill = counts.clone();
-    let mut binned = vec![0u32; counts[n_bands] as usize];
-    for (k, t) in tris.iter().enumerate() {
-        for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
-            binned[fill[b] as usize] = k as u32;
-            fill[b] += 1;
-        }
-    }
-
-    let band_len = rows_per_band * grid.width;
-    let mut nearest = vec![f32::INFINITY; grid.len()];
-    let mut farthest = want_farthest.then(|| vec![f32::INFINITY; grid.len()]);
-    let run_band = |b: usize, near_band: &mut [f32], far_band: Option<&mut [f32]>| {
-        let rows = b * rows_per_band..((b + 1) * rows_per_band).min(grid.height);
-        let mut far_band = far_band;
-        for &k in &binned[counts[b] as usize..counts[b + 1] as usize] {
-            raster_tri(
-                &tris[k as usize],
-                grid,
-                rows.clone(),
-                near_band,
-                far_band.as_deref_mut(),
-            );
-        }
-    };
-    match farthest.as_mut() {
-        Some(far) => nearest
-            .par_chunks_mut(band_len)
-            .zip(far.par_chunks_mut(band_len))
-            .enumerate()
-            .for_each(|(b, (nb, fb))| run_band(b, nb, Some(fb))),
-        None => nearest
-            .par_chunks_mut(band_len)
-            .enumerate()
-            .for_each(|(b, nb)| run_band(b, nb, None)),
-    }
-    DepthLayers { nearest, farthest }
+    Prepared::new(grid, verts, faces, near).nearest_farthest(want_farthest)
 }
 
 #[cfg(test)]
@@ -454,11 +507,7 @@ mod tests {
         }
         let mut hits = vec![0u32; g.len()];
         for t in &tris {
-            let mut near = vec![f32::INFINITY; g.len()];
-            raster_tri(t, &g, 0..n, &mut near, None);
-            for (h, d) in hits.iter_mut().zip(&near) {
-                *h += d.is_finite() as u32;
-            }
+            raster_tri(t, &g, 0..n, |idx, _| hits[idx] += 1);
         }
         assert!(hits.iter().all(|&h| h == 1), "hits: {:?}", &hits[..]);
     }
@@ -491,11 +540,7 @@ mod tests {
                 &mut tris,
             );
             for t in &tris {
-                let mut near = vec![f32::INFINITY; g.len()];
-                raster_tri(t, &g, 0..n, &mut near, None);
-                for (h, d) in hits.iter_mut().zip(&near) {
-                    *h += d.is_finite() as u32;
-                }
+                raster_tri(t, &g, 0..n, |idx, _| hits[idx] += 1);
             }
         }
         assert!(hits.iter().all(|&h| h <= 1));
@@ -553,6 +598,30 @@ mod tests {
         assert_eq!(d.nearest[side], 2.0);
         assert_eq!(far[side], 2.0);
         assert!(d.nearest[0].is_infinite());
+    }
+
+    #[test]
+    fn depth_peeling_finds_the_layers_in_order() {
+        // Three stacked quads at depths 2, 3, 4 (the middle one smaller).
+        let g = grid(8);
+        let (mut v, mut f) = quad(2.0, 0.5);
+        for (z, s) in [(3.0, 0.25), (4.0, 0.5)] {
+            let (v2, f2) = quad(z, s);
+            let off = v.len() as u32;
+            v.extend(v2);
+            f.extend(f2.iter().map(|t| t.map(|i| i + off)));
+        }
+        let p = Prepared::new(&g, &v, &f, 1e-9);
+        let first = p.nearest_farthest(false).nearest;
+        let second = p.peel(&first);
+        let third = p.peel(&second);
+        let fourth = p.peel(&third);
+        let (mid, side) = (4 * 8 + 4, 4 * 8 + 5);
+        assert_eq!([first[mid], second[mid], third[mid]], [2.0, 3.0, 4.0]);
+        assert!(fourth[mid].is_infinite());
+        // Outside the small quad the second layer is the far one.
+        assert_eq!([first[side], second[side]], [2.0, 4.0]);
+        assert!(third[side].is_infinite());
     }
 
     #[test]

@@ -38,8 +38,10 @@ def shadow_map_from_meshes(
     light-view maps and computes the visibility. Returns a dict with
     ``visibility`` and ``receiver_depth`` ((H, W) float32), ``occluder_depth``
     and ``occluder_depth_back`` (on the occluder grid; None with one pass, or
-    for methods that trace triangles), ``extent``: (tx, ty) and ``timings``:
-    {stage: seconds}. ``samples`` is for the sampling methods only."""
+    for methods that trace triangles), ``occluder_depth_middle`` (the peeled
+    layers, a list; empty below 3 passes), ``extent``: (tx, ty) and
+    ``timings``: {stage: seconds}. ``samples`` is for the sampling methods
+    only."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
@@ -66,6 +68,7 @@ def sample_points(
     occluder_depth_back: npt.NDArray[np.float32] | None = None,
     occ_vertices: npt.NDArray[np.float64] | None = None,
     occ_faces: npt.NDArray[np.uint32] | None = None,
+    occluder_depth_middle: list[npt.NDArray[np.float32]] | None = None,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.bool_]]:
     """Visibility at world points (N, 3), and whether each lies inside the map
     (points outside, or at or behind the light's plane, get 1 and False). The

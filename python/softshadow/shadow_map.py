@@ -19,6 +19,7 @@ METHODS = ("ssm", "bitmask", "exact")
 SAMPLING_METHODS = ("bitmask", "exact")
 TRACING_METHODS = ("exact",)
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
+MAX_PASSES = 8  # keep in sync with MAX_PASSES in src/pipeline.rs
 BACKENDS = ("cpu",)
 LATER_BACKENDS = ("gpu", "auto")
 
@@ -54,6 +55,9 @@ class ShadowMap:
     """Seconds per stage, in the order the stages ran."""
     samples: int | None = None
     """Light samples per receiver (sampling methods), else None."""
+    occluder_depth_middle: tuple[np.ndarray, ...] = ()
+    """With ``passes`` >= 3, the peeled layers between front and back, nearest
+    first: layer k is the nearest surface beyond layer k - 1."""
     _occluder_mesh: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
     @property
@@ -104,7 +108,11 @@ class ShadowMap:
             ov, of = self._occluder_mesh
             occ = {"occ_vertices": ov, "occ_faces": of}
         else:
-            occ = {"occluder_depth": self.occluder_depth, "occluder_depth_back": self.occluder_depth_back}
+            occ = {
+                "occluder_depth": self.occluder_depth,
+                "occluder_depth_back": self.occluder_depth_back,
+                "occluder_depth_middle": list(self.occluder_depth_middle),
+            }
         vis, inside = _core.sample_points(
             self.light._core_args(),
             self.extent,
@@ -173,8 +181,11 @@ def soft_shadow_map(
         to the receivers' own extent. Fitting needs every occluder vertex in
         front of the light's plane.
     passes
-        1: the front occluder layer; 2: front and back layers, merged by the
-        larger occlusion (§3.5 of the paper).
+        The occluder depth layers: 1, the front; 2, front and back (§3.5 of
+        the paper); 3 to 8, front, ``passes - 2`` layers found by depth
+        peeling (each the nearest surface beyond the previous layer), and
+        back. ``ssm`` merges the layers' sums by the larger occlusion,
+        ``bitmask`` ORs their masks. (Ignored by ``exact``.)
     method
         ``"ssm"``: soft shadow maps as published (Atty et al. 2005).
         ``"bitmask"``: the micro-patches of the occluder maps mark the light
@@ -207,8 +218,8 @@ def soft_shadow_map(
     occ_res = None if occluder_resolution is None else check.resolution(occluder_resolution, "occluder_resolution")
     ext = None if extent is None else check.extent(extent)
     passes = check.integer("passes", passes)
-    if passes not in (1, 2):
-        raise ValueError(f"passes: must be 1 or 2, got {passes}")
+    if not 1 <= passes <= MAX_PASSES:
+        raise ValueError(f"passes: must be in [1, {MAX_PASSES}] (occluder depth layers), got {passes}")
     method = check.choice("method", method, METHODS)
     samples = _check_samples(samples, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
@@ -230,6 +241,7 @@ def soft_shadow_map(
         extent_fitted=extent is None,
         timings=dict(r["timings"]),
         samples=samples,
+        occluder_depth_middle=tuple(r["occluder_depth_middle"]),
         _occluder_mesh=(ov, of) if method in TRACING_METHODS else None,
     )
 

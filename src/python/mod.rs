@@ -129,6 +129,12 @@ fn shadow_map_from_meshes<'py>(
             None => d.set_item(key, py.None())?,
         }
     }
+    let middle = r
+        .occluder_middle
+        .into_iter()
+        .map(|m| map(py, &r.occluder_grid, m))
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("occluder_depth_middle", middle)?;
     Ok(d)
 }
 
@@ -181,7 +187,7 @@ fn shadow_map_from_depth<'py>(
 /// Visibility at world points from a shadow map's occluders: its occluder maps
 /// (map methods) or the occluder mesh (ray-traced methods).
 #[pyfunction]
-#[pyo3(signature = (light, extent, width, height, points, method, samples=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None))]
+#[pyo3(signature = (light, extent, width, height, points, method, samples=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None, occluder_depth_middle=None))]
 #[allow(clippy::too_many_arguments)]
 fn sample_points<'py>(
     py: Python<'py>,
@@ -196,23 +202,29 @@ fn sample_points<'py>(
     occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
     occ_vertices: Option<PyReadonlyArray2<'py, f64>>,
     occ_faces: Option<PyReadonlyArray2<'py, u32>>,
+    occluder_depth_middle: Option<Vec<PyReadonlyArray2<'py, f32>>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let light = light_of(light)?;
     let method = Method::parse(method, samples)?;
     let grid = MapGrid::new(width, height, [extent.0, extent.1])?;
+    let middle = occluder_depth_middle.unwrap_or_default();
     let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
         (Some(front), None, None) => {
             let oshape = front.shape();
+            // Front first, the peeled layers, back last (the order of the map
+            // pipeline's layers).
+            let mut layers = vec![slice("occluder_depth", front)?];
+            for m in &middle {
+                same_shape("occluder_depth_middle", m.shape(), oshape)?;
+                layers.push(slice("occluder_depth_middle", m)?);
+            }
             if let Some(b) = &occluder_depth_back {
                 same_shape("occluder_depth_back", b.shape(), oshape)?;
+                layers.push(slice("occluder_depth_back", b)?);
             }
             OccluderSource::Maps {
                 grid: MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?,
-                front: slice("occluder_depth", front)?,
-                back: match &occluder_depth_back {
-                    Some(b) => Some(slice("occluder_depth_back", b)?),
-                    None => None,
-                },
+                layers,
             }
         }
         (None, Some(v), Some(f)) => OccluderSource::Mesh(MeshRef {
