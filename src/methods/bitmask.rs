@@ -212,43 +212,10 @@ mod tests {
     #[test]
     fn a_flat_plate_matches_the_closed_form_to_the_pattern_resolution() {
         // One plate, one depth: the union of its micro-patches is its
-        // back-projection; the pattern places each edge to 1/n^2.
-        let n = 48;
-        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
-        let (zo, zr, a) = (2.0f64, 4.0f64, 0.25f64);
-        let front: Vec<f32> = (0..n * n)
-            .map(|k| {
-                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
-                if x.abs() < a && y.abs() < a {
-                    zo as f32
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
-        let receiver = vec![zr as f32; n * n];
-        let inputs = ShadowInputs {
-            grid,
-            occluder_grid: grid,
-            light_size: [1.0, 1.0],
-            receiver: &receiver,
-            occluder_layers: vec![&front],
-            occluder_triangles: None,
-        };
-        let v = Bitmask::new(256).visibility_map(&inputs);
-        let k = zr * zo / (zr - zo);
-        let ov = |c: f64| {
-            ((k * (a - c) + 0.5).clamp(0.0, 1.0) - (k * (-a - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
-        };
-        let mut max = 0f64;
-        for j in 0..n {
-            for i in 0..n {
-                let exact = 1.0 - ov(grid.x_of(i)) * ov(grid.y_of(j));
-                max = max.max((v[j * n + i] as f64 - exact).abs());
-            }
-        }
-        // Each of the 4 edges misplaced by at most one fine stratum: 4 x 16 samples
-        // of 256 in the worst case (a stratum's samples lie in one coarse row/column).
+        // back-projection, and the pattern places each of its 4 edges to one
+        // fine stratum: 4 x 16 samples of 256 in the worst case (a stratum's
+        // samples lie in one coarse row or column).
+        let max = crate::methods::plate_case::max_error(&Bitmask::new(256), 48);
         assert!(max <= 4.0 * 16.0 / 256.0 + 1e-6, "max error {max}");
     }
 

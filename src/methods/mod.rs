@@ -118,6 +118,57 @@ impl Method {
     }
 }
 
+/// A texel-aligned square plate over a parallel floor, whose visibility has
+/// a closed form: the methods' shared accuracy check.
+#[cfg(test)]
+pub(crate) mod plate_case {
+    use super::{MapGrid, ShadowInputs, ShadowMethod};
+
+    /// Largest |V - V_exact| of `method` on an n x n map of a plate covering
+    /// tangent [-1/4, 1/4]^2 at depth 2 over a floor at depth 4 (light 1 x 1).
+    /// The plate's edges fall on texel edges, so the occluder map holds it
+    /// exactly and any error is the method's.
+    pub fn max_error(method: &dyn ShadowMethod, n: usize) -> f64 {
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let (zo, zr, a) = (2.0f64, 4.0f64, 0.25f64);
+        let front: Vec<f32> = (0..n * n)
+            .map(|k| {
+                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
+                if x.abs() < a && y.abs() < a {
+                    zo as f32
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        let receiver = vec![zr as f32; n * n];
+        let inputs = ShadowInputs {
+            grid,
+            occluder_grid: grid,
+            light_size: [1.0, 1.0],
+            receiver: &receiver,
+            occluder_layers: vec![&front],
+            occluder_triangles: None,
+        };
+        let v = method.visibility_map(&inputs);
+        // The back-projection of the plate seen from the floor point at
+        // tangent c is k [-a - c, a - c], k = zr zo / (zr - zo), on the light
+        // [-1/2, 1/2] (per axis).
+        let k = zr * zo / (zr - zo);
+        let ov = |c: f64| {
+            ((k * (a - c) + 0.5).clamp(0.0, 1.0) - (k * (-a - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
+        };
+        let mut max = 0f64;
+        for j in 0..n {
+            for i in 0..n {
+                let exact = 1.0 - ov(grid.x_of(i)) * ov(grid.y_of(j));
+                max = max.max((v[j * n + i] as f64 - exact).abs());
+            }
+        }
+        max
+    }
+}
+
 /// The bunny's maps that `benchmarks/dump_maps.py` writes to /tmp, timed by
 /// the kernels' ignored bench tests.
 #[cfg(test)]

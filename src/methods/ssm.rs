@@ -244,46 +244,9 @@ mod tests {
 
     #[test]
     fn plate_over_parallel_floor_matches_the_closed_form() {
-        // Plate covering tangent [-a, a]^2 at depth zo, floor at depth zr: the
-        // occlusion is the overlap of the back-projected square with the light.
-        // The map samples the plate on texels: where the plate's edges fall on
-        // texel edges the discretized plate is exact, and so is the SSM.
-        let n = 64;
-        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
-        let (zo, zr, a) = (2.0f64, 4.0f64, 0.25f64);
-        let front: Vec<f32> = (0..n * n)
-            .map(|k| {
-                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
-                if x.abs() < a && y.abs() < a {
-                    zo as f32
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
-        let receiver = vec![zr as f32; n * n];
-        let inputs = ShadowInputs {
-            grid,
-            occluder_grid: grid,
-            light_size: [1.0, 1.0],
-            receiver: &receiver,
-            occluder_layers: vec![&front],
-            occluder_triangles: None,
-        };
-        let v = Ssm.visibility_map(&inputs);
-        let k = zr * zo / (zr - zo);
-        let ov = |c: f64| {
-            ((k * (a - c) + 0.5).clamp(0.0, 1.0) - (k * (-a - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
-        };
-        let mut max = 0f64;
-        for j in 0..n {
-            for i in 0..n {
-                let exact = 1.0 - ov(grid.x_of(i)) * ov(grid.y_of(j));
-                max = max.max((v[j * n + i] as f64 - exact).abs());
-            }
-        }
-        // Additive micro-patches of one flat plate tile the back-projection
+        // Additive micro-patches of one flat plate tile its back-projection
         // exactly, so only f32 rounding remains.
+        let max = crate::methods::plate_case::max_error(&Ssm, 64);
         assert!(max < 1e-5, "max error {max}");
     }
 }
