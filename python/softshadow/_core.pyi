@@ -32,6 +32,7 @@ def shadow_map_from_meshes(
     passes: int,
     method: str,
     samples: int | None = None,
+    hierarchy: bool | None = None,
     occluder_resolution: tuple[int, int] | None = None,
 ) -> dict[str, Any]:
     """Rasterizes the receivers (and, for the map methods, the occluders) into
@@ -51,6 +52,7 @@ def shadow_map_from_depth(
     extent: tuple[float, float],
     method: str,
     samples: int | None = None,
+    hierarchy: bool | None = None,
 ) -> dict[str, Any]:
     """Visibility from depth maps (the occluder maps may have their own
     resolution; the output has the receiver map's). Returns ``visibility`` and
@@ -64,6 +66,7 @@ def sample_points(
     points: npt.NDArray[np.float64],
     method: str,
     samples: int | None = None,
+    hierarchy: bool | None = None,
     occluder_depth: npt.NDArray[np.float32] | None = None,
     occluder_depth_back: npt.NDArray[np.float32] | None = None,
     occ_vertices: npt.NDArray[np.float64] | None = None,

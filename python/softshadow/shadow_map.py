@@ -14,10 +14,16 @@ from .light import RectLight
 from .scene import Scene
 
 METHODS = ("ssm", "bitmask", "exact")
+# "auto" resolves to one of METHODS (see `auto_settings`); the result names
+# the method that ran.
+AUTO = "auto"
 # Methods that take `samples=`; of them, those that trace the occluder
 # triangles (and so make no occluder maps).
 SAMPLING_METHODS = ("bitmask", "exact")
 TRACING_METHODS = ("exact",)
+# Whether the occluder hierarchy is on by default, per occluder-map method:
+# off for the paper's method (published without one), on for bitmask.
+DEFAULT_HIERARCHY = {"ssm": False, "bitmask": True}
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 MAX_PASSES = 8  # keep in sync with MAX_PASSES in src/pipeline.rs
 BACKENDS = ("cpu",)
@@ -55,6 +61,8 @@ class ShadowMap:
     """Seconds per stage, in the order the stages ran."""
     samples: int | None = None
     """Light samples per receiver (sampling methods), else None."""
+    hierarchy: bool | None = None
+    """Whether the occluder hierarchy was used (occluder-map methods), else None."""
     occluder_depth_middle: tuple[np.ndarray, ...] = ()
     """With ``passes`` >= 3, the peeled layers between front and back, nearest
     first: layer k is the nearest surface beyond layer k - 1."""
@@ -121,6 +129,7 @@ class ShadowMap:
             np.ascontiguousarray(pts),
             self.method,
             self.samples,
+            self.hierarchy,
             **occ,
         )
         if not inside.all():
@@ -150,6 +159,34 @@ def _check_samples(samples: Any, method: str) -> int | None:
     return samples
 
 
+def auto_settings(resolution: tuple[int, int]) -> tuple[str, tuple[int, int]]:
+    """What ``method="auto"`` runs at output ``resolution`` (W, H): the method
+    and the occluder maps' resolution.
+
+    The rule comes from the study (``python -m softshadow.study``, table in
+    ``docs/study/study.md``): on its four scenes at 256², the point of the
+    accuracy-time plane where softshadow is furthest ahead of Mitsuba's
+    ``ray_test`` at equal error is the paper's method with two passes and
+    occluder maps a quarter of the output's resolution (4.7-8.4x faster, errors
+    0.030-0.037); finer occluder maps cost 2.5-8x more for at most 0.005 less
+    error. Below 64 texels an occluder map loses small occluders, so the rule
+    keeps at least 64 (never more than the output's). For errors near 0.01,
+    ask for ``method="bitmask"``.
+    """
+    return "ssm", tuple(min(n, max(64, n // 4)) for n in resolution)
+
+
+def _check_hierarchy(hierarchy: Any, method: str) -> bool | None:
+    if hierarchy is None:
+        return DEFAULT_HIERARCHY.get(method)
+    if not isinstance(hierarchy, (bool, np.bool_)):
+        raise TypeError(f"hierarchy: must be a bool or None, got {type(hierarchy).__name__}")
+    if method not in DEFAULT_HIERARCHY:
+        allowed = tuple(DEFAULT_HIERARCHY)
+        raise ValueError(f"hierarchy: applies to the occluder-map methods {allowed}, not to {method!r}")
+    return bool(hierarchy)
+
+
 def soft_shadow_map(
     scene: Scene,
     light: RectLight,
@@ -160,6 +197,7 @@ def soft_shadow_map(
     method: str = "ssm",
     samples: int | None = None,
     occluder_resolution: int | tuple[int, int] | None = None,
+    hierarchy: bool | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map of ``scene``'s occluders on its receivers.
@@ -198,6 +236,11 @@ def soft_shadow_map(
         deterministically; converges to the true visibility as the samples
         grow. It reads no occluder maps (``occluder_depth`` is None, and
         ``passes`` does not apply).
+        ``"auto"``: the settings that, on the study's scenes, are furthest
+        ahead of ray tracing at equal error (see :func:`auto_settings`):
+        ``"ssm"`` with occluder maps at a quarter of ``resolution`` (at least
+        64) unless ``occluder_resolution`` is given. The result's ``method``
+        names the method that ran.
     samples
         Light samples per receiver for ``"bitmask"`` and ``"exact"``
         (default 256, a 16x16 stratification); refused for ``"ssm"``.
@@ -207,6 +250,15 @@ def soft_shadow_map(
         square of the occluder texel count per penumbra, so a coarser occluder
         map is much cheaper; its error is the discretization of §4.1.1 (the
         paper notes that large lights need fewer occluder texels).
+    hierarchy
+        For the occluder-map methods: read the occluder maps through a
+        min/max pyramid (2x2 texels per level). Each 8x8 tile of receivers
+        skips what cannot reach it and reads the coarsest level whose
+        texels, back-projected onto the light from the nearest occluder that
+        can reach the tile, cover at most 1/8 of the light's width: wide
+        penumbrae read few coarse texels, contact shadows keep the finest.
+        Default: on for ``"bitmask"``, off for ``"ssm"`` (the paper's
+        method, reproduced as published).
     backend
         ``"cpu"`` (all cores).
     """
@@ -220,13 +272,19 @@ def soft_shadow_map(
     passes = check.integer("passes", passes)
     if not 1 <= passes <= MAX_PASSES:
         raise ValueError(f"passes: must be in [1, {MAX_PASSES}] (occluder depth layers), got {passes}")
-    method = check.choice("method", method, METHODS)
+    method = check.choice("method", method, (*METHODS, AUTO))
+    if method == AUTO:
+        method, auto_occ = auto_settings((w, h))
+        occ_res = auto_occ if occ_res is None else occ_res
     samples = _check_samples(samples, method)
+    hierarchy = _check_hierarchy(hierarchy, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
     if occ_res is not None and method in TRACING_METHODS:
         raise ValueError(f"occluder_resolution: {method!r} reads no occluder maps")
-    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, occ_res)
+    r = _core.shadow_map_from_meshes(
+        ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, hierarchy, occ_res
+    )
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(
@@ -241,6 +299,7 @@ def soft_shadow_map(
         extent_fitted=extent is None,
         timings=dict(r["timings"]),
         samples=samples,
+        hierarchy=hierarchy,
         occluder_depth_middle=tuple(r["occluder_depth_middle"]),
         _occluder_mesh=(ov, of) if method in TRACING_METHODS else None,
     )
@@ -255,6 +314,7 @@ def soft_shadow_map_from_depth(
     occluder_depth_back: np.ndarray | None = None,
     method: str = "ssm",
     samples: int | None = None,
+    hierarchy: bool | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map from light-view depth maps rendered by the caller.
@@ -267,7 +327,8 @@ def soft_shadow_map_from_depth(
     light's (width, height) in the depth's units; ``extent`` the maps' tangent
     half-extents. The result's ``light`` is the canonical light of that size
     (center at the origin, normal +z, up +y), so ``sample`` takes points in that
-    frame.
+    frame. ``method``, ``samples`` and ``hierarchy`` are as for
+    :func:`soft_shadow_map`.
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
@@ -280,10 +341,13 @@ def soft_shadow_map_from_depth(
     if not all(s > 0 for s in size):
         raise ValueError(f"light_size: must be > 0, got {list(size)}")
     ext = check.extent(extent)
-    method = check.choice("method", method, METHODS)
+    method = check.choice("method", method, (*METHODS, AUTO))
+    if method == AUTO:
+        method = auto_settings(rec.shape[::-1])[0]
     samples = _check_samples(samples, method)
+    hierarchy = _check_hierarchy(hierarchy, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
-    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples)
+    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples, hierarchy)
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(
@@ -298,4 +362,5 @@ def soft_shadow_map_from_depth(
         extent_fitted=False,
         timings=dict(r["timings"]),
         samples=samples,
+        hierarchy=hierarchy,
     )

@@ -17,7 +17,7 @@
 //! Not done yet: closing the gaps between neighbouring micro-patches at
 //! different depths (they leak light inside the penumbra, §4.1.2).
 
-use super::gather::{self, Accumulator, Group, Lanes, RowLanes, LANES};
+use super::gather::{self, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES};
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 
 /// A 256-bit set of light samples.
@@ -26,6 +26,7 @@ type Mask = [u64; 4];
 /// The bitmask method with n x n light samples.
 pub struct Bitmask {
     pattern: Pattern,
+    hierarchy: Option<Hierarchy>,
 }
 
 /// The sample pattern as lookup tables of rank prefixes.
@@ -95,10 +96,11 @@ impl Pattern {
 
 impl Bitmask {
     /// `samples` must be one of SAMPLE_COUNTS (checked by `Method::parse`).
-    pub fn new(samples: u32) -> Bitmask {
+    pub fn new(samples: u32, hierarchy: Option<Hierarchy>) -> Bitmask {
         let n = (samples as f64).sqrt().round() as usize;
         Bitmask {
             pattern: Pattern::new(n),
+            hierarchy,
         }
     }
 }
@@ -169,11 +171,11 @@ impl Accumulator for Bitmask {
 
 impl ShadowMethod for Bitmask {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
-        gather::visibility_map(self, inputs)
+        gather::visibility_map(self, inputs, self.hierarchy)
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        gather::visibility_points(self, inputs, points)
+        gather::visibility_points(self, inputs, points, self.hierarchy)
     }
 }
 
@@ -215,7 +217,7 @@ mod tests {
         // back-projection, and the pattern places each of its 4 edges to one
         // fine stratum: 4 x 16 samples of 256 in the worst case (a stratum's
         // samples lie in one coarse row or column).
-        let max = crate::methods::plate_case::max_error(&Bitmask::new(256), 48);
+        let max = crate::methods::plate_case::max_error(&Bitmask::new(256, None), 48);
         assert!(max <= 4.0 * 16.0 / 256.0 + 1e-6, "max error {max}");
     }
 
@@ -234,7 +236,7 @@ mod tests {
             occluder_layers: vec![&front, &front],
             occluder_triangles: None,
         };
-        let v = Bitmask::new(64).visibility_map(&inputs);
+        let v = Bitmask::new(64, None).visibility_map(&inputs);
         assert!(v.iter().all(|&x| x == 0.0), "{v:?}");
     }
 }
@@ -248,7 +250,7 @@ mod bench {
     #[test]
     #[ignore]
     fn bench_bitmask() {
-        let (t, sum) = crate::methods::bench_data::time(&Bitmask::new(256), 5);
+        let (t, sum) = crate::methods::bench_data::time(&Bitmask::new(256, None), 5);
         println!("median {:.2} ms (checksum {sum:.3})", t * 1e3);
     }
 }

@@ -18,11 +18,15 @@
 //! The traversal is the shared gather of `gather.rs`; this module adds the
 //! published arithmetic: each pair adds its clipped area, the layers merge by max.
 
-use super::gather::{self, max, min, Accumulator, Group, Lanes, RowLanes, LANES};
+use super::gather::{self, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES};
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 
-/// The published method.
-pub struct Ssm;
+/// The published method; with a hierarchy, occluder texels are read at a
+/// coarser level where the penumbra is wide (not in the paper).
+#[derive(Default)]
+pub struct Ssm {
+    pub hierarchy: Option<Hierarchy>,
+}
 
 /// Added to d^2 (d = 1/zO - 1/zR) in the division: keeps 0 / 0 away where
 /// occluder and receiver share a depth (there the clipped intervals are empty
@@ -73,11 +77,11 @@ impl Accumulator for Sum {
 
 impl ShadowMethod for Ssm {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
-        gather::visibility_map(&Sum, inputs)
+        gather::visibility_map(&Sum, inputs, self.hierarchy)
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        gather::visibility_points(&Sum, inputs, points)
+        gather::visibility_points(&Sum, inputs, points, self.hierarchy)
     }
 }
 
@@ -176,7 +180,7 @@ mod tests {
                     occluder_layers: layers,
                     occluder_triangles: None,
                 };
-                let fast = Ssm.visibility_map(&inputs);
+                let fast = Ssm::default().visibility_map(&inputs);
                 let slow = brute_force(&inputs);
                 let max = fast
                     .iter()
@@ -193,7 +197,7 @@ mod tests {
                         z: receiver[k],
                     })
                     .collect();
-                let at_points = Ssm.visibility_points(&inputs, &pts);
+                let at_points = Ssm::default().visibility_points(&inputs, &pts);
                 let max = at_points
                     .iter()
                     .zip(&fast)
@@ -231,7 +235,7 @@ mod tests {
                 occluder_layers: vec![&front],
                 occluder_triangles: None,
             };
-            let fast = Ssm.visibility_map(&inputs);
+            let fast = Ssm::default().visibility_map(&inputs);
             let slow = brute_force(&inputs);
             let max = fast
                 .iter()
@@ -242,11 +246,108 @@ mod tests {
         }
     }
 
+    /// Random occluder depths in [2, 3] with the given occupancy, inf elsewhere.
+    fn random_occluders(n: usize, occupancy: f64, seed: &mut u64) -> Vec<f32> {
+        (0..n)
+            .map(|_| {
+                if lcg(seed) < occupancy {
+                    (2.0 + lcg(seed)) as f32
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_hierarchy_held_at_level_0_changes_no_bit() {
+        let mut seed = 5u64;
+        let grid = MapGrid::new(45, 38, [0.4, 0.3]).unwrap();
+        let front = random_occluders(grid.len(), 0.5, &mut seed);
+        let receiver: Vec<f32> = (0..grid.len())
+            .map(|_| (3.2 + lcg(&mut seed)) as f32)
+            .collect();
+        let inputs = ShadowInputs {
+            grid,
+            occluder_grid: grid,
+            light_size: [1.0, 0.7],
+            receiver: &receiver,
+            occluder_layers: vec![&front],
+            occluder_triangles: None,
+        };
+        let fine = Some(Hierarchy {
+            max_texel_on_light: 1e-9,
+        });
+        let without = Ssm::default().visibility_map(&inputs);
+        let with = Ssm { hierarchy: fine }.visibility_map(&inputs);
+        assert_eq!(with, without);
+    }
+
+    #[test]
+    fn a_coarse_level_reads_as_the_map_downsampled_by_majority() {
+        // An 8x8 occluder map has levels 8x8 and 4x4; with no limit on the
+        // texel's size on the light every tile reads the 4x4 level, which
+        // must shade exactly as a 4x4 map over the same extent holding, per
+        // 2x2 block, the mean 1/depth of the occupied texels where most are
+        // occupied (ties: where block i + j is even).
+        let mut seed = 9u64;
+        let (n, c) = (8usize, 4usize);
+        let og = MapGrid::new(n, n, [0.4, 0.4]).unwrap();
+        let coarse_grid = MapGrid::new(c, c, [0.4, 0.4]).unwrap();
+        let grid = MapGrid::new(24, 24, [0.4, 0.4]).unwrap();
+        for occupancy in [0.3, 0.5, 0.8] {
+            let front = random_occluders(og.len(), occupancy, &mut seed);
+            let mut coarse = vec![f32::INFINITY; c * c];
+            for j in 0..c {
+                for i in 0..c {
+                    let kids: Vec<f32> = [(0, 0), (0, 1), (1, 0), (1, 1)]
+                        .iter()
+                        .map(|(dj, di)| front[(2 * j + dj) * n + 2 * i + di])
+                        .filter(|z| z.is_finite())
+                        .collect();
+                    let wins = kids.len() > 2 || (kids.len() == 2 && (i + j) % 2 == 0);
+                    if wins {
+                        let mean_w = kids.iter().map(|z| 1.0 / z).sum::<f32>() / kids.len() as f32;
+                        coarse[j * c + i] = 1.0 / mean_w;
+                    }
+                }
+            }
+            let receiver = vec![4.0f32; grid.len()];
+            let with_levels = ShadowInputs {
+                grid,
+                occluder_grid: og,
+                light_size: [1.0, 0.8],
+                receiver: &receiver,
+                occluder_layers: vec![&front],
+                occluder_triangles: None,
+            };
+            let coarse_inputs = ShadowInputs {
+                occluder_grid: coarse_grid,
+                occluder_layers: vec![&coarse],
+                ..with_levels.clone()
+            };
+            let any_size = Some(Hierarchy {
+                max_texel_on_light: 1e9,
+            });
+            let fast = Ssm {
+                hierarchy: any_size,
+            }
+            .visibility_map(&with_levels);
+            let slow = brute_force(&coarse_inputs);
+            let max = fast
+                .iter()
+                .zip(&slow)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0f32, f32::max);
+            assert!(max < 2e-5, "occupancy {occupancy}: {max}");
+        }
+    }
+
     #[test]
     fn plate_over_parallel_floor_matches_the_closed_form() {
         // Additive micro-patches of one flat plate tile its back-projection
         // exactly, so only f32 rounding remains.
-        let max = crate::methods::plate_case::max_error(&Ssm, 64);
+        let max = crate::methods::plate_case::max_error(&Ssm::default(), 64);
         assert!(max < 1e-5, "max error {max}");
     }
 }
@@ -260,7 +361,7 @@ mod bench {
     #[test]
     #[ignore]
     fn bench_dumped() {
-        let (t, sum) = crate::methods::bench_data::time(&Ssm, 30);
+        let (t, sum) = crate::methods::bench_data::time(&Ssm::default(), 30);
         println!("median {:.2} ms (checksum {sum:.3})", t * 1e3);
     }
 }

@@ -79,7 +79,7 @@ fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, occluder_resolution=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, hierarchy=None, occluder_resolution=None))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -94,10 +94,11 @@ fn shadow_map_from_meshes<'py>(
     passes: u32,
     method: &str,
     samples: Option<u32>,
+    hierarchy: Option<bool>,
     occluder_resolution: Option<(usize, usize)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let light = light_of(light)?;
-    let method = Method::parse(method, samples)?;
+    let method = Method::parse(method, samples, hierarchy)?;
     let occ = MeshRef {
         vertices: triples("occluders", &occ_vertices)?,
         faces: triples("occluders", &occ_faces)?,
@@ -140,7 +141,7 @@ fn shadow_map_from_meshes<'py>(
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None, hierarchy=None))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_depth<'py>(
     py: Python<'py>,
@@ -151,8 +152,9 @@ fn shadow_map_from_depth<'py>(
     extent: (f64, f64),
     method: &str,
     samples: Option<u32>,
+    hierarchy: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = Method::parse(method, samples)?;
+    let method = Method::parse(method, samples, hierarchy)?;
     let shape = receiver_depth.shape();
     // The occluder maps may be coarser or finer than the receiver map (same extent).
     let oshape = occluder_depth.shape();
@@ -187,7 +189,7 @@ fn shadow_map_from_depth<'py>(
 /// Visibility at world points from a shadow map's occluders: its occluder maps
 /// (map methods) or the occluder mesh (ray-traced methods).
 #[pyfunction]
-#[pyo3(signature = (light, extent, width, height, points, method, samples=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None, occluder_depth_middle=None))]
+#[pyo3(signature = (light, extent, width, height, points, method, samples=None, hierarchy=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None, occluder_depth_middle=None))]
 #[allow(clippy::too_many_arguments)]
 fn sample_points<'py>(
     py: Python<'py>,
@@ -198,6 +200,7 @@ fn sample_points<'py>(
     points: PyReadonlyArray2<'py, f64>,
     method: &str,
     samples: Option<u32>,
+    hierarchy: Option<bool>,
     occluder_depth: Option<PyReadonlyArray2<'py, f32>>,
     occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
     occ_vertices: Option<PyReadonlyArray2<'py, f64>>,
@@ -205,7 +208,7 @@ fn sample_points<'py>(
     occluder_depth_middle: Option<Vec<PyReadonlyArray2<'py, f32>>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let light = light_of(light)?;
-    let method = Method::parse(method, samples)?;
+    let method = Method::parse(method, samples, hierarchy)?;
     let grid = MapGrid::new(width, height, [extent.0, extent.1])?;
     let middle = occluder_depth_middle.unwrap_or_default();
     let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
