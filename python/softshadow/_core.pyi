@@ -33,6 +33,7 @@ def shadow_map_from_meshes(
     method: str,
     samples: int | None = None,
     hierarchy: bool | None = None,
+    precision: str | None = None,
     occluder_resolution: tuple[int, int] | None = None,
 ) -> dict[str, Any]:
     """Rasterizes the receivers (and, for the map methods, the occluders) into
@@ -42,7 +43,9 @@ def shadow_map_from_meshes(
     for methods that trace triangles), ``occluder_depth_middle`` (the peeled
     layers, a list; empty below 3 passes), ``extent``: (tx, ty) and
     ``timings``: {stage: seconds}. ``samples`` is for the sampling methods
-    only."""
+    only, ``hierarchy`` (None: the method's default) for the occluder-map
+    methods, ``precision`` ("f32", "f64", "f16", "f16-batched"; None: "f32")
+    for "ssm"."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
@@ -53,6 +56,7 @@ def shadow_map_from_depth(
     method: str,
     samples: int | None = None,
     hierarchy: bool | None = None,
+    precision: str | None = None,
 ) -> dict[str, Any]:
     """Visibility from depth maps (the occluder maps may have their own
     resolution; the output has the receiver map's). Returns ``visibility`` and
@@ -67,6 +71,7 @@ def sample_points(
     method: str,
     samples: int | None = None,
     hierarchy: bool | None = None,
+    precision: str | None = None,
     occluder_depth: npt.NDArray[np.float32] | None = None,
     occluder_depth_back: npt.NDArray[np.float32] | None = None,
     occ_vertices: npt.NDArray[np.float64] | None = None,

@@ -24,6 +24,8 @@ TRACING_METHODS = ("exact",)
 # Whether the occluder hierarchy is on by default, per occluder-map method:
 # off for the paper's method (published without one), on for bitmask.
 DEFAULT_HIERARCHY = {"ssm": False, "bitmask": True}
+# How "ssm" sums micro-patch occlusions (the others count samples exactly).
+PRECISIONS = ("f32", "f64", "f16", "f16-batched")
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 MAX_PASSES = 8  # keep in sync with MAX_PASSES in src/pipeline.rs
 BACKENDS = ("cpu",)
@@ -63,6 +65,8 @@ class ShadowMap:
     """Light samples per receiver (sampling methods), else None."""
     hierarchy: bool | None = None
     """Whether the occluder hierarchy was used (occluder-map methods), else None."""
+    precision: str | None = None
+    """How ``"ssm"`` summed the occlusions (see ``precision=``), else None."""
     occluder_depth_middle: tuple[np.ndarray, ...] = ()
     """With ``passes`` >= 3, the peeled layers between front and back, nearest
     first: layer k is the nearest surface beyond layer k - 1."""
@@ -130,6 +134,7 @@ class ShadowMap:
             self.method,
             self.samples,
             self.hierarchy,
+            self.precision,
             **occ,
         )
         if not inside.all():
@@ -176,6 +181,15 @@ def auto_settings(resolution: tuple[int, int]) -> tuple[str, tuple[int, int]]:
     return "ssm", tuple(min(n, max(64, n // 4)) for n in resolution)
 
 
+def _check_precision(precision: Any, method: str) -> str | None:
+    if precision is None:
+        return "f32" if method == "ssm" else None
+    precision = check.choice("precision", precision, PRECISIONS)
+    if method != "ssm":
+        raise ValueError(f"precision: applies to 'ssm' (sums of occlusions), not to {method!r}")
+    return precision
+
+
 def _check_hierarchy(hierarchy: Any, method: str) -> bool | None:
     if hierarchy is None:
         return DEFAULT_HIERARCHY.get(method)
@@ -198,6 +212,7 @@ def soft_shadow_map(
     samples: int | None = None,
     occluder_resolution: int | tuple[int, int] | None = None,
     hierarchy: bool | None = None,
+    precision: str | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map of ``scene``'s occluders on its receivers.
@@ -259,6 +274,19 @@ def soft_shadow_map(
         penumbrae read few coarse texels, contact shadows keep the finest.
         Default: on for ``"bitmask"``, off for ``"ssm"`` (the paper's
         method, reproduced as published).
+    precision
+        How ``"ssm"`` sums the micro-patch occlusions (Appendix A of the
+        paper): ``"f32"`` (default; each occluder row is summed on its own
+        before joining the total, which keeps the rounding error near
+        sqrt(M) eps for M micro-patches: within 1e-4 of ``"f64"`` at 4096²),
+        ``"f64"``, ``"f16"`` (the 2005 GPUs' FP16 blending, emulated: every
+        contribution rounded to binary16 and added to a binary16 sum, to
+        nearest, in rasterization order; fails where a micro-patch hides less
+        than about 2^-10 of the light, see ``softshadow.fp16`` and
+        docs/precision/fp16.md) and ``"f16-batched"`` (the paper's workaround:
+        FP16 sums over batches of about sqrt(M) micro-patches, the batches
+        added in f32). Refused for the other methods, which count samples
+        exactly.
     backend
         ``"cpu"`` (all cores).
     """
@@ -278,12 +306,13 @@ def soft_shadow_map(
         occ_res = auto_occ if occ_res is None else occ_res
     samples = _check_samples(samples, method)
     hierarchy = _check_hierarchy(hierarchy, method)
+    precision = _check_precision(precision, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
     if occ_res is not None and method in TRACING_METHODS:
         raise ValueError(f"occluder_resolution: {method!r} reads no occluder maps")
     r = _core.shadow_map_from_meshes(
-        ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, hierarchy, occ_res
+        ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, hierarchy, precision, occ_res
     )
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
@@ -300,6 +329,7 @@ def soft_shadow_map(
         timings=dict(r["timings"]),
         samples=samples,
         hierarchy=hierarchy,
+        precision=precision,
         occluder_depth_middle=tuple(r["occluder_depth_middle"]),
         _occluder_mesh=(ov, of) if method in TRACING_METHODS else None,
     )
@@ -315,6 +345,7 @@ def soft_shadow_map_from_depth(
     method: str = "ssm",
     samples: int | None = None,
     hierarchy: bool | None = None,
+    precision: str | None = None,
     backend: str = "cpu",
 ) -> ShadowMap:
     """Soft shadow map from light-view depth maps rendered by the caller.
@@ -327,7 +358,7 @@ def soft_shadow_map_from_depth(
     light's (width, height) in the depth's units; ``extent`` the maps' tangent
     half-extents. The result's ``light`` is the canonical light of that size
     (center at the origin, normal +z, up +y), so ``sample`` takes points in that
-    frame. ``method``, ``samples`` and ``hierarchy`` are as for
+    frame. ``method``, ``samples``, ``hierarchy`` and ``precision`` are as for
     :func:`soft_shadow_map`.
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
@@ -346,8 +377,9 @@ def soft_shadow_map_from_depth(
         method = auto_settings(rec.shape[::-1])[0]
     samples = _check_samples(samples, method)
     hierarchy = _check_hierarchy(hierarchy, method)
+    precision = _check_precision(precision, method)
     check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
-    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples, hierarchy)
+    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples, hierarchy, precision)
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(
@@ -363,4 +395,5 @@ def soft_shadow_map_from_depth(
         timings=dict(r["timings"]),
         samples=samples,
         hierarchy=hierarchy,
+        precision=precision,
     )

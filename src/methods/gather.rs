@@ -30,6 +30,15 @@ pub(super) trait Accumulator: Sync {
     fn full(&self, acc: &Self::State, g: &Group) -> bool;
     /// Occlusion per lane in [0, 1].
     fn occlusion(&self, acc: &Self::State) -> Lanes;
+    /// Whether occluder rows are visited top to bottom, the order in which
+    /// the paper's GPU blended micro-patches (what FP16 emulation needs),
+    /// rather than outward from the tile (what reaches umbra soonest).
+    const ROW_MAJOR: bool = false;
+    /// Called (with ROW_MAJOR) where the rows pass from one batch of about
+    /// sqrt(M) micro-patches to the next (see `Layer::row_batch`).
+    fn end_batch(&self, _acc: &mut Self::State) {}
+    /// Called after each occluder row a group shades (before `full`).
+    fn end_row(&self, _acc: &mut Self::State) {}
 }
 
 /// Per-lane receiver coordinates for one occluder row, in half-light units
@@ -73,6 +82,10 @@ struct Layer {
     block_w_max: Vec<f32>,
     rows: Vec<RowSpan>,
     w_max: f32,
+    /// Batch of each row: runs of rows holding about sqrt(M) of the M
+    /// occupied texels each (Appendix A's workaround for FP16 blending; the
+    /// batches end at row boundaries here).
+    row_batch: Vec<u32>,
 }
 
 #[derive(Clone, Copy)]
@@ -172,7 +185,23 @@ impl Layer {
             })
             .collect();
         let w_max = rows.iter().fold(0f32, |m, r| m.max(r.w_max));
+        let occupied: Vec<usize> = w
+            .chunks(width)
+            .map(|row| row.iter().filter(|&&x| x > 0.0).count())
+            .collect();
+        let m: usize = occupied.iter().sum();
+        let per_batch = m.div_ceil(((m as f64).sqrt() as usize).max(1)).max(1);
+        let mut before = 0;
+        let row_batch = occupied
+            .iter()
+            .map(|&n| {
+                let b = (before / per_batch) as u32;
+                before += n;
+                b
+            })
+            .collect();
         Layer {
+            row_batch,
             w,
             w_far,
             w_near,
@@ -482,6 +511,21 @@ impl Kernel {
         let last = lv.height as isize - 1;
         let j_lo = (self.row_coord(lv, g.y_hi + reach_y).floor() as isize).clamp(0, last);
         let j_hi = (self.row_coord(lv, g.y_lo - reach_y).ceil() as isize).clamp(0, last);
+        if A::ROW_MAJOR {
+            for j in j_lo..=j_hi {
+                let j = j as usize;
+                if j as isize > j_lo && layer.row_batch[j] != layer.row_batch[j - 1] {
+                    a.end_batch(acc);
+                }
+                if self.add_row(a, acc, lv, layer, j, g) {
+                    a.end_row(acc);
+                    if a.full(acc, g) {
+                        return;
+                    }
+                }
+            }
+            return;
+        }
         // Visit rows outward from the receivers' own rows: in umbra the sums
         // reach 1 soonest that way.
         let j_c = (self.row_coord(lv, 0.5 * (g.y_lo + g.y_hi)).round() as isize).clamp(j_lo, j_hi);
@@ -489,8 +533,9 @@ impl Kernel {
         while up >= j_lo || down <= j_hi {
             let mut touched = false;
             for j in [up, down] {
-                if j >= j_lo && j <= j_hi {
-                    touched |= self.add_row(a, acc, lv, layer, j as usize, g);
+                if j >= j_lo && j <= j_hi && self.add_row(a, acc, lv, layer, j as usize, g) {
+                    a.end_row(acc);
+                    touched = true;
                 }
             }
             if touched && a.full(acc, g) {

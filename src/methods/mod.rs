@@ -54,7 +54,10 @@ pub enum Method {
     /// Soft shadow maps, Atty et al. 2005, as published (additive
     /// micro-patches); `hierarchy` reads coarser occluder texels where the
     /// penumbra is wide (off by default: the paper has none).
-    Ssm { hierarchy: bool },
+    Ssm {
+        hierarchy: bool,
+        precision: ssm::Precision,
+    },
     /// Ray casting against the occluder triangles with stratified light samples.
     Exact { samples: u32 },
     /// Micro-patches marking light samples in a bit mask per receiver (OR);
@@ -80,11 +83,33 @@ pub const MAX_SAMPLES: u32 = 1 << 16;
 
 impl Method {
     /// The method named `name`; `samples` is for the sampling methods only,
-    /// `hierarchy` for the occluder-map methods only.
-    pub fn parse(name: &str, samples: Option<u32>, hierarchy: Option<bool>) -> Result<Self> {
+    /// `hierarchy` for the occluder-map methods only, `precision` for "ssm"
+    /// only (the others count samples in integers).
+    pub fn parse(
+        name: &str,
+        samples: Option<u32>,
+        hierarchy: Option<bool>,
+        precision: Option<&str>,
+    ) -> Result<Self> {
+        let precision = match precision {
+            None => None,
+            Some(p) => Some(ssm::Precision::parse(p).ok_or_else(|| {
+                Error::invalid(
+                    "precision",
+                    format!("must be one of \"f32\", \"f64\", \"f16\", \"f16-batched\", got {p:?}"),
+                )
+            })?),
+        };
+        if name != "ssm" && precision.is_some() {
+            return Err(Error::invalid(
+                "precision",
+                "applies to \"ssm\" (sums of occlusions); the other methods count samples exactly",
+            ));
+        }
         let method = match name {
             "ssm" => Method::Ssm {
                 hierarchy: hierarchy.unwrap_or(false),
+                precision: precision.unwrap_or_default(),
             },
             "exact" => Method::Exact {
                 samples: samples.unwrap_or(DEFAULT_SAMPLES),
@@ -137,8 +162,12 @@ impl Method {
 
     pub fn implementation(&self) -> Box<dyn ShadowMethod> {
         match *self {
-            Method::Ssm { hierarchy } => Box::new(ssm::Ssm {
+            Method::Ssm {
+                hierarchy,
+                precision,
+            } => Box::new(ssm::Ssm {
                 hierarchy: hierarchy.then_some(HIERARCHY),
+                precision,
             }),
             Method::Exact { samples } => Box::new(exact::Exact { samples }),
             Method::Bitmask { samples, hierarchy } => Box::new(bitmask::Bitmask::new(

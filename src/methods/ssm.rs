@@ -26,62 +26,240 @@ use super::{LightPoint, ShadowInputs, ShadowMethod};
 #[derive(Default)]
 pub struct Ssm {
     pub hierarchy: Option<Hierarchy>,
+    pub precision: Precision,
+}
+
+/// How the micro-patch occlusions are summed (Appendix A of the paper).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Precision {
+    /// f32 sums, each occluder row summed on its own before joining the
+    /// total: a two-level sum whose rounding error grows as sqrt(M) eps, not
+    /// M eps, for M micro-patches (held to 1e-4 of f64 at 4096²).
+    #[default]
+    F32,
+    /// f64 sums (the contributions themselves are computed in f32).
+    F64,
+    /// The 2005 GPUs' FP16 blending, emulated: every contribution rounded to
+    /// binary16, added to a binary16 sum (to nearest), in the order the
+    /// micro-patches were rasterized (occluder rows top to bottom, texels
+    /// left to right).
+    F16,
+    /// Appendix A's workaround: FP16 sums over batches of about sqrt(M)
+    /// micro-patches (runs of occluder rows), the batches added in f32.
+    F16Batched,
+}
+
+impl Precision {
+    pub fn parse(name: &str) -> Option<Precision> {
+        Some(match name {
+            "f32" => Precision::F32,
+            "f64" => Precision::F64,
+            "f16" => Precision::F16,
+            "f16-batched" => Precision::F16Batched,
+            _ => return None,
+        })
+    }
 }
 
 /// Added to d^2 (d = 1/zO - 1/zR) in the division: keeps 0 / 0 away where
 /// occluder and receiver share a depth (there the clipped intervals are empty
 /// and the contribution is exactly 0); negligible against any real d^2.
 const D2_MIN: f32 = 1e-36;
-/// Sums 4x the occluded fraction (see `add_texel`).
+
+/// 4x the light fraction micro-patch [x0, x1] x (row) hides from lane l.
+/// The patch seen from the receiver covers, on the light, r [x0 - xr, x1 - xr]
+/// with r = 1/d, d = wO - wR, intersected with the light [-1, 1];
+/// equivalently [x0 - xr, x1 - xr] is clipped to [-d, d] and the length
+/// scaled by r. The area fraction is cx cy / (4 d^2): one division per pair
+/// and no mask, since for d <= 0 the clipped intervals are empty.
+#[inline(always)]
+fn contribution(l: usize, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) -> f32 {
+    let d = w - g.wr[l];
+    // |[a, b] ∩ [-d, d]| = min(b, d) + min(-a, d) when >= 0.
+    let cx = min(x1 - r.xr[l], d) + min(r.xr[l] - x0, d);
+    let cy = min(r.ay1[l], d) + min(r.nay0[l], d);
+    // d^2 + D2_MIN keeps 0/0 away where d = 0 (then cx, cy <= 0).
+    max(cx, 0.0) * max(cy, 0.0) / d.mul_add(d, D2_MIN)
+}
+
+/// f32 sums of 4x the occluded fraction (the 1/4 is applied in `occlusion`),
+/// two-level: `row` collects one occluder row, `total` the rows.
 struct Sum;
 
+#[derive(Clone, Copy)]
+struct TwoLevel {
+    total: Lanes,
+    row: Lanes,
+}
+
 impl Accumulator for Sum {
-    type State = Lanes;
+    type State = TwoLevel;
     const LAYERS_SHARE_STATE: bool = false;
 
-    fn empty(&self) -> Lanes {
-        [0.0; LANES]
-    }
-
-    /// The micro-patch [x0, x1] seen from the receiver covers, on the light,
-    /// r [x0 - xr, x1 - xr] with r = 1/d, d = wO - wR, intersected with the
-    /// light [-1, 1]; equivalently [x0 - xr, x1 - xr] is clipped to [-d, d]
-    /// and the length scaled by r. The area fraction is cx cy / (4 d^2): one
-    /// division per pair and no mask, since for d <= 0 the clipped intervals
-    /// are empty. The 1/4 is applied in `occlusion`.
-    #[inline(always)]
-    #[allow(clippy::needless_range_loop)] // one index over several lane arrays: what vectorizes
-    fn add_texel(&self, acc: &mut Lanes, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
-        for l in 0..LANES {
-            let d = w - g.wr[l];
-            // |[a, b] ∩ [-d, d]| = min(b, d) + min(-a, d) when >= 0.
-            let cx = min(x1 - r.xr[l], d) + min(r.xr[l] - x0, d);
-            let cy = min(r.ay1[l], d) + min(r.nay0[l], d);
-            // d^2 + D2_MIN keeps 0/0 away where d = 0 (then cx, cy <= 0).
-            acc[l] += max(cx, 0.0) * max(cy, 0.0) / d.mul_add(d, D2_MIN);
+    fn empty(&self) -> TwoLevel {
+        TwoLevel {
+            total: [0.0; LANES],
+            row: [0.0; LANES],
         }
     }
 
-    /// Contributions are non-negative and the result is clamped, so a sum that
-    /// reached 1 is final.
     #[inline(always)]
-    fn full(&self, acc: &Lanes, _g: &Group) -> bool {
-        acc.iter().all(|&a| a >= 4.0)
+    #[allow(clippy::needless_range_loop)] // one index over several lane arrays: what vectorizes
+    fn add_texel(&self, acc: &mut TwoLevel, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
+        for l in 0..LANES {
+            acc.row[l] += contribution(l, w, x0, x1, r, g);
+        }
+    }
+
+    /// The gather calls `full` after every row it shades: the row's sums
+    /// join the totals there. Contributions are non-negative and the result
+    /// is clamped, so a total that reached 1 is final.
+    #[inline(always)]
+    fn full(&self, acc: &TwoLevel, _g: &Group) -> bool {
+        acc.total.iter().zip(&acc.row).all(|(&t, &r)| t + r >= 4.0)
     }
 
     #[inline(always)]
-    fn occlusion(&self, acc: &Lanes) -> Lanes {
-        acc.map(|a| (0.25 * a).min(1.0))
+    fn occlusion(&self, acc: &TwoLevel) -> Lanes {
+        std::array::from_fn(|l| (0.25 * (acc.total[l] + acc.row[l])).min(1.0))
+    }
+
+    #[inline(always)]
+    fn end_row(&self, acc: &mut TwoLevel) {
+        for l in 0..LANES {
+            acc.total[l] += acc.row[l];
+            acc.row[l] = 0.0;
+        }
+    }
+}
+
+/// f64 sums of 4x the occluded fraction.
+struct Sum64;
+
+impl Accumulator for Sum64 {
+    type State = [f64; LANES];
+    const LAYERS_SHARE_STATE: bool = false;
+
+    fn empty(&self) -> Self::State {
+        [0.0; LANES]
+    }
+
+    #[inline(always)]
+    fn add_texel(&self, acc: &mut Self::State, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
+        for (l, a) in acc.iter_mut().enumerate() {
+            *a += contribution(l, w, x0, x1, r, g) as f64;
+        }
+    }
+
+    fn full(&self, acc: &Self::State, _g: &Group) -> bool {
+        acc.iter().all(|&a| a >= 4.0)
+    }
+
+    fn occlusion(&self, acc: &Self::State) -> Lanes {
+        acc.map(|a| (0.25 * a).min(1.0) as f32)
+    }
+}
+
+/// A finite x >= 0 rounded to the nearest binary16 value, ties to even (10
+/// mantissa bits, normals from 2^-14, subnormals in steps of 2^-24, largest
+/// 65504), as f32. Appendix A states the rule X + e = X for e < 2^-10 X
+/// (one ulp); to nearest, e is lost below half an ulp. Rounding toward zero
+/// instead was measured to break the floating bunny already at 128² (12%
+/// errors where condition (4) holds everywhere), which Figure 14 does not
+/// show; to nearest reproduces it (docs/precision/fp16.md).
+pub fn round_to_f16(x: f32) -> f32 {
+    const MIN_NORMAL: f32 = 1.0 / 16384.0; // 2^-14
+    if x < MIN_NORMAL {
+        return (x * 16_777_216.0).round_ties_even() / 16_777_216.0; // steps of 2^-24
+    }
+    // Drop 13 of f32's 23 mantissa bits, rounding to nearest even.
+    let bits = x.to_bits();
+    let rounded = f32::from_bits((bits + 0x0fff + ((bits >> 13) & 1)) & !0x1fff);
+    if rounded > 65504.0 {
+        f32::INFINITY
+    } else {
+        rounded
+    }
+}
+
+/// FP16 blending, emulated: occluded fractions (not 4x: the GPU blended the
+/// fraction) rounded to binary16 and summed in binary16 (see
+/// `round_to_f16`), in rasterization order; with `batched`, the FP16 sum restarts every batch and the batches
+/// add in f32.
+struct SumF16 {
+    batched: bool,
+}
+
+#[derive(Clone, Copy)]
+struct F16State {
+    /// The finished batches, in f32.
+    done: Lanes,
+    /// The current binary16 sum (every value representable in binary16).
+    sum: Lanes,
+}
+
+impl Accumulator for SumF16 {
+    type State = F16State;
+    const LAYERS_SHARE_STATE: bool = false;
+    const ROW_MAJOR: bool = true;
+
+    fn empty(&self) -> F16State {
+        F16State {
+            done: [0.0; LANES],
+            sum: [0.0; LANES],
+        }
+    }
+
+    #[inline(always)]
+    fn add_texel(&self, acc: &mut F16State, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
+        for l in 0..LANES {
+            // Exact in binary: the 1/4 only moves the exponent.
+            let c = round_to_f16(0.25 * contribution(l, w, x0, x1, r, g));
+            acc.sum[l] = round_to_f16(acc.sum[l] + c);
+        }
+    }
+
+    fn full(&self, acc: &F16State, _g: &Group) -> bool {
+        acc.done.iter().zip(&acc.sum).all(|(&d, &s)| d + s >= 1.0)
+    }
+
+    fn occlusion(&self, acc: &F16State) -> Lanes {
+        std::array::from_fn(|l| (acc.done[l] + acc.sum[l]).min(1.0))
+    }
+
+    fn end_batch(&self, acc: &mut F16State) {
+        if self.batched {
+            for l in 0..LANES {
+                acc.done[l] += acc.sum[l];
+                acc.sum[l] = 0.0;
+            }
+        }
     }
 }
 
 impl ShadowMethod for Ssm {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
-        gather::visibility_map(&Sum, inputs, self.hierarchy)
+        let h = self.hierarchy;
+        match self.precision {
+            Precision::F32 => gather::visibility_map(&Sum, inputs, h),
+            Precision::F64 => gather::visibility_map(&Sum64, inputs, h),
+            Precision::F16 => gather::visibility_map(&SumF16 { batched: false }, inputs, h),
+            Precision::F16Batched => gather::visibility_map(&SumF16 { batched: true }, inputs, h),
+        }
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        gather::visibility_points(&Sum, inputs, points, self.hierarchy)
+        let h = self.hierarchy;
+        match self.precision {
+            Precision::F32 => gather::visibility_points(&Sum, inputs, points, h),
+            Precision::F64 => gather::visibility_points(&Sum64, inputs, points, h),
+            Precision::F16 => {
+                gather::visibility_points(&SumF16 { batched: false }, inputs, points, h)
+            }
+            Precision::F16Batched => {
+                gather::visibility_points(&SumF16 { batched: true }, inputs, points, h)
+            }
+        }
     }
 }
 
@@ -279,7 +457,11 @@ mod tests {
             max_texel_on_light: 1e-9,
         });
         let without = Ssm::default().visibility_map(&inputs);
-        let with = Ssm { hierarchy: fine }.visibility_map(&inputs);
+        let with = Ssm {
+            hierarchy: fine,
+            ..Default::default()
+        }
+        .visibility_map(&inputs);
         assert_eq!(with, without);
     }
 
@@ -331,6 +513,7 @@ mod tests {
             });
             let fast = Ssm {
                 hierarchy: any_size,
+                ..Default::default()
             }
             .visibility_map(&with_levels);
             let slow = brute_force(&coarse_inputs);
@@ -340,6 +523,61 @@ mod tests {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0f32, f32::max);
             assert!(max < 2e-5, "occupancy {occupancy}: {max}");
+        }
+    }
+
+    /// binary16 bits -> value, written independently of `round_to_f16`.
+    fn decode_f16(bits: u16) -> f32 {
+        let e = ((bits >> 10) & 0x1f) as i32;
+        let m = (bits & 0x3ff) as f32;
+        match e {
+            0 => m * 2f32.powi(-24),
+            _ => (1.0 + m / 1024.0) * 2f32.powi(e - 15),
+        }
+    }
+
+    #[test]
+    fn rounding_to_f16_keeps_every_f16_and_sends_midpoints_to_even() {
+        // Every positive finite binary16 value, and the way to the next.
+        for bits in 0u16..0x7bff {
+            let (a, b) = (decode_f16(bits), decode_f16(bits + 1));
+            assert_eq!(round_to_f16(a), a, "{bits:#x}");
+            let mid = 0.5 * (a + b); // exact in f32
+            let even = if bits % 2 == 0 { a } else { b };
+            assert_eq!(round_to_f16(mid), even, "midpoint after {bits:#x}");
+            assert_eq!(round_to_f16(mid - (b - a) / 64.0), a);
+            assert_eq!(round_to_f16(mid + (b - a) / 64.0), b);
+        }
+        assert_eq!(round_to_f16(65504.0), 65504.0);
+        assert_eq!(round_to_f16(65520.0), f32::INFINITY);
+        // Appendix A: 2048 + 1 = 2048 (a tie, to even); 0.5 + 1/2049 is lost
+        // to truncation, which the paper's rule describes, but not to
+        // nearest, which goes up to 0.5 + 1/2048; below half an ulp it is lost.
+        assert_eq!(round_to_f16(2048.0 + 1.0), 2048.0);
+        assert_eq!(
+            round_to_f16(0.5 + round_to_f16(1.0 / 2049.0)),
+            0.5 + 1.0 / 2048.0
+        );
+        assert_eq!(round_to_f16(0.5 + round_to_f16(1.0 / 4097.0)), 0.5);
+    }
+
+    #[test]
+    fn every_precision_meets_the_plate_closed_form_where_fp16_suffices() {
+        // At 48² each micro-patch of the plate hides (1/24)² of the light,
+        // above FP16's 2^-10 limit (Appendix A), so every precision holds;
+        // f16 rounds each of about 300 contributions, each by 2^-11 at most.
+        for (precision, bound) in [
+            (Precision::F32, 1e-5),
+            (Precision::F64, 1e-5),
+            (Precision::F16, 2e-2),
+            (Precision::F16Batched, 2e-2),
+        ] {
+            let ssm = Ssm {
+                precision,
+                ..Default::default()
+            };
+            let max = crate::methods::plate_case::max_error(&ssm, 48);
+            assert!(max < bound, "{precision:?}: max error {max}");
         }
     }
 

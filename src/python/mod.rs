@@ -79,7 +79,7 @@ fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, hierarchy=None, occluder_resolution=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, hierarchy=None, precision=None, occluder_resolution=None))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -95,10 +95,11 @@ fn shadow_map_from_meshes<'py>(
     method: &str,
     samples: Option<u32>,
     hierarchy: Option<bool>,
+    precision: Option<&str>,
     occluder_resolution: Option<(usize, usize)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let light = light_of(light)?;
-    let method = Method::parse(method, samples, hierarchy)?;
+    let method = Method::parse(method, samples, hierarchy, precision)?;
     let occ = MeshRef {
         vertices: triples("occluders", &occ_vertices)?,
         faces: triples("occluders", &occ_faces)?,
@@ -141,7 +142,7 @@ fn shadow_map_from_meshes<'py>(
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None, hierarchy=None))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None, hierarchy=None, precision=None))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_depth<'py>(
     py: Python<'py>,
@@ -153,8 +154,9 @@ fn shadow_map_from_depth<'py>(
     method: &str,
     samples: Option<u32>,
     hierarchy: Option<bool>,
+    precision: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = Method::parse(method, samples, hierarchy)?;
+    let method = Method::parse(method, samples, hierarchy, precision)?;
     let shape = receiver_depth.shape();
     // The occluder maps may be coarser or finer than the receiver map (same extent).
     let oshape = occluder_depth.shape();
@@ -189,7 +191,7 @@ fn shadow_map_from_depth<'py>(
 /// Visibility at world points from a shadow map's occluders: its occluder maps
 /// (map methods) or the occluder mesh (ray-traced methods).
 #[pyfunction]
-#[pyo3(signature = (light, extent, width, height, points, method, samples=None, hierarchy=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None, occluder_depth_middle=None))]
+#[pyo3(signature = (light, extent, width, height, points, method, samples=None, hierarchy=None, precision=None, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None, occluder_depth_middle=None))]
 #[allow(clippy::too_many_arguments)]
 fn sample_points<'py>(
     py: Python<'py>,
@@ -201,6 +203,7 @@ fn sample_points<'py>(
     method: &str,
     samples: Option<u32>,
     hierarchy: Option<bool>,
+    precision: Option<&str>,
     occluder_depth: Option<PyReadonlyArray2<'py, f32>>,
     occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
     occ_vertices: Option<PyReadonlyArray2<'py, f64>>,
@@ -208,7 +211,7 @@ fn sample_points<'py>(
     occluder_depth_middle: Option<Vec<PyReadonlyArray2<'py, f32>>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let light = light_of(light)?;
-    let method = Method::parse(method, samples, hierarchy)?;
+    let method = Method::parse(method, samples, hierarchy, precision)?;
     let grid = MapGrid::new(width, height, [extent.0, extent.1])?;
     let middle = occluder_depth_middle.unwrap_or_default();
     let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
