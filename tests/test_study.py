@@ -40,3 +40,18 @@ def test_study_plane_on_a_small_map(tmp_path):
     # The plate is the paper's easy case: the SSM is nearly exact on it.
     row = next(line for line in md.splitlines() if "| square_plate | ssm | 2 passes, occluders 64² |" in line)
     assert float(row.split("|")[5]) < 0.02
+    assert "| square_plate | auto | ssm, 2 passes, occluders 64² |" in md
+    summary = md.split("### Summary")[1]
+    assert "| square_plate |" in summary
+
+
+def test_mitsuba_time_at_equal_error_follows_the_sample_law():
+    from softshadow.study import Point, mitsuba_seconds_at
+
+    # error = 0.4 / sqrt(k), time = k ms: the interpolation is exact inside
+    # and the extrapolation keeps the law outside.
+    pts = [Point("s", "mitsuba", f"{k} samples", k * 1e-3, 0.4 / k**0.5) for k in (4, 16, 64)]
+    for k, outside in ((8, False), (30, False), (256, True), (2, True)):
+        t, out = mitsuba_seconds_at(0.4 / k**0.5, pts)
+        assert t == pytest.approx(k * 1e-3, rel=1e-9)
+        assert out is outside

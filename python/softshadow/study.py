@@ -37,7 +37,7 @@ import numpy as np
 from . import metrics, scenes
 from .light import RectLight
 from .scene import Scene
-from .shadow_map import ShadowMap, soft_shadow_map
+from .shadow_map import ShadowMap, auto_settings, soft_shadow_map
 
 PLANE_SCENES = ("bunny_floating", "bunny_on_floor", "two_spheres", "torus")
 
@@ -101,11 +101,19 @@ class Study:
                     passes=passes,
                     occluder_resolution=occ,
                 )
+        measure("auto", f"ssm, 2 passes, occluders {auto_settings((res, res))[1][0]}²", method="auto")
         for k in (64, 256) if not self.quick else (256,):
             for occ in occ_levels[:2]:
                 measure(
                     "bitmask", f"{k} samples, occluders {occ}²", method="bitmask", samples=k, occluder_resolution=occ
                 )
+        measure(
+            "bitmask",
+            f"256 samples, occluders {res}², no hierarchy",
+            method="bitmask",
+            samples=256,
+            hierarchy=False,
+        )
         for k in (16, 64, 256) if not self.quick else (16, 64):
             measure("exact", f"{k} samples", method="exact", samples=k)
         rscene = self.reference.ReferenceScene(scene.occluders)
@@ -200,6 +208,7 @@ def plot_plane(points: list[Point], path: str, title: str) -> None:
     fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=110)
     styles = {
         "ssm": ("o", "tab:blue"),
+        "auto": ("*", "tab:orange"),
         "bitmask": ("D", "tab:purple"),
         "exact": ("s", "tab:green"),
         "mitsuba": ("^", "tab:red"),
@@ -252,10 +261,55 @@ def plot_curves(
     plt.close(fig)
 
 
+def mitsuba_seconds_at(error: float, points: list[Point]) -> tuple[float, bool]:
+    """Mitsuba's ray_test time at ``error`` on the scene of ``points``,
+    interpolated log-log between its measured sample counts (error ~
+    1/sqrt(samples), time ~ samples), and whether that extrapolates."""
+    mi = sorted((p.error, p.seconds) for p in points if p.method == "mitsuba")
+    le, lt = np.log([m[0] for m in mi]), np.log([m[1] for m in mi])
+    outside = not (le[0] <= np.log(error) <= le[-1])
+    # Beyond the measured range, extend the last segment's slope.
+    i = 0 if np.log(error) < le[0] else max(0, min(len(le) - 2, int(np.searchsorted(le, np.log(error))) - 1))
+    slope = (lt[i + 1] - lt[i]) / (le[i + 1] - le[i])
+    return float(np.exp(lt[i] + slope * (np.log(error) - le[i]))), outside
+
+
 def markdown_plane(points: list[Point]) -> str:
-    lines = ["| scene | method | setting | time (ms) | error |", "|---|---|---|---|---|"]
+    lines = [
+        "| scene | method | setting | time (ms) | error | Mitsuba at equal error (ms) | Mitsuba time / time |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for p in points:
-        lines.append(f"| {p.scene} | {p.method} | {p.setting} | {p.seconds * 1e3:.1f} | {p.error:.4f} |")
+        cells = ["", ""]
+        if p.method != "mitsuba":
+            same = [q for q in points if q.scene == p.scene]
+            t, outside = mitsuba_seconds_at(p.error, same)
+            mark = "*" if outside else ""
+            cells = [f"{t * 1e3:.1f}{mark}", f"{t / p.seconds:.2f}{mark}"]
+        head = f"| {p.scene} | {p.method} | {p.setting} | {p.seconds * 1e3:.1f} | {p.error:.4f}"
+        lines.append(f"{head} | {cells[0]} | {cells[1]} |")
+    return "\n".join(lines)
+
+
+def markdown_summary(points: list[Point]) -> str:
+    """Per scene: the largest lead over Mitsuba at equal error, and bitmask's
+    error with its defaults at the output's resolution."""
+    lines = [
+        "| scene | fastest against Mitsuba at equal error | error | Mitsuba time / time "
+        "| bitmask, defaults: error | bitmask, defaults: Mitsuba time / time |",
+        "|---|---|---|---|---|---|",
+    ]
+    for scene in dict.fromkeys(p.scene for p in points):
+        same = [q for q in points if q.scene == scene]
+        ratio = {id(p): mitsuba_seconds_at(p.error, same)[0] / p.seconds for p in same if p.method != "mitsuba"}
+        best = max((p for p in same if p.method != "mitsuba"), key=lambda p: ratio[id(p)])
+        # The first 256-sample bitmask setting has the occluder maps at the
+        # output's resolution and the hierarchy on: the defaults.
+        bm = [p for p in same if p.method == "bitmask" and p.setting.startswith("256 ")]
+        bm_cells = f"{bm[0].error:.4f} | {ratio[id(bm[0])]:.2f}" if bm else "- | -"
+        lines.append(
+            f"| {scene} | {best.method}, {best.setting} | {best.error:.4f} | {ratio[id(best)]:.2f} | {bm_cells} |"
+        )
     return "\n".join(lines)
 
 
@@ -291,7 +345,17 @@ def main(argv: list[str] | None = None) -> int:
             all_points += pts
             plot_plane(pts, os.path.join(a.out, f"plane_{name}.png"), f"{name}, {a.resolution}²")
             print(f"plane {name}: {len(pts)} settings", flush=True)
-        md += [markdown_plane(all_points), ""]
+        md += [
+            "Mitsuba's time at a method's error is interpolated log-log between its sample counts "
+            "(* where it extrapolates).",
+            "",
+            markdown_plane(all_points),
+            "",
+            "### Summary",
+            "",
+            markdown_summary(all_points),
+            "",
+        ]
         md += [f"![{n}](plane_{n}.png)" for n in a.scenes] + [""]
 
     exp_res = 128 if a.quick else a.resolution // 2
