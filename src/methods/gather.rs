@@ -319,6 +319,11 @@ pub struct Hierarchy {
     pub max_texel_on_light: f32,
 }
 
+/// Whether two depth maps hold the same bits.
+fn same_bits(a: &[f32], b: &[f32]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// Everything the per-group loop reads, prepared once per call.
 struct Kernel {
     /// The output (receiver) grid: width, column and row centers.
@@ -350,8 +355,18 @@ impl Kernel {
         let r = &inputs.grid;
         let (hw, hh) = g.half_texel();
         let [lx, ly] = inputs.light_size;
-        let mut layers: Vec<Layer> = inputs
+        // A layer equal to one already kept changes nothing (sums merge by
+        // max, masks by OR), so it is not shaded: single-sided or flat
+        // occluders make the back map equal the front one, and such a scene
+        // then costs one pass whatever `passes` says.
+        let distinct: Vec<&[f32]> = inputs
             .occluder_layers
+            .iter()
+            .enumerate()
+            .filter(|&(i, d)| !inputs.occluder_layers[..i].iter().any(|e| same_bits(e, d)))
+            .map(|(_, d)| *d)
+            .collect();
+        let mut layers: Vec<Layer> = distinct
             .iter()
             .map(|d| Layer::from_depth(d, g.width))
             .collect();
@@ -836,4 +851,34 @@ pub(super) fn visibility_points<A: Accumulator>(
         out[n as usize] = v;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::MapGrid;
+
+    /// Layers the kernel keeps for the occluder maps `layers`.
+    fn kept(layers: Vec<&[f32]>) -> usize {
+        let grid = MapGrid::new(8, 8, [0.5, 0.5]).unwrap();
+        let receiver = vec![4.0f32; 64];
+        let inputs = ShadowInputs {
+            grid,
+            occluder_grid: grid,
+            light_size: [1.0, 1.0],
+            receiver: &receiver,
+            occluder_layers: layers,
+            occluder_triangles: None,
+        };
+        Kernel::new(&inputs, None).levels[0].layers.len()
+    }
+
+    #[test]
+    fn a_layer_equal_to_an_earlier_one_is_not_shaded_again() {
+        let front = vec![2.0f32; 64];
+        let mut back = front.clone();
+        assert_eq!(kept(vec![&front, &back, &front]), 1);
+        back[5] = 3.0;
+        assert_eq!(kept(vec![&front, &back, &front]), 2);
+    }
 }
