@@ -39,6 +39,23 @@ pub(super) trait Accumulator: Sync {
     fn end_batch(&self, _acc: &mut Self::State) {}
     /// Called after each occluder row a group shades (before `full`).
     fn end_row(&self, _acc: &mut Self::State) {}
+    /// `add_texel` for a group that is a whole tile (lane l = row TILE_W +
+    /// column) whose receivers share one depth, as on a floor facing the
+    /// light: lanes in a column then share x, lanes in a row share y, and a
+    /// method may work per column and per row instead of per lane. Must give
+    /// the same bits as `add_texel`.
+    #[inline(always)]
+    fn add_texel_tile(
+        &self,
+        acc: &mut Self::State,
+        w: f32,
+        x0: f32,
+        x1: f32,
+        row: &RowLanes,
+        g: &Group,
+    ) {
+        self.add_texel(acc, w, x0, x1, row, g)
+    }
 }
 
 /// Per-lane receiver coordinates for one occluder row, in half-light units
@@ -59,8 +76,8 @@ const _: () = assert!(LANES.is_power_of_two());
 /// receivers: one visit of an occluder row serves the whole tile, and a
 /// square keeps the union of the receivers' extents small. (Measured on the
 /// bunny at 256²: 8x8 beats 16x1 by 1.4x and 16x4 or 32x2 by 5-15%.)
-const TILE_W: usize = 8;
-const ROWS_PER_GROUP: usize = LANES / TILE_W;
+pub(super) const TILE_W: usize = 8;
+pub(super) const ROWS_PER_GROUP: usize = LANES / TILE_W;
 /// Occluder texels per block for the block-level depth bound (8 measured
 /// best: 16 costs 5% more, 32 15%).
 const BLOCK: usize = 8;
@@ -221,6 +238,9 @@ pub(super) struct Group {
     /// Bounds over the active lanes.
     pub wr_min: f32,
     wr_max: f32,
+    /// A whole tile (lane l = row TILE_W + column, every lane active) whose
+    /// receivers share one depth (see `Accumulator::add_texel_tile`).
+    uniform_tile: bool,
     x_lo: f32,
     x_hi: f32,
     y_lo: f32,
@@ -228,14 +248,16 @@ pub(super) struct Group {
 }
 
 impl Group {
-    /// `None` when no lane has a receiver in front of the light.
-    fn new(pts: impl Iterator<Item = (f32, f32, f32)>) -> Option<Group> {
+    /// `None` when no lane has a receiver in front of the light. `tile`:
+    /// the points are a whole tile of the output grid, row by row.
+    fn new(pts: impl Iterator<Item = (f32, f32, f32)>, tile: bool) -> Option<Group> {
         let mut g = Group {
             xr: [0.0; LANES],
             yr: [0.0; LANES],
             wr: [f32::INFINITY; LANES],
             wr_min: f32::INFINITY,
             wr_max: 0.0,
+            uniform_tile: false,
             x_lo: f32::INFINITY,
             x_hi: f32::NEG_INFINITY,
             y_lo: f32::INFINITY,
@@ -256,6 +278,8 @@ impl Group {
             g.y_lo = g.y_lo.min(y);
             g.y_hi = g.y_hi.max(y);
         }
+        let first = g.wr[0].to_bits();
+        g.uniform_tile = tile && g.wr[0].is_finite() && g.wr.iter().all(|w| w.to_bits() == first);
         g.wr_min.is_finite().then_some(g)
     }
 }
@@ -628,12 +652,16 @@ impl Kernel {
             return true;
         }
         let (s, e) = ((b_lo * BLOCK).max(i_lo), (b_hi * BLOCK).min(i_hi));
-        for (&w, &x0) in row[s..e].iter().zip(&lv.col_x0_scaled[s..e]) {
-            let x1 = x0 + wx;
-            if w <= g.wr_min {
-                continue; // empty, or behind every lane's receiver
+        let texels = row[s..e].iter().zip(&lv.col_x0_scaled[s..e]);
+        // w <= wr_min: empty, or behind every lane's receiver.
+        if g.uniform_tile {
+            for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
+                a.add_texel_tile(acc, w, x0, x0 + wx, &rl, g);
             }
-            a.add_texel(acc, w, x0, x1, &rl, g);
+        } else {
+            for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
+                a.add_texel(acc, w, x0, x0 + wx, &rl, g);
+            }
         }
         true
     }
@@ -708,7 +736,7 @@ impl Kernel {
                     }
                 })
             });
-            if let Some(g) = Group::new(pts) {
+            if let Some(g) = Group::new(pts, e - c == TILE_W && rows == ROWS_PER_GROUP) {
                 let v = self.shade_group(a, &g);
                 for r in 0..rows {
                     out[r * w + c..r * w + e].copy_from_slice(&v[r * TILE_W..r * TILE_W + (e - c)]);
@@ -720,7 +748,7 @@ impl Kernel {
     #[inline(always)]
     fn shade_points_generic<A: Accumulator>(&self, a: &A, pts: &[LightPoint], out: &mut [f32]) {
         for (o, p) in out.chunks_mut(LANES).zip(pts.chunks(LANES)) {
-            if let Some(g) = Group::new(p.iter().map(|p| (p.x, p.y, p.z))) {
+            if let Some(g) = Group::new(p.iter().map(|p| (p.x, p.y, p.z)), false) {
                 let v = self.shade_group(a, &g);
                 o.copy_from_slice(&v[..o.len()]);
             }
