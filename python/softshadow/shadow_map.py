@@ -270,7 +270,7 @@ def soft_shadow_map(
         min/max pyramid (2x2 texels per level). Each 8x8 tile of receivers
         skips what cannot reach it and reads the coarsest level whose
         texels, back-projected onto the light from the nearest occluder that
-        can reach the tile, cover at most 1/8 of the light's width: wide
+        can reach the tile, cover at most 3% of the light's width: wide
         penumbrae read few coarse texels, contact shadows keep the finest.
         Default: on for ``"bitmask"``, off for ``"ssm"`` (the paper's
         method, reproduced as published).
