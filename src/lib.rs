@@ -7,6 +7,7 @@
 // comparison is the point, not an accident.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod depth_plane;
 pub mod error;
 pub mod extent;
 pub mod light;
