@@ -10,6 +10,8 @@
 mod depth_plane;
 pub mod error;
 pub mod extent;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod light;
 pub mod mesh;
 pub mod methods;

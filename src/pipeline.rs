@@ -60,19 +60,20 @@ pub struct MapSettings {
     pub method: Method,
 }
 
-struct Stopwatch {
+pub(crate) struct Stopwatch {
     t: Instant,
-    timings: Timings,
+    pub timings: Timings,
 }
 
 impl Stopwatch {
-    fn new() -> Self {
+    pub fn new() -> Self {
         Stopwatch {
             t: Instant::now(),
             timings: Vec::new(),
         }
     }
-    fn lap(&mut self, name: &'static str) {
+    /// Records the time since the last lap as stage `name`.
+    pub fn lap(&mut self, name: &'static str) {
         let now = Instant::now();
         self.timings.push((name, (now - self.t).as_secs_f64()));
         self.t = now;
@@ -86,13 +87,25 @@ fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
     (far * 1e-9).max(f64::MIN_POSITIVE)
 }
 
-/// Soft shadow map from meshes.
-pub fn from_meshes(
-    occluders: MeshRef,
-    receivers: MeshRef,
+/// A scene moved to light space with its map grids fitted: what both
+/// backends start from.
+pub(crate) struct FramedScene {
+    pub occ_ls: Vec<DVec3>,
+    pub rec_ls: Vec<DVec3>,
+    pub grid: MapGrid,
+    pub occluder_grid: MapGrid,
+    pub near: f64,
+}
+
+/// Checks the input, moves the meshes to light space and fits the grids
+/// (stages "transform" and "extent").
+pub(crate) fn frame_scene(
+    occluders: &MeshRef,
+    receivers: &MeshRef,
     light: &RectLight,
     s: &MapSettings,
-) -> Result<ShadowResult> {
+    sw: &mut Stopwatch,
+) -> Result<FramedScene> {
     check_passes(s.passes)?;
     if occluders.is_empty() {
         return Err(Error::invalid(
@@ -114,7 +127,6 @@ pub fn from_meshes(
     occluders.validate("occluders")?;
     receivers.validate("receivers")?;
 
-    let mut sw = Stopwatch::new();
     let occ_ls = occluders.to_light_space(light);
     let rec_ls = receivers.to_light_space(light);
     sw.lap("transform");
@@ -126,6 +138,30 @@ pub fn from_meshes(
     let occluder_grid = MapGrid::new(ow, oh, extent)?;
     sw.lap("extent");
     let near = near_plane(&occ_ls, &rec_ls);
+    Ok(FramedScene {
+        occ_ls,
+        rec_ls,
+        grid,
+        occluder_grid,
+        near,
+    })
+}
+
+/// Soft shadow map from meshes.
+pub fn from_meshes(
+    occluders: MeshRef,
+    receivers: MeshRef,
+    light: &RectLight,
+    s: &MapSettings,
+) -> Result<ShadowResult> {
+    let mut sw = Stopwatch::new();
+    let FramedScene {
+        occ_ls,
+        rec_ls,
+        grid,
+        occluder_grid,
+        near,
+    } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
     let receiver = rasterize(&grid, &rec_ls, receivers.faces, near, false).nearest;
     sw.lap("raster_receivers");
     // Only what the method reads: occluder maps for the map methods, light-space

@@ -243,10 +243,10 @@ impl Projector {
         // there (barycentric, well conditioned), and its gradient per texel.
         let (cx, cy) = (i0 as i64 * ONE + ONE / 2, j0 as i64 * ONE + ONE / 2);
         let mut w_ref = 0f64;
-        for k in 0..3 {
+        for (k, wk) in w.iter().enumerate() {
             let (s, e) = ((k + 1) % 3, (k + 2) % 3);
             let edge = (x[e] - x[s]) * (cy - y[s]) - (y[e] - y[s]) * (cx - x[s]);
-            w_ref += edge as f64 * w[k];
+            w_ref += edge as f64 * wk;
         }
         let area_f = area as f64;
         let (dx1, dy1) = ((x[1] - x[0]) as f64, (y[1] - y[0]) as f64);

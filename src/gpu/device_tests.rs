@@ -1,0 +1,186 @@
+//! GPU against CPU on a small scene (needs a device: lavapipe in CI). Without
+//! an adapter these tests say so and pass, unless SOFTSHADOW_REQUIRE_GPU=1
+//! (set by scripts/test.sh, which installs lavapipe) makes that a failure.
+
+use crate::light::RectLight;
+use crate::mesh::MeshRef;
+use crate::methods::Method;
+use crate::pipeline::{self, MapSettings, ShadowResult};
+
+fn device_or_skip() -> bool {
+    match super::info() {
+        Ok(_) => true,
+        Err(e) => {
+            assert!(
+                std::env::var("SOFTSHADOW_REQUIRE_GPU").as_deref() != Ok("1"),
+                "SOFTSHADOW_REQUIRE_GPU=1 but {e}"
+            );
+            eprintln!("skipped: {e}");
+            false
+        }
+    }
+}
+
+/// A UV sphere (radius r at c) with `n` segments: curved, closed, with
+/// silhouette edges at every angle.
+fn sphere(c: [f64; 3], r: f64, n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut v = vec![];
+    let mut f = vec![];
+    let rings = n / 2;
+    for a in 0..=rings {
+        let th = std::f64::consts::PI * a as f64 / rings as f64;
+        for b in 0..n {
+            let ph = 2.0 * std::f64::consts::PI * b as f64 / n as f64;
+            v.push([
+                c[0] + r * th.sin() * ph.cos(),
+                c[1] + r * th.cos(),
+                c[2] + r * th.sin() * ph.sin(),
+            ]);
+        }
+    }
+    for a in 0..rings {
+        for b in 0..n {
+            let (p, q) = (a * n + b, a * n + (b + 1) % n);
+            f.push([p, p + n, q]);
+            f.push([q, p + n, q + n]);
+        }
+    }
+    (v, f)
+}
+
+fn floor() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let s = 4.0;
+    (
+        vec![[-s, 0.0, -s], [s, 0.0, -s], [s, 0.0, s], [-s, 0.0, s]],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+}
+
+fn run(gpu: bool, passes: u32, method: Method) -> ShadowResult {
+    let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
+    let (rv, rf) = floor();
+    let light = RectLight::new(
+        [0.0, 4.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0],
+    )
+    .unwrap();
+    let s = MapSettings {
+        width: 64,
+        height: 48,
+        extent: None,
+        occluder_resolution: None,
+        passes,
+        method,
+    };
+    let occ = MeshRef {
+        vertices: &ov,
+        faces: &of,
+    };
+    let rec = MeshRef {
+        vertices: &rv,
+        faces: &rf,
+    };
+    if gpu {
+        super::from_meshes(occ, rec, &light, &s).unwrap()
+    } else {
+        pipeline::from_meshes(occ, rec, &light, &s).unwrap()
+    }
+}
+
+fn same_bits(a: &[f32], b: &[f32]) -> usize {
+    a.iter()
+        .zip(b)
+        .filter(|(x, y)| x.to_bits() != y.to_bits())
+        .count()
+}
+
+#[test]
+fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
+    if !device_or_skip() {
+        return;
+    }
+    for passes in [1, 2, 4] {
+        let c = run(false, passes, Method::Ssm);
+        let g = run(true, passes, Method::Ssm);
+        // The scene must exercise every map: covered texels and a penumbra.
+        let covered = |m: &[f32]| m.iter().filter(|z| z.is_finite()).count();
+        assert!(covered(c.occluder_front.as_ref().unwrap()) > 100);
+        assert!(
+            c.visibility
+                .iter()
+                .filter(|&&v| v > 0.01 && v < 0.99)
+                .count()
+                > 50
+        );
+        eprintln!("{:?}", g.timings);
+        assert_eq!(same_bits(&c.receiver, &g.receiver), 0, "receiver");
+        let (cf, gf) = (c.occluder_front.unwrap(), g.occluder_front.unwrap());
+        assert_eq!(same_bits(&cf, &gf), 0, "front, passes {passes}");
+        assert_eq!(c.occluder_middle.len(), g.occluder_middle.len());
+        for (k, (a, b)) in c.occluder_middle.iter().zip(&g.occluder_middle).enumerate() {
+            assert_eq!(same_bits(a, b), 0, "middle {k}, passes {passes}");
+        }
+        match (c.occluder_back, g.occluder_back) {
+            (Some(a), Some(b)) => assert_eq!(same_bits(&a, &b), 0, "back, passes {passes}"),
+            (None, None) => {}
+            _ => panic!("back layers differ in presence"),
+        }
+        let dv: Vec<f32> = c
+            .visibility
+            .iter()
+            .zip(&g.visibility)
+            .map(|(a, b)| (a - b).abs())
+            .collect();
+        let max = dv.iter().fold(0f32, |m, &x| m.max(x));
+        let mean = dv.iter().sum::<f32>() / dv.len() as f32;
+        assert!(
+            max <= 2e-3 && mean <= 1e-4,
+            "passes {passes}: max {max}, mean {mean}"
+        );
+    }
+}
+
+#[test]
+fn methods_not_on_the_gpu_are_refused() {
+    let e = run_err(Method::Exact { samples: 16 });
+    assert!(
+        e.contains("method") && e.contains("not implemented on the GPU"),
+        "{e}"
+    );
+}
+
+fn run_err(method: Method) -> String {
+    let (ov, of) = sphere([0.0, 1.0, 0.0], 0.5, 8);
+    let (rv, rf) = floor();
+    let light = RectLight::new(
+        [0.0, 4.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0],
+    )
+    .unwrap();
+    let s = MapSettings {
+        width: 8,
+        height: 8,
+        extent: None,
+        occluder_resolution: None,
+        passes: 2,
+        method,
+    };
+    super::from_meshes(
+        MeshRef {
+            vertices: &ov,
+            faces: &of,
+        },
+        MeshRef {
+            vertices: &rv,
+            faces: &rf,
+        },
+        &light,
+        &s,
+    )
+    .unwrap_err()
+    .to_string()
+}

@@ -1,0 +1,144 @@
+//! Rasterization on the GPU: the set-up triangles of the CPU rasterizer
+//! (projected, clipped and snapped in f64 on the CPU, since WGSL has no f64)
+//! are uploaded once and drawn by `raster.wgsl` into depth layers held as u32
+//! bits in one `maps` buffer. The CPU twin is `raster::raster_tri`.
+
+use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
+use crate::raster::{SetupTri, PEEL_GAP};
+use bytemuck::{Pod, Zeroable};
+use std::sync::OnceLock;
+
+pub const SOURCE: &str = include_str!("raster.wgsl");
+/// No layer (WGSL `NONE`).
+pub const NONE: u32 = u32::MAX;
+const GROUP: u32 = 64;
+/// The bits of +inf: the start of a nearest-depth layer.
+pub const INF_BITS: u32 = 0x7f80_0000;
+
+/// `RasterParams` of raster.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct RasterParams {
+    pub tri_count: u32,
+    pub width: u32,
+    pub height: u32,
+    pub out_offset: u32,
+    pub far_offset: u32,
+    pub prev_offset: u32,
+    pub peel_factor: f32,
+    pub _pad: u32,
+}
+
+/// `Tri` of raster.wgsl: a `SetupTri` with 32-bit coordinates.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct GpuTri {
+    pub x: [i32; 3],
+    pub y: [i32; 3],
+    pub i0: u32,
+    pub i1: u32,
+    pub j0: u32,
+    pub j1: u32,
+    pub w_ref: f32,
+    pub gx: [f32; 3],
+    pub gy: [f32; 3],
+}
+
+/// `FillParams` of raster.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct FillParams {
+    pub offset: u32,
+    pub len: u32,
+    pub value: u32,
+    pub _pad: u32,
+}
+
+impl GpuTri {
+    /// Fixed-point coordinates stay within (side + 2 guard bands) x 256, below
+    /// 2^31 for the map sides the GPU backend accepts (see `MAX_SIDE`).
+    pub fn from_setup(t: &SetupTri) -> GpuTri {
+        GpuTri {
+            x: t.x.map(|v| v as i32),
+            y: t.y.map(|v| v as i32),
+            i0: t.i0,
+            i1: t.i1,
+            j0: t.j0,
+            j1: t.j1,
+            w_ref: t.depth.w_ref,
+            gx: t.depth.gx,
+            gy: t.depth.gy,
+        }
+    }
+}
+
+/// 1 + PEEL_GAP rounded as the CPU rasterizer rounds it.
+pub fn peel_factor() -> f32 {
+    1.0 + PEEL_GAP
+}
+
+pub struct RasterPipelines {
+    raster: wgpu::ComputePipeline,
+    fill: wgpu::ComputePipeline,
+}
+
+impl RasterPipelines {
+    /// Compiled once per process.
+    pub fn get(device: &wgpu::Device) -> &'static RasterPipelines {
+        static P: OnceLock<RasterPipelines> = OnceLock::new();
+        P.get_or_init(|| {
+            let m = module(device, "raster.wgsl", SOURCE);
+            RasterPipelines {
+                raster: pipeline(device, &m, "raster"),
+                fill: pipeline(device, &m, "fill"),
+            }
+        })
+    }
+
+    /// Records maps[offset .. offset + len] = value.
+    pub fn fill(
+        &self,
+        device: &wgpu::Device,
+        pass: &mut wgpu::ComputePass,
+        maps: &wgpu::Buffer,
+        offset: u32,
+        len: u32,
+        value: u32,
+    ) {
+        let p = uniform(
+            device,
+            "fill params",
+            &FillParams {
+                offset,
+                len,
+                value,
+                _pad: 0,
+            },
+        );
+        let bg = bind(device, &self.fill, &[Some(maps), None, None, Some(&p)]);
+        pass.set_pipeline(&self.fill);
+        pass.set_bind_group(0, &bg, &[]);
+        let (x, y) = groups_1d(len, GROUP);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+
+    /// Records the drawing of `tri_count` triangles of `tris` with `params`.
+    pub fn raster(
+        &self,
+        device: &wgpu::Device,
+        pass: &mut wgpu::ComputePass,
+        maps: &wgpu::Buffer,
+        tris: &wgpu::Buffer,
+        params: &RasterParams,
+    ) {
+        if params.tri_count == 0 {
+            return;
+        }
+        let p = uniform(device, "raster params", params);
+        let bg = bind(device, &self.raster, &[Some(maps), Some(tris), Some(&p)]);
+        pass.set_pipeline(&self.raster);
+        pass.set_bind_group(0, &bg, &[]);
+        let (x, y) = groups_1d(params.tri_count, GROUP);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}
