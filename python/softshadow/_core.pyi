@@ -33,6 +33,7 @@ def shadow_map_from_meshes(
     method: str,
     samples: int | None = None,
     occluder_resolution: tuple[int, int] | None = None,
+    backend: str = "cpu",
 ) -> dict[str, Any]:
     """Rasterizes the receivers (and, for the map methods, the occluders) into
     light-view maps and computes the visibility. Returns a dict with
@@ -41,7 +42,8 @@ def shadow_map_from_meshes(
     for methods that trace triangles), ``occluder_depth_middle`` (the peeled
     layers, a list; empty below 3 passes), ``extent``: (tx, ty) and
     ``timings``: {stage: seconds}. ``samples`` is for the sampling methods
-    only."""
+    only. ``backend``: "cpu" or "gpu" (the GPU runs "ssm"; any other method
+    raises ValueError, no adapter GpuUnavailableError)."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
@@ -80,3 +82,17 @@ def receiver_points(
     extent: tuple[float, float],
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64]]:
     """World points (M, 3) of the texels with a receiver, and their flat indices."""
+
+class GpuUnavailableError(RuntimeError):
+    """backend="gpu" was asked for and no GPU adapter can be opened (none
+    present, no Vulkan driver, or SOFTSHADOW_GPU=off)."""
+
+def gpu_available() -> bool:
+    """Whether a GPU adapter opens (software ones such as lavapipe count).
+    The device is opened once per process and kept."""
+
+def gpu_info() -> dict[str, Any]:
+    """The adapter backend="gpu" uses: ``name``, ``backend`` ("vulkan"),
+    ``device_type`` ("discrete_gpu", "integrated_gpu", "virtual_gpu", "cpu"
+    or "other"), ``driver`` and ``software`` (bool: a CPU renderer). Raises
+    GpuUnavailableError when there is none."""

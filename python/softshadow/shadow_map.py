@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
+from . import backend as backends
 from .light import RectLight
 from .scene import Scene
 
@@ -20,8 +21,6 @@ SAMPLING_METHODS = ("bitmask", "exact")
 TRACING_METHODS = ("exact",)
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 MAX_PASSES = 8  # keep in sync with MAX_PASSES in src/pipeline.rs
-BACKENDS = ("cpu",)
-LATER_BACKENDS = ("gpu", "auto")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -208,7 +207,14 @@ def soft_shadow_map(
         map is much cheaper; its error is the discretization of §4.1.1 (the
         paper notes that large lights need fewer occluder texels).
     backend
-        ``"cpu"`` (all cores).
+        ``"cpu"`` (all cores); ``"gpu"``: rasterization, shading and the
+        merge of the layers on the GPU (wgpu, Vulkan), one upload of the
+        set-up triangles and one readback; methods on the GPU:
+        ``"ssm"``. It never falls back: no adapter raises
+        ``GpuUnavailableError``, another method ValueError. ``"auto"``: the
+        GPU when a real (non-software) one is present and runs ``method``,
+        else the CPU. ``timings`` then hold the device's stages
+        (``gpu_*``, from timestamp queries where the adapter has them).
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
@@ -222,11 +228,13 @@ def soft_shadow_map(
         raise ValueError(f"passes: must be in [1, {MAX_PASSES}] (occluder depth layers), got {passes}")
     method = check.choice("method", method, METHODS)
     samples = _check_samples(samples, method)
-    check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
+    run_on = backends.resolve(backend, method)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
     if occ_res is not None and method in TRACING_METHODS:
         raise ValueError(f"occluder_resolution: {method!r} reads no occluder maps")
-    r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, occ_res)
+    r = _core.shadow_map_from_meshes(
+        ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, occ_res, run_on
+    )
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(
@@ -267,7 +275,8 @@ def soft_shadow_map_from_depth(
     light's (width, height) in the depth's units; ``extent`` the maps' tangent
     half-extents. The result's ``light`` is the canonical light of that size
     (center at the origin, normal +z, up +y), so ``sample`` takes points in that
-    frame.
+    frame. ``backend``: ``"cpu"``; ``"auto"`` runs on the CPU; ``"gpu"`` is
+    refused (only :func:`soft_shadow_map` runs on the GPU in this version).
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
@@ -282,7 +291,9 @@ def soft_shadow_map_from_depth(
     ext = check.extent(extent)
     method = check.choice("method", method, METHODS)
     samples = _check_samples(samples, method)
-    check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
+    # Depth maps are shaded on the CPU in this version: "auto" picks it, "gpu" is refused.
+    if backends.resolve(backend, method) == "gpu":
+        raise ValueError('backend: soft_shadow_map_from_depth runs on the CPU only in this version; use backend="cpu"')
     r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples)
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES

@@ -3,6 +3,7 @@
 //! dtypes live in the Python package; value checks live in the core.
 
 mod errors;
+mod gpu;
 
 use crate::light::{MapGrid, RectLight};
 use crate::mesh::MeshRef;
@@ -79,7 +80,7 @@ fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, occluder_resolution=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, occluder_resolution=None, backend="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -95,6 +96,7 @@ fn shadow_map_from_meshes<'py>(
     method: &str,
     samples: Option<u32>,
     occluder_resolution: Option<(usize, usize)>,
+    backend: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let light = light_of(light)?;
     let method = Method::parse(method, samples)?;
@@ -114,7 +116,7 @@ fn shadow_map_from_meshes<'py>(
         passes,
         method,
     };
-    let r = py.detach(|| pipeline::from_meshes(occ, rec, &light, &settings))?;
+    let r = py.detach(|| gpu::from_meshes(backend, occ, rec, &light, &settings))?;
     let d = PyDict::new(py);
     d.set_item("extent", (r.grid.tx, r.grid.ty))?;
     d.set_item("timings", timings_dict(py, &r.timings)?)?;
@@ -275,6 +277,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shadow_map_from_depth, m)?)?;
     m.add_function(wrap_pyfunction!(sample_points, m)?)?;
     m.add_function(wrap_pyfunction!(receiver_points, m)?)?;
+    m.add_function(wrap_pyfunction!(gpu::gpu_available, m)?)?;
+    m.add_function(wrap_pyfunction!(gpu::gpu_info, m)?)?;
+    m.add(
+        "GpuUnavailableError",
+        m.py().get_type::<errors::GpuUnavailableError>(),
+    )?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
