@@ -18,7 +18,7 @@ GpuUnavailableError = _core.GpuUnavailableError
 
 BACKENDS = ("cpu", "gpu", "auto")
 # Methods with a GPU kernel; keep in sync with method_source in src/gpu/gather.rs.
-GPU_METHODS = ("ssm",)
+GPU_METHODS = ("ssm", "bitmask")
 
 
 def gpu_available() -> bool:

@@ -177,7 +177,10 @@ pub fn from_meshes(
         .collect();
     sw.lap("setup");
     let ax = axes(&grid, &occluder_grid, light.size);
-    let params = gather_params(&grid, &occluder_grid, light.size, passes as u32, &ax);
+    let mut params = gather_params(&grid, &occluder_grid, light.size, passes as u32, &ax);
+    if let crate::methods::Method::Bitmask { samples } = s.method {
+        params.samples = samples;
+    }
     let out = run(
         g,
         s,
@@ -283,6 +286,13 @@ fn run(
         usage: wgpu::BufferUsages::STORAGE,
     });
     const _: () = assert!(std::mem::size_of::<RowSpan>() == 16);
+    let tables = gather::method_tables(s.method).map(|t| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("method tables"),
+            contents: bytemuck::cast_slice(&t),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    });
     sw.lap("upload");
 
     let rp = RasterPipelines::get(device);
@@ -363,6 +373,7 @@ fn run(
         layer_w_max: &layer_w_max,
         axes: &axes_buf,
         vis: &vis,
+        tables: tables.as_ref(),
     };
     {
         let mut pass = enc.begin_compute_pass(&timer.pass("row_stats"));

@@ -11,6 +11,7 @@ use std::sync::OnceLock;
 
 pub const GATHER_SOURCE: &str = include_str!("gather.wgsl");
 pub const SSM_SOURCE: &str = include_str!("ssm.wgsl");
+pub const BITMASK_SOURCE: &str = include_str!("bitmask.wgsl");
 
 /// The WGSL of the module that runs `method`: the shared gather part and the
 /// method's own file.
@@ -67,10 +68,11 @@ struct MethodPipelines {
 fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
     match method {
         Method::Ssm => Ok(("ssm", SSM_SOURCE)),
-        Method::Bitmask { .. } | Method::Exact { .. } => Err(Error::invalid(
+        Method::Bitmask { .. } => Ok(("bitmask", BITMASK_SOURCE)),
+        Method::Exact { .. } => Err(Error::invalid(
             "method",
             format!(
-                "{} is not implemented on the GPU backend yet; use backend=\"cpu\" (GPU methods: \"ssm\")",
+                "{:?} is not implemented on the GPU backend yet; use backend=\"cpu\" (GPU methods: \"ssm\", \"bitmask\")",
                 method.name()
             ),
         )),
@@ -84,10 +86,12 @@ pub fn check_method(method: Method) -> Result<()> {
 
 fn pipelines(device: &wgpu::Device, method: Method) -> Result<&'static MethodPipelines> {
     static SSM: OnceLock<MethodPipelines> = OnceLock::new();
+    static BITMASK: OnceLock<MethodPipelines> = OnceLock::new();
     let (name, source) = method_source(method)?;
     let cell = match method {
         Method::Ssm => &SSM,
-        _ => unreachable!("method_source refused it"),
+        Method::Bitmask { .. } => &BITMASK,
+        Method::Exact { .. } => unreachable!("method_source refused it"),
     };
     Ok(cell.get_or_init(|| {
         let m = module(device, name, &module_source(source));
@@ -105,6 +109,19 @@ pub struct GatherBuffers<'a> {
     pub layer_w_max: &'a wgpu::Buffer,
     pub axes: &'a wgpu::Buffer,
     pub vis: &'a wgpu::Buffer,
+    /// The bitmask method's rank tables (None for the others).
+    pub tables: Option<&'a wgpu::Buffer>,
+}
+
+/// The method's constant tables, as the shader reads them (bitmask's rank
+/// tables), or None.
+pub fn method_tables(method: Method) -> Option<Vec<u32>> {
+    match method {
+        Method::Bitmask { samples } => {
+            Some(crate::methods::bitmask::Bitmask::new(samples).rank_tables())
+        }
+        _ => None,
+    }
 }
 
 /// Records the row statistics pass body.
@@ -150,6 +167,7 @@ pub fn record_shade(
             Some(&u),
             Some(b.axes),
             Some(b.vis),
+            b.tables,
         ],
     );
     pass.set_pipeline(&p.shade);

@@ -2,7 +2,9 @@
 //! naga (what wgpu runs on it), and every parameter struct shared by Rust and
 //! WGSL has the same member offsets and sizes on both sides.
 
-use super::gather::{module_source, GatherParams, RowSpan, GATHER_SOURCE, SSM_SOURCE};
+use super::gather::{
+    module_source, GatherParams, RowSpan, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
+};
 use super::raster::{FillParams, GpuTri, RasterParams, SOURCE as RASTER_SOURCE};
 use std::mem::{offset_of, size_of};
 
@@ -11,6 +13,7 @@ fn modules() -> Vec<(&'static str, String)> {
     vec![
         ("raster.wgsl", RASTER_SOURCE.to_string()),
         ("gather.wgsl + ssm.wgsl", module_source(SSM_SOURCE)),
+        ("gather.wgsl + bitmask.wgsl", module_source(BITMASK_SOURCE)),
     ]
 }
 
@@ -23,7 +26,7 @@ fn parse(name: &str, src: &str) -> naga::Module {
 fn every_wgsl_file_is_used_by_a_module() {
     // Files on disk beside this module: each must be part of a checked module.
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/gpu");
-    let sources = [RASTER_SOURCE, GATHER_SOURCE, SSM_SOURCE];
+    let sources = [RASTER_SOURCE, GATHER_SOURCE, SSM_SOURCE, BITMASK_SOURCE];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "wgsl") {
