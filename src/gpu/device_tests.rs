@@ -57,6 +57,10 @@ fn floor() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 }
 
 fn run(gpu: bool, passes: u32, method: Method) -> ShadowResult {
+    run_at(gpu, passes, method, (64, 48))
+}
+
+fn run_at(gpu: bool, passes: u32, method: Method, (width, height): (usize, usize)) -> ShadowResult {
     let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
     let (rv, rf) = floor();
     let light = RectLight::new(
@@ -67,8 +71,8 @@ fn run(gpu: bool, passes: u32, method: Method) -> ShadowResult {
     )
     .unwrap();
     let s = MapSettings {
-        width: 64,
-        height: 48,
+        width,
+        height,
         extent: None,
         occluder_resolution: None,
         passes,
@@ -144,6 +148,19 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
             "passes {passes}: max {max}, mean {mean}"
         );
     }
+}
+
+#[test]
+fn triangles_larger_than_an_invocations_loop_budget_are_drawn_whole() {
+    // The floor's two triangles cover 300 x 300 texels: one invocation per
+    // triangle would stop after 65535 loop iterations on lavapipe.
+    if !device_or_skip() {
+        return;
+    }
+    let c = run_at(false, 1, Method::Ssm, (300, 300));
+    let g = run_at(true, 1, Method::Ssm, (300, 300));
+    assert!(c.receiver.iter().all(|z| z.is_finite()));
+    assert_eq!(same_bits(&c.receiver, &g.receiver), 0);
 }
 
 #[test]

@@ -9,7 +9,9 @@
 
 use super::context::{gpu, Gpu};
 use super::gather::{self, GatherBuffers, GatherParams, RowSpan};
-use super::raster::{peel_factor, GpuTri, RasterParams, RasterPipelines, INF_BITS, NONE};
+use super::raster::{
+    peel_factor, tiles, GpuTri, RasterParams, RasterPipelines, RasterTile, INF_BITS, NONE,
+};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::light::{MapGrid, RectLight};
@@ -19,9 +21,11 @@ use crate::raster::setup_triangles;
 use wgpu::util::DeviceExt;
 
 /// The largest map side on the GPU: fixed-point coordinates ((side + 2
-/// guard bands) x 256) must fit in i32 for the shader's edge functions, and
-/// texel offsets below 2^16 keep the depth plane's limb products exact.
-pub const MAX_SIDE: usize = 1 << 16;
+/// guard bands) x 256) must fit in i32 for the shader's edge functions,
+/// texel offsets below 2^16 keep the depth plane's limb products exact, and
+/// a row's statistics (one invocation a row) stay within lavapipe's 65535
+/// loop iterations.
+pub const MAX_SIDE: usize = 1 << 14;
 
 fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
     if g.0 > MAX_SIDE || g.1 > MAX_SIDE {
@@ -50,21 +54,16 @@ fn storage(
     })
 }
 
-fn upload_tris(device: &wgpu::Device, label: &str, tris: &[GpuTri]) -> wgpu::Buffer {
-    // A binding must not be empty: an empty mesh gets one unused triangle.
-    let one = [GpuTri::zeroed_tri()];
-    let data: &[GpuTri] = if tris.is_empty() { &one } else { tris };
+/// A read-only storage buffer holding `items`; a binding must not be
+/// empty, so an empty list gets one unused zeroed item.
+fn upload<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, items: &[T]) -> wgpu::Buffer {
+    let one = [T::zeroed()];
+    let data: &[T] = if items.is_empty() { &one } else { items };
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
         contents: bytemuck::cast_slice(data),
         usage: wgpu::BufferUsages::STORAGE,
     })
-}
-
-impl GpuTri {
-    fn zeroed_tri() -> GpuTri {
-        bytemuck::Zeroable::zeroed()
-    }
 }
 
 /// Tangent coordinates the shaders read, computed in f64 like the CPU
@@ -181,6 +180,10 @@ pub fn from_meshes(
     if let crate::methods::Method::Bitmask { samples } = s.method {
         params.samples = samples;
     }
+    // The occluders' largest 1/depth, from their vertices in front of the near plane.
+    let w_max = occ_ls.iter().fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
+    let (rows_per_chunk, chunks) = gather::chunking(&occluder_grid, light.size, w_max, s.method);
+    params.rows_per_chunk = rows_per_chunk;
     let out = run(
         g,
         s,
@@ -190,6 +193,7 @@ pub fn from_meshes(
         &occ_tris,
         &ax,
         &params,
+        chunks,
         &mut sw,
     )?;
     let mut timings = sw.timings;
@@ -247,6 +251,7 @@ fn run(
     occ_tris: &[GpuTri],
     ax: &Axes,
     params: &GatherParams,
+    chunks: u32,
     sw: &mut Stopwatch,
 ) -> Result<DeviceOutput> {
     let device = &g.device;
@@ -278,14 +283,25 @@ fn run(
         passes as u64 * 4,
         wgpu::BufferUsages::COPY_DST,
     );
-    let rec_buf = upload_tris(device, "receiver triangles", rec_tris);
-    let occ_buf = upload_tris(device, "occluder triangles", occ_tris);
+    let rec_tiles: Vec<RasterTile> = tiles(rec_tris);
+    let occ_tiles: Vec<RasterTile> = tiles(occ_tris);
+    let rec_buf = upload(device, "receiver triangles", rec_tris);
+    let occ_buf = upload(device, "occluder triangles", occ_tris);
+    let rec_tile_buf = upload(device, "receiver tiles", &rec_tiles);
+    let occ_tile_buf = upload(device, "occluder tiles", &occ_tiles);
     let axes_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("axes"),
         contents: bytemuck::cast_slice(&ax.data),
         usage: wgpu::BufferUsages::STORAGE,
     });
     const _: () = assert!(std::mem::size_of::<RowSpan>() == 16);
+    let acc_words = gather::accumulator_words(s.method, passes) as u64 * rec_len as u64;
+    let acc = storage(
+        device,
+        "accumulators",
+        acc_words * 4,
+        wgpu::BufferUsages::COPY_DST,
+    );
     let tables = gather::method_tables(s.method).map(|t| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("method tables"),
@@ -308,8 +324,9 @@ fn run(
             &mut pass,
             &maps,
             &rec_buf,
+            &rec_tile_buf,
             &RasterParams {
-                tri_count: rec_tris.len() as u32,
+                tile_count: rec_tiles.len() as u32,
                 width: grid.width as u32,
                 height: grid.height as u32,
                 out_offset: 0,
@@ -340,7 +357,7 @@ fn run(
             NONE
         };
         let base = RasterParams {
-            tri_count: occ_tris.len() as u32,
+            tile_count: occ_tiles.len() as u32,
             width: og.width as u32,
             height: og.height as u32,
             out_offset: layer(0),
@@ -349,7 +366,7 @@ fn run(
             peel_factor: peel_factor(),
             _pad: 0,
         };
-        rp.raster(device, &mut pass, &maps, &occ_buf, &base);
+        rp.raster(device, &mut pass, &maps, &occ_buf, &occ_tile_buf, &base);
         // Depth peeling: layer k is the nearest surface beyond layer k - 1.
         for k in 1..passes.saturating_sub(1) {
             rp.raster(
@@ -357,6 +374,7 @@ fn run(
                 &mut pass,
                 &maps,
                 &occ_buf,
+                &occ_tile_buf,
                 &RasterParams {
                     out_offset: layer(k),
                     far_offset: NONE,
@@ -367,6 +385,7 @@ fn run(
         }
     }
     enc.clear_buffer(&layer_w_max, 0, None);
+    enc.clear_buffer(&acc, 0, None);
     let gb = GatherBuffers {
         maps: &maps,
         rows: &rows,
@@ -374,6 +393,7 @@ fn run(
         axes: &axes_buf,
         vis: &vis,
         tables: tables.as_ref(),
+        acc: &acc,
     };
     {
         let mut pass = enc.begin_compute_pass(&timer.pass("row_stats"));
@@ -381,7 +401,7 @@ fn run(
     }
     {
         let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
-        gather::record_shade(device, &mut pass, s.method, &gb, params)?;
+        gather::record_shade(device, &mut pass, s.method, &gb, params, chunks)?;
     }
     // One readback: the maps, then the visibility, then the timestamps.
     let maps_bytes = maps_len as u64 * 4;

@@ -5,6 +5,7 @@
 
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
 use crate::error::{Error, Result};
+use crate::light::MapGrid;
 use crate::methods::Method;
 use bytemuck::{Pod, Zeroable};
 use std::sync::OnceLock;
@@ -44,9 +45,52 @@ pub struct GatherParams {
     pub half_lx: f32,
     pub half_ly: f32,
     pub wx: f32,
+    pub rows_per_chunk: u32,
     pub _pad0: u32,
     pub _pad1: u32,
-    pub _pad2: u32,
+}
+
+/// `ChunkParams` of gather.wgsl: which layer and chunk of rows a dispatch adds.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct ChunkParams {
+    pub layer: u32,
+    pub chunk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// Loop iterations we let one invocation run per dispatch: half of lavapipe's
+/// limit of 65535 (llvmpipe's loop limiter counts every iteration of every
+/// loop of an invocation), leaving room for the loops around the texel loop.
+const ITERATION_BUDGET: usize = 32768;
+
+/// How the rows in reach are cut into chunks: rows per chunk and the number
+/// of chunks that covers any receiver's rows. `w_max` bounds the occluders'
+/// 1/depth (from their vertices: 1/Z is linear over a triangle, so its
+/// largest value is at a vertex), which bounds how far a micro-patch reaches.
+pub fn chunking(og: &MapGrid, light_size: [f64; 2], w_max: f64, method: Method) -> (u32, u32) {
+    let (hw, hh) = og.half_texel();
+    // Texels in reach along a row (rows in reach along a column): a patch
+    // reaches half_texel + (L/2) w_max in tangent units, and the rounding of
+    // both ends adds up to 3 texels.
+    let reach = |half_texel: f64, light: f64, n: usize| -> usize {
+        let t = (1.0 + 0.5 * light * w_max / half_texel).ceil() + 3.0;
+        if t.is_finite() {
+            (t as usize).min(n)
+        } else {
+            n
+        }
+    };
+    let cols = reach(hw, light_size[0], og.width);
+    let rows = reach(hh, light_size[1], og.height);
+    // The bitmask's 8-word loop per texel, in case the compiler keeps it a loop.
+    let per_texel = match method {
+        Method::Bitmask { .. } => 9,
+        _ => 1,
+    };
+    let rows_per_chunk = (ITERATION_BUDGET / (cols * per_texel + 2)).max(1);
+    (rows_per_chunk as u32, rows.div_ceil(rows_per_chunk) as u32)
 }
 
 /// `RowSpan` of gather.wgsl (written by the GPU; 16 bytes a row).
@@ -61,7 +105,10 @@ pub struct RowSpan {
 
 struct MethodPipelines {
     row_stats: wgpu::ComputePipeline,
-    shade: wgpu::ComputePipeline,
+    /// Adds one chunk of one layer to the accumulators.
+    chunk: wgpu::ComputePipeline,
+    /// Accumulators -> visibility.
+    resolve: wgpu::ComputePipeline,
 }
 
 /// The methods that run on the GPU, and the error for the others.
@@ -97,7 +144,8 @@ fn pipelines(device: &wgpu::Device, method: Method) -> Result<&'static MethodPip
         let m = module(device, name, &module_source(source));
         MethodPipelines {
             row_stats: pipeline(device, &m, "row_stats"),
-            shade: pipeline(device, &m, name),
+            chunk: pipeline(device, &m, name),
+            resolve: pipeline(device, &m, &format!("{name}_resolve")),
         }
     }))
 }
@@ -111,6 +159,17 @@ pub struct GatherBuffers<'a> {
     pub vis: &'a wgpu::Buffer,
     /// The bitmask method's rank tables (None for the others).
     pub tables: Option<&'a wgpu::Buffer>,
+    /// Per-receiver accumulators, zeroed (`accumulator_words` u32 a receiver).
+    pub acc: &'a wgpu::Buffer,
+}
+
+/// u32 words of accumulator per receiver texel: a sum per layer (ssm), or
+/// one 256-bit mask (bitmask).
+pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
+    match method {
+        Method::Bitmask { .. } => 8,
+        _ => n_layers,
+    }
 }
 
 /// The method's constant tables, as the shader reads them (bitmask's rank
@@ -147,31 +206,68 @@ pub fn record_row_stats(
     Ok(())
 }
 
-/// Records the shading pass body: one invocation per receiver texel.
+/// Records the shading pass body: for every layer and chunk of rows, one
+/// dispatch adding it to the accumulators (one invocation per receiver
+/// texel), then the resolve into visibility.
 pub fn record_shade(
     device: &wgpu::Device,
     pass: &mut wgpu::ComputePass,
     method: Method,
     b: &GatherBuffers,
     params: &GatherParams,
+    chunks: u32,
 ) -> Result<()> {
     let p = pipelines(device, method)?;
     let u = uniform(device, "gather params", params);
+    let groups = (params.rec_w.div_ceil(8), params.rec_h.div_ceil(8));
+    pass.set_pipeline(&p.chunk);
+    for layer in 0..params.n_layers {
+        for chunk in 0..chunks {
+            let c = uniform(
+                device,
+                "chunk params",
+                &ChunkParams {
+                    layer,
+                    chunk,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            );
+            let bg = bind(
+                device,
+                &p.chunk,
+                &[
+                    Some(b.maps),
+                    Some(b.rows),
+                    Some(b.layer_w_max),
+                    Some(&u),
+                    Some(b.axes),
+                    None,
+                    b.tables,
+                    Some(b.acc),
+                    Some(&c),
+                ],
+            );
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(groups.0, groups.1, 1);
+        }
+    }
     let bg = bind(
         device,
-        &p.shade,
+        &p.resolve,
         &[
             Some(b.maps),
-            Some(b.rows),
-            Some(b.layer_w_max),
+            None,
+            None,
             Some(&u),
             Some(b.axes),
             Some(b.vis),
-            b.tables,
+            None,
+            Some(b.acc),
         ],
     );
-    pass.set_pipeline(&p.shade);
+    pass.set_pipeline(&p.resolve);
     pass.set_bind_group(0, &bg, &[]);
-    pass.dispatch_workgroups(params.rec_w.div_ceil(8), params.rec_h.div_ceil(8), 1);
+    pass.dispatch_workgroups(groups.0, groups.1, 1);
     Ok(())
 }

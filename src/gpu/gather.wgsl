@@ -2,10 +2,17 @@
 // method's file is appended to this one): one invocation per receiver texel
 // loops over the occluder texels that can reach it, like src/methods/gather.rs
 // does for groups of 64 receivers. A gather, not a scatter: each invocation
-// owns its receiver's sum (or mask), so it accumulates in registers with no
-// atomics. A scatter (one invocation per occluder texel adding into the
-// receivers it reaches) would need float atomic adds, which WGSL lacks, and
-// its sums would depend on the scheduling order.
+// owns its receiver's sum (or mask), so it accumulates with no atomics. A
+// scatter (one invocation per occluder texel adding into the receivers it
+// reaches) would need float atomic adds, which WGSL lacks, and its sums would
+// depend on the scheduling order.
+//
+// The work is cut into chunks: one dispatch per (layer, chunk of occluder
+// rows), each invocation adding its chunk to its receiver's accumulator in
+// `acc`, then a resolve dispatch turning accumulators into visibility. This
+// bounds the loop iterations of an invocation (lavapipe stops an invocation
+// after 65535 in all; real GPUs reset long-running dispatches) whatever the
+// penumbra's size in texels.
 
 // Shared with Rust (`GatherParams` in gather.rs; a test compares layouts).
 struct GatherParams {
@@ -37,9 +44,18 @@ struct GatherParams {
     half_ly: f32,
     // Texel width in half-light units.
     wx: f32,
+    // Occluder rows per chunk (of a receiver's rows in reach).
+    rows_per_chunk: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
+}
+
+// Which chunk a dispatch adds. Shared with Rust (`ChunkParams` in gather.rs).
+struct ChunkParams {
+    layer: u32,
+    chunk: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // One occluder row: its nearest 1/depth and occupied columns [first, last).
@@ -51,14 +67,15 @@ struct RowSpan {
     _pad: u32,
 }
 
-const GATHER_GROUP: u32 = 64u;
-
 @group(0) @binding(0) var<storage, read> maps: array<u32>;
 @group(0) @binding(1) var<storage, read_write> rows: array<RowSpan>;
 @group(0) @binding(2) var<storage, read_write> layer_w_max: array<atomic<u32>>;
 @group(0) @binding(3) var<uniform> gp: GatherParams;
 @group(0) @binding(4) var<storage, read> axes: array<f32>;
 @group(0) @binding(5) var<storage, read_write> vis: array<f32>;
+// Per-receiver accumulators (the method's layout), zeroed before the chunks.
+@group(0) @binding(7) var<storage, read_write> acc: array<u32>;
+@group(0) @binding(8) var<uniform> chunk: ChunkParams;
 
 // 1/depth of a map texel, 0 where empty (+inf, or 0 bits: a farthest layer
 // never written), as gather.rs's Layer::new.
@@ -112,6 +129,33 @@ fn row_stats(@builtin(global_invocation_id) gid: vec3<u32>) {
     atomicMax(&layer_w_max[layer], bitcast<u32>(span.w_max));
 }
 
+// A receiver texel: its index, tangent position, 1/depth; ok = false where
+// there is no receiver.
+struct Receiver {
+    ok: bool,
+    idx: u32,
+    xr: f32,
+    yr: f32,
+    wr: f32,
+}
+
+fn receiver(gid: vec3<u32>) -> Receiver {
+    var r = Receiver(false, 0u, 0.0, 0.0, 0.0);
+    if gid.x >= gp.rec_w || gid.y >= gp.rec_h {
+        return r;
+    }
+    r.idx = gid.y * gp.rec_w + gid.x;
+    let zr = bitcast<f32>(maps[r.idx]);
+    if !(zr > 0.0 && zr < bitcast<f32>(0x7f800000u)) {
+        return r;
+    }
+    r.ok = true;
+    r.wr = 1.0 / zr;
+    r.xr = axes[gp.ax_rec_x + gid.x];
+    r.yr = axes[gp.ax_rec_y + gid.y];
+    return r;
+}
+
 // What one occluder row offers a receiver: the columns in reach and the row's
 // y-interval relative to the receiver in half-light units, [-nay0, ay1].
 struct RowReach {
@@ -149,9 +193,11 @@ fn row_reach(layer: u32, j: u32, xr: f32, yr: f32, wr: f32) -> RowReach {
     return r;
 }
 
-// The occluder rows a receiver at (yr, wr) can see in a layer whose nearest
-// 1/depth is w_max: [j_lo, j_hi], empty when j_lo > j_hi.
-fn layer_rows(w_max: f32, yr: f32, wr: f32) -> vec2<i32> {
+// The occluder rows of this dispatch's chunk that a receiver at (yr, wr) can
+// see in this dispatch's layer: [x, y], empty when x > y. The rows in reach
+// are those of gather.rs's add_layer, the chunk a slice of rows_per_chunk.
+fn chunk_rows(yr: f32, wr: f32) -> vec2<i32> {
+    let w_max = bitcast<f32>(atomicLoad(&layer_w_max[chunk.layer]));
     if w_max <= wr {
         return vec2<i32>(1, 0);
     }
@@ -159,7 +205,8 @@ fn layer_rows(w_max: f32, yr: f32, wr: f32) -> vec2<i32> {
     let last = i32(gp.occ_h) - 1;
     let j_lo = clamp_index(floor(row_coord(yr + reach_y)), 0, last);
     let j_hi = clamp_index(ceil(row_coord(yr - reach_y)), 0, last);
-    return vec2<i32>(j_lo, j_hi);
+    let start = j_lo + i32(chunk.chunk * gp.rows_per_chunk);
+    return vec2<i32>(start, min(j_hi, start + i32(gp.rows_per_chunk) - 1));
 }
 
 fn layer_offset(layer: u32) -> u32 {

@@ -19,7 +19,7 @@ pub const INF_BITS: u32 = 0x7f80_0000;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct RasterParams {
-    pub tri_count: u32,
+    pub tile_count: u32,
     pub width: u32,
     pub height: u32,
     pub out_offset: u32,
@@ -42,6 +42,40 @@ pub struct GpuTri {
     pub w_ref: f32,
     pub gx: [f32; 3],
     pub gy: [f32; 3],
+}
+
+/// `Tile` of raster.wgsl: texels [i0, i1] x [j0, j1] of triangle `tri`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct RasterTile {
+    pub tri: u32,
+    pub i0: u32,
+    pub i1: u32,
+    pub j0: u32,
+    pub j1: u32,
+}
+
+/// The side of a raster tile in texels: TILE^2 + TILE loop iterations an
+/// invocation, far below lavapipe's 65535.
+pub const TILE: u32 = 64;
+
+/// Cuts every triangle's bounding box into tiles of at most TILE x TILE texels.
+pub fn tiles(tris: &[GpuTri]) -> Vec<RasterTile> {
+    let mut out = Vec::with_capacity(tris.len());
+    for (k, t) in tris.iter().enumerate() {
+        for j0 in (t.j0..=t.j1).step_by(TILE as usize) {
+            for i0 in (t.i0..=t.i1).step_by(TILE as usize) {
+                out.push(RasterTile {
+                    tri: k as u32,
+                    i0,
+                    i1: (i0 + TILE - 1).min(t.i1),
+                    j0,
+                    j1: (j0 + TILE - 1).min(t.j1),
+                });
+            }
+        }
+    }
+    out
 }
 
 /// `FillParams` of raster.wgsl.
@@ -122,23 +156,29 @@ impl RasterPipelines {
         pass.dispatch_workgroups(x, y, 1);
     }
 
-    /// Records the drawing of `tri_count` triangles of `tris` with `params`.
+    /// Records the drawing of `tile_count` tiles of `tiles` (of triangles
+    /// `tris`) with `params`.
     pub fn raster(
         &self,
         device: &wgpu::Device,
         pass: &mut wgpu::ComputePass,
         maps: &wgpu::Buffer,
         tris: &wgpu::Buffer,
+        tiles: &wgpu::Buffer,
         params: &RasterParams,
     ) {
-        if params.tri_count == 0 {
+        if params.tile_count == 0 {
             return;
         }
         let p = uniform(device, "raster params", params);
-        let bg = bind(device, &self.raster, &[Some(maps), Some(tris), Some(&p)]);
+        let bg = bind(
+            device,
+            &self.raster,
+            &[Some(maps), Some(tris), Some(&p), None, Some(tiles)],
+        );
         pass.set_pipeline(&self.raster);
         pass.set_bind_group(0, &bg, &[]);
-        let (x, y) = groups_1d(params.tri_count, GROUP);
+        let (x, y) = groups_1d(params.tile_count, GROUP);
         pass.dispatch_workgroups(x, y, 1);
     }
 }

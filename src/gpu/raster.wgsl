@@ -1,5 +1,9 @@
-// GPU twin of the CPU rasterizer (src/raster.rs): one invocation per set-up
-// triangle walks its bounding box. Coverage uses the same fixed-point edge
+// GPU twin of the CPU rasterizer (src/raster.rs): one invocation per tile
+// (at most TILE x TILE texels) of a set-up triangle's bounding box walks that
+// tile. Tiles bound the work per invocation: it balances big and small
+// triangles, and Mesa's lavapipe stops any invocation after 65535 loop
+// iterations in all (llvmpipe's loop limiter), which a whole floor triangle
+// exceeds. Coverage uses the same fixed-point edge
 // functions and tie rule, evaluated exactly in 64 bits emulated with u32
 // pairs (WGSL has no i64; the products reach 2^50). Depth is the f32 plane of
 // src/depth_plane.rs, evaluated in the same order. Depth min/max go through
@@ -8,7 +12,7 @@
 
 // Shared with Rust (`RasterParams` in raster.rs; a test compares layouts).
 struct RasterParams {
-    tri_count: u32,
+    tile_count: u32,
     width: u32,
     height: u32,
     // Where the nearest (or peeled) layer goes in `maps`, in texels.
@@ -35,6 +39,16 @@ struct Tri {
     gy: array<f32, 3>,
 }
 
+// A piece of a triangle's bounding box: texels [i0, i1] x [j0, j1].
+// Shared with Rust (`RasterTile` in raster.rs).
+struct Tile {
+    tri: u32,
+    i0: u32,
+    i1: u32,
+    j0: u32,
+    j1: u32,
+}
+
 // Shared with Rust (`FillParams` in raster.rs).
 struct FillParams {
     offset: u32,
@@ -51,6 +65,7 @@ const GROUP: u32 = 64u;
 @group(0) @binding(1) var<storage, read> tris: array<Tri>;
 @group(0) @binding(2) var<uniform> params: RasterParams;
 @group(0) @binding(3) var<uniform> fill_params: FillParams;
+@group(0) @binding(4) var<storage, read> tiles: array<Tile>;
 
 // Signed 64-bit integers as vec2(lo, hi) in two's complement.
 fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
@@ -130,10 +145,11 @@ fn write_depth(idx: u32, z: f32) {
 fn raster(@builtin(global_invocation_id) gid: vec3<u32>,
           @builtin(num_workgroups) groups: vec3<u32>) {
     let n = gid.x + gid.y * groups.x * GROUP;
-    if n >= params.tri_count {
+    if n >= params.tile_count {
         return;
     }
-    let t = tris[n];
+    let tile = tiles[n];
+    let t = tris[tile.tri];
     // Edge k goes from vertex k+1 to vertex k+2 (as in raster_tri).
     var dx: array<i32, 3>;
     var dy: array<i32, 3>;
@@ -147,8 +163,8 @@ fn raster(@builtin(global_invocation_id) gid: vec3<u32>,
         owns[k] = owns_ties(dx[k], dy[k]);
         step[k] = mul64(-dy[k], ONE);
     }
-    let cx0 = i32(t.i0) * ONE + ONE / 2;
-    for (var j = t.j0; j <= t.j1; j++) {
+    let cx0 = i32(tile.i0) * ONE + ONE / 2;
+    for (var j = tile.j0; j <= tile.j1; j++) {
         let cy = i32(j) * ONE + ONE / 2;
         var e: array<vec2<u32>, 3>;
         for (var k = 0u; k < 3u; k++) {
@@ -156,7 +172,7 @@ fn raster(@builtin(global_invocation_id) gid: vec3<u32>,
             e[k] = add64(mul64(dx[k], cy - t.y[s]), neg64(mul64(dy[k], cx0 - t.x[s])));
         }
         let row = j * params.width;
-        for (var i = t.i0; i <= t.i1; i++) {
+        for (var i = tile.i0; i <= tile.i1; i++) {
             if inside64(e[0], owns[0]) && inside64(e[1], owns[1]) && inside64(e[2], owns[2]) {
                 let w = inv_depth_at(t, i - t.i0, j - t.j0);
                 if w > 0.0 {

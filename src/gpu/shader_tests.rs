@@ -3,9 +3,9 @@
 //! WGSL has the same member offsets and sizes on both sides.
 
 use super::gather::{
-    module_source, GatherParams, RowSpan, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
+    module_source, ChunkParams, GatherParams, RowSpan, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
-use super::raster::{FillParams, GpuTri, RasterParams, SOURCE as RASTER_SOURCE};
+use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
 use std::mem::{offset_of, size_of};
 
 /// Every shader module the backend builds, by name.
@@ -98,7 +98,7 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
         RASTER_SOURCE,
         "RasterParams",
         rust_layout!(RasterParams {
-            tri_count,
+            tile_count,
             width,
             height,
             out_offset,
@@ -121,6 +121,17 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             w_ref,
             gx,
             gy
+        }),
+    );
+    assert_same(
+        RASTER_SOURCE,
+        "Tile",
+        rust_layout!(RasterTile {
+            tri,
+            i0,
+            i1,
+            j0,
+            j1
         }),
     );
     assert_same(
@@ -159,9 +170,19 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             half_lx,
             half_ly,
             wx,
+            rows_per_chunk,
             _pad0,
-            _pad1,
-            _pad2
+            _pad1
+        }),
+    );
+    assert_same(
+        &gather,
+        "ChunkParams",
+        rust_layout!(ChunkParams {
+            layer,
+            chunk,
+            _pad0,
+            _pad1
         }),
     );
     assert_same(
