@@ -9,6 +9,8 @@ renders on the CPU.
 from __future__ import annotations
 
 import os
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -159,3 +161,13 @@ def test_bad_backends_name_the_argument():
         ss.soft_shadow_map(scene, light, resolution=16, backend="cuda")
     with pytest.raises(TypeError, match="backend"):
         ss.soft_shadow_map(scene, light, resolution=16, backend=None)
+
+
+def test_the_readme_gpu_example_runs(gpu):
+    text = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    block = re.search(r"## GPU backend\n\n```python\n(.*?)```", text, re.S)
+    assert block, "the GPU example is missing from the README"
+    env: dict = {}
+    exec(compile(block.group(1), "README.md", "exec"), env)
+    assert env["sm"].visibility.shape == (128, 128)
+    assert any(k.startswith("gpu") for k in env["sm"].timings)

@@ -157,11 +157,14 @@ pub fn from_meshes(
     let passes = s.passes as usize;
     let texels = grid.len() as u64 + passes as u64 * occluder_grid.len() as u64;
     let bytes = texels * 4;
-    if texels >= u32::MAX as u64 || bytes > g.max_storage_binding {
+    // The accumulators: a sum per layer (ssm) or a 256-bit mask (bitmask) per receiver.
+    let acc_bytes = gather::accumulator_words(s.method, s.passes) as u64 * grid.len() as u64 * 4;
+    if texels >= u32::MAX as u64 || bytes.max(acc_bytes) > g.max_storage_binding {
         return Err(Error::too_large(
             "resolution",
             format!(
-                "the maps need {bytes} bytes in one GPU buffer; the device binds at most {}",
+                "the maps need {} bytes in one GPU buffer; the device binds at most {}",
+                bytes.max(acc_bytes),
                 g.max_storage_binding
             ),
         ));
@@ -241,8 +244,43 @@ struct DeviceOutput {
     device_timings: Vec<(&'static str, f64)>,
 }
 
+/// `run_captured` with the device's errors (out of memory, validation,
+/// internal) caught in error scopes and returned as `Error::Gpu`, rather than
+/// left to wgpu's default handler, which panics.
 #[allow(clippy::too_many_arguments)]
 fn run(
+    g: &Gpu,
+    s: &MapSettings,
+    grid: &MapGrid,
+    og: &MapGrid,
+    rec_tris: &[GpuTri],
+    occ_tris: &[GpuTri],
+    ax: &Axes,
+    params: &GatherParams,
+    chunks: u32,
+    sw: &mut Stopwatch,
+) -> Result<DeviceOutput> {
+    let scopes = [
+        wgpu::ErrorFilter::OutOfMemory,
+        wgpu::ErrorFilter::Validation,
+        wgpu::ErrorFilter::Internal,
+    ]
+    .map(|f| g.device.push_error_scope(f));
+    let out = run_captured(g, s, grid, og, rec_tris, occ_tris, ax, params, chunks, sw);
+    let errors: Vec<String> = scopes
+        .into_iter()
+        .rev()
+        .filter_map(|scope| pollster::block_on(scope.pop()))
+        .map(|e| e.to_string())
+        .collect();
+    if !errors.is_empty() {
+        return Err(Error::gpu(errors.join("; ")));
+    }
+    out
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_captured(
     g: &Gpu,
     s: &MapSettings,
     grid: &MapGrid,
@@ -421,10 +459,18 @@ fn run(
     let submitted = std::time::Instant::now();
     g.queue.submit([cmd]);
     let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
     device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| Error::gpu(format!("waiting for the device: {e}")))?;
+    match rx.try_recv() {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => return Err(Error::gpu(format!("mapping the results: {e}"))),
+        Err(_) => return Err(Error::gpu("the results were not mapped after the wait")),
+    }
     let device_wall = submitted.elapsed().as_secs_f64();
     sw.lap("device");
     let view = slice
