@@ -27,6 +27,33 @@ pub fn uniform<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, value: &T) 
     })
 }
 
+/// A storage buffer of `bytes` (at least 16: a binding must not be empty).
+pub fn storage(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: u64,
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | extra,
+        mapped_at_creation: false,
+    })
+}
+
+/// A read-only storage buffer holding `items`; a binding must not be
+/// empty, so an empty list gets one unused zeroed item.
+pub fn upload<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, items: &[T]) -> wgpu::Buffer {
+    let one = [T::zeroed()];
+    let data: &[T] = if items.is_empty() { &one } else { items };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(data),
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
 /// A bind group for group 0 of `pipeline` with `buffers` at bindings 0, 1, ...
 /// (`None` skips a binding the entry point does not use).
 pub fn bind(

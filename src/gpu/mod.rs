@@ -16,8 +16,10 @@ mod dispatch;
 mod from_meshes;
 mod gather;
 mod raster;
+mod readback;
 #[cfg(test)]
 mod shader_tests;
+mod shading;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};

@@ -3,7 +3,10 @@
 //! are uploaded once and drawn by `raster.wgsl` into depth layers held as u32
 //! bits in one `maps` buffer. The CPU twin is `raster::raster_tri`.
 
-use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
+use super::context::Gpu;
+use super::dispatch::{bind, groups_1d, module, pipeline, uniform, upload};
+use super::timing::StageTimer;
+use crate::light::MapGrid;
 use crate::raster::{SetupTri, PEEL_GAP};
 use bytemuck::{Pod, Zeroable};
 use std::sync::OnceLock;
@@ -180,5 +183,125 @@ impl RasterPipelines {
         pass.set_bind_group(0, &bg, &[]);
         let (x, y) = groups_1d(params.tile_count, GROUP);
         pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+/// The set-up triangles and their tiles on the device.
+pub struct RasterInput {
+    rec_tris: wgpu::Buffer,
+    rec_tiles: wgpu::Buffer,
+    rec_tile_count: u32,
+    occ_tris: wgpu::Buffer,
+    occ_tiles: wgpu::Buffer,
+    occ_tile_count: u32,
+}
+
+impl RasterInput {
+    /// The one upload of the geometry: triangles and tiles of both meshes.
+    pub fn upload(g: &Gpu, rec: &[GpuTri], occ: &[GpuTri]) -> RasterInput {
+        let d = &g.device;
+        let (rt, ot) = (tiles(rec), tiles(occ));
+        RasterInput {
+            rec_tris: upload(d, "receiver triangles", rec),
+            rec_tiles: upload(d, "receiver tiles", &rt),
+            rec_tile_count: rt.len() as u32,
+            occ_tris: upload(d, "occluder triangles", occ),
+            occ_tiles: upload(d, "occluder tiles", &ot),
+            occ_tile_count: ot.len() as u32,
+        }
+    }
+
+    /// Records the passes "raster_receivers" (the receiver map at 0 in
+    /// `maps`) and "raster_occluders" (`passes` layers after it: front, the
+    /// peeled ones, back), as `pipeline::from_meshes` makes them.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+        grid: &MapGrid,
+        og: &MapGrid,
+        passes: u32,
+    ) {
+        let device = &g.device;
+        let rp = RasterPipelines::get(device);
+        let rec_len = grid.len() as u32;
+        let occ_len = og.len() as u32;
+        {
+            let mut pass = enc.begin_compute_pass(&timer.pass("raster_receivers"));
+            rp.fill(device, &mut pass, maps, 0, rec_len, INF_BITS);
+            rp.raster(
+                device,
+                &mut pass,
+                maps,
+                &self.rec_tris,
+                &self.rec_tiles,
+                &RasterParams {
+                    tile_count: self.rec_tile_count,
+                    width: grid.width as u32,
+                    height: grid.height as u32,
+                    out_offset: 0,
+                    far_offset: NONE,
+                    prev_offset: NONE,
+                    peel_factor: peel_factor(),
+                    _pad: 0,
+                },
+            );
+        }
+        let mut pass = enc.begin_compute_pass(&timer.pass("raster_occluders"));
+        let layer = |k: u32| rec_len + k * occ_len;
+        // Nearest and peeled layers start at +inf (atomicMin), the farthest at 0 (atomicMax).
+        let nearest_layers = if passes >= 2 { passes - 1 } else { 1 };
+        rp.fill(
+            device,
+            &mut pass,
+            maps,
+            layer(0),
+            occ_len * nearest_layers,
+            INF_BITS,
+        );
+        let far = if passes >= 2 {
+            rp.fill(device, &mut pass, maps, layer(passes - 1), occ_len, 0);
+            layer(passes - 1)
+        } else {
+            NONE
+        };
+        let base = RasterParams {
+            tile_count: self.occ_tile_count,
+            width: og.width as u32,
+            height: og.height as u32,
+            out_offset: layer(0),
+            far_offset: far,
+            prev_offset: NONE,
+            peel_factor: peel_factor(),
+            _pad: 0,
+        };
+        rp.raster(
+            device,
+            &mut pass,
+            maps,
+            &self.occ_tris,
+            &self.occ_tiles,
+            &base,
+        );
+        // Depth peeling: layer k is the nearest surface beyond layer k - 1.
+        for k in 1..passes.saturating_sub(1) {
+            let peel = RasterParams {
+                out_offset: layer(k),
+                far_offset: NONE,
+                prev_offset: layer(k - 1),
+                ..base
+            };
+            rp.raster(
+                device,
+                &mut pass,
+                maps,
+                &self.occ_tris,
+                &self.occ_tiles,
+                &peel,
+            );
+        }
     }
 }
