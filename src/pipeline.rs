@@ -241,8 +241,9 @@ pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
     Ok(())
 }
 
-/// Soft shadow map from depth maps the user rendered.
-pub fn from_depth(
+/// Checks the inputs of `from_depth` (both backends): the light size, a
+/// method that reads maps, each map's size and depths. Returns the light size.
+pub(crate) fn check_depth_inputs(
     grid: &MapGrid,
     occluder_grid: &MapGrid,
     light_size: [f64; 2],
@@ -250,7 +251,7 @@ pub fn from_depth(
     back: Option<&[f32]>,
     receiver: &[f32],
     method: Method,
-) -> Result<(Vec<f32>, Timings)> {
+) -> Result<[f64; 2]> {
     let light_size = check_light_size("light_size", light_size)?;
     if method.traces_triangles() {
         return Err(Error::invalid(
@@ -273,6 +274,28 @@ pub fn from_depth(
             check_depth(arg, d)?;
         }
     }
+    Ok(light_size)
+}
+
+/// Soft shadow map from depth maps the user rendered.
+pub fn from_depth(
+    grid: &MapGrid,
+    occluder_grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> Result<(Vec<f32>, Timings)> {
+    let light_size = check_depth_inputs(
+        grid,
+        occluder_grid,
+        light_size,
+        front,
+        back,
+        receiver,
+        method,
+    )?;
     let mut sw = Stopwatch::new();
     let mut layers = vec![front];
     if let Some(b) = back {

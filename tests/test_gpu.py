@@ -132,12 +132,28 @@ def test_methods_not_on_the_gpu_are_refused_not_run_on_the_cpu(method):
         ss.soft_shadow_map(scene, light, resolution=16, method=method, backend="gpu")
 
 
-def test_depth_maps_are_not_shaded_on_the_gpu_yet():
-    z = np.full((8, 8), 2.0, np.float32)
-    with pytest.raises(ValueError, match="backend: soft_shadow_map_from_depth runs on the CPU only"):
-        ss.soft_shadow_map_from_depth(z, z * 2, light_size=1.0, extent=0.5, backend="gpu")
-    sm = ss.soft_shadow_map_from_depth(z, z * 2, light_size=1.0, extent=0.5, backend="auto")
-    assert sm.visibility.shape == (8, 8)
+@pytest.mark.parametrize("method, samples", GPU_METHODS)
+def test_depth_maps_shaded_on_the_gpu_match_the_cpu(gpu, method, samples):
+    scene, light = scenes.bunny_floating()
+    sm = ss.soft_shadow_map(scene, light, resolution=(48, 40), occluder_resolution=32, passes=2)
+    kw = dict(
+        light_size=light.size,
+        extent=sm.extent,
+        occluder_depth_back=sm.occluder_depth_back,
+        method=method,
+        samples=samples,
+    )
+    c = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="cpu", **kw)
+    g = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="gpu", **kw)
+    assert_visibility_agrees(c.visibility, g.visibility, method)
+    assert "gpu_shadow" in g.timings or "gpu" in g.timings
+    one = ss.soft_shadow_map_from_depth(
+        sm.occluder_depth, sm.receiver_depth, backend="gpu", **{**kw, "occluder_depth_back": None}
+    )
+    ref = ss.soft_shadow_map_from_depth(
+        sm.occluder_depth, sm.receiver_depth, backend="cpu", **{**kw, "occluder_depth_back": None}
+    )
+    assert_visibility_agrees(ref.visibility, one.visibility, f"{method}, one layer")
 
 
 def test_without_an_adapter_gpu_raises_and_auto_runs_on_the_cpu(monkeypatch):
@@ -149,6 +165,9 @@ def test_without_an_adapter_gpu_raises_and_auto_runs_on_the_cpu(monkeypatch):
         ss.gpu_info()
     with pytest.raises(ss.GpuUnavailableError, match="no GPU available"):
         ss.soft_shadow_map(scene, light, resolution=16, backend="gpu")
+    z = np.full((8, 8), 2.0, np.float32)
+    with pytest.raises(ss.GpuUnavailableError, match="no GPU available"):
+        ss.soft_shadow_map_from_depth(z, z * 2, light_size=1.0, extent=0.5, backend="gpu")
     assert issubclass(ss.GpuUnavailableError, RuntimeError)
     auto = ss.soft_shadow_map(scene, light, resolution=16, backend="auto")
     cpu = ss.soft_shadow_map(scene, light, resolution=16, backend="cpu")

@@ -53,10 +53,11 @@ def shadow_map_from_depth(
     extent: tuple[float, float],
     method: str,
     samples: int | None = None,
+    backend: str = "cpu",
 ) -> dict[str, Any]:
     """Visibility from depth maps (the occluder maps may have their own
     resolution; the output has the receiver map's). Returns ``visibility`` and
-    ``timings``."""
+    ``timings``. ``backend``: "cpu" or "gpu" (as for shadow_map_from_meshes)."""
 
 def sample_points(
     light: Light,

@@ -275,8 +275,8 @@ def soft_shadow_map_from_depth(
     light's (width, height) in the depth's units; ``extent`` the maps' tangent
     half-extents. The result's ``light`` is the canonical light of that size
     (center at the origin, normal +z, up +y), so ``sample`` takes points in that
-    frame. ``backend``: ``"cpu"``; ``"auto"`` runs on the CPU; ``"gpu"`` is
-    refused (only :func:`soft_shadow_map` runs on the GPU in this version).
+    frame. ``backend``: as for :func:`soft_shadow_map` (``"gpu"``: the maps
+    go up once, the shading runs on the device, the visibility comes back).
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
@@ -291,10 +291,8 @@ def soft_shadow_map_from_depth(
     ext = check.extent(extent)
     method = check.choice("method", method, METHODS)
     samples = _check_samples(samples, method)
-    # Depth maps are shaded on the CPU in this version: "auto" picks it, "gpu" is refused.
-    if backends.resolve(backend, method) == "gpu":
-        raise ValueError('backend: soft_shadow_map_from_depth runs on the CPU only in this version; use backend="cpu"')
-    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples)
+    run_on = backends.resolve(backend, method)
+    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples, run_on)
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(

@@ -7,12 +7,15 @@
 //! * `gather.wgsl` + `ssm.wgsl` (`gather.rs`): row statistics and the
 //!   published soft shadow map; twin `crate::methods::{gather, ssm}`.
 //!
-//! Device, queue and pipelines are made once per process (`context.rs`).
+//! Entry points: `from_meshes` (the whole mesh pipeline) and `from_depth`
+//! (the user's depth maps, shaded). Device, queue and pipelines are made once
+//! per process (`context.rs`).
 
 mod context;
 #[cfg(test)]
 mod device_tests;
 mod dispatch;
+mod from_depth;
 mod from_meshes;
 mod gather;
 mod raster;
@@ -23,6 +26,7 @@ mod shading;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};
+pub use from_depth::from_depth;
 pub use from_meshes::{from_meshes, MAX_SIDE};
 
 use crate::error::Result;

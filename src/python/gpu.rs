@@ -3,9 +3,10 @@
 //! GpuUnavailableError.
 
 use crate::error::{Error, Result};
-use crate::light::RectLight;
+use crate::light::{MapGrid, RectLight};
 use crate::mesh::MeshRef;
-use crate::pipeline::{self, MapSettings, ShadowResult};
+use crate::methods::Method;
+use crate::pipeline::{self, MapSettings, ShadowResult, Timings};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -21,6 +22,47 @@ pub fn from_meshes(
         "cpu" => pipeline::from_meshes(occ, rec, light, s),
         #[cfg(feature = "gpu")]
         "gpu" => crate::gpu::from_meshes(occ, rec, light, s),
+        #[cfg(not(feature = "gpu"))]
+        "gpu" => Err(not_built()),
+        other => Err(Error::invalid(
+            "backend",
+            format!("must be \"cpu\" or \"gpu\", got {other:?}"),
+        )),
+    }
+}
+
+/// Shades depth maps on `backend` ("cpu" or "gpu").
+#[allow(clippy::too_many_arguments)]
+pub fn from_depth(
+    backend: &str,
+    grid: &MapGrid,
+    occluder_grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> Result<(Vec<f32>, Timings)> {
+    match backend {
+        "cpu" => pipeline::from_depth(
+            grid,
+            occluder_grid,
+            light_size,
+            front,
+            back,
+            receiver,
+            method,
+        ),
+        #[cfg(feature = "gpu")]
+        "gpu" => crate::gpu::from_depth(
+            grid,
+            occluder_grid,
+            light_size,
+            front,
+            back,
+            receiver,
+            method,
+        ),
         #[cfg(not(feature = "gpu"))]
         "gpu" => Err(not_built()),
         other => Err(Error::invalid(

@@ -142,7 +142,7 @@ fn shadow_map_from_meshes<'py>(
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None, backend="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_depth<'py>(
     py: Python<'py>,
@@ -153,6 +153,7 @@ fn shadow_map_from_depth<'py>(
     extent: (f64, f64),
     method: &str,
     samples: Option<u32>,
+    backend: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::parse(method, samples)?;
     let shape = receiver_depth.shape();
@@ -170,7 +171,8 @@ fn shadow_map_from_depth<'py>(
     };
     let receiver = slice("receiver_depth", &receiver_depth)?;
     let (v, t) = py.detach(|| {
-        pipeline::from_depth(
+        gpu::from_depth(
+            backend,
             &grid,
             &occluder_grid,
             light_size,
