@@ -61,7 +61,8 @@ def assert_visibility_agrees(cpu: np.ndarray, gpu: np.ndarray, name: str) -> Non
     assert dv.mean() <= 1e-4 and dv.max() <= 2e-3, f"{name}: mean {dv.mean():.2e}, max {dv.max():.2e}"
 
 
-GPU_METHODS = [("ssm", None), ("bitmask", 16), ("bitmask", 256)]
+GPU_METHODS = [("ssm", None), ("bitmask", 16), ("bitmask", 256), ("exact", 16)]
+MAP_METHODS = GPU_METHODS[:3]
 
 
 @pytest.mark.parametrize("method, samples", GPU_METHODS)
@@ -75,6 +76,9 @@ def test_gpu_matches_cpu_on_the_scenes(gpu, name, passes, method, samples):
     assert g.extent == c.extent
     assert_visibility_agrees(c.visibility, g.visibility, name)
     assert_depth_maps_agree(c.receiver_depth, g.receiver_depth, f"{name} receiver")
+    if method == "exact":  # traces the triangles: no occluder maps on either backend
+        assert g.occluder_depth is None and c.occluder_depth is None
+        return
     assert_depth_maps_agree(c.occluder_depth, g.occluder_depth, f"{name} front")
     if passes >= 2:
         assert_depth_maps_agree(c.occluder_depth_back, g.occluder_depth_back, f"{name} back")
@@ -120,19 +124,16 @@ def test_auto_takes_the_gpu_only_when_it_is_real(gpu):
     sm = ss.soft_shadow_map(scene, light, resolution=32, backend="auto")
     on_gpu = any(k.startswith("gpu") for k in sm.timings)
     assert on_gpu == (not gpu["software"])
-    # A method the GPU does not run stays on the CPU with "auto".
-    sm = ss.soft_shadow_map(scene, light, resolution=16, method="exact", samples=4, backend="auto")
-    assert not any(k.startswith("gpu") for k in sm.timings)
 
 
-@pytest.mark.parametrize("method", ["exact"])
-def test_methods_not_on_the_gpu_are_refused_not_run_on_the_cpu(method):
-    scene, light = scenes.square_plate()
-    with pytest.raises(ValueError, match=f"method: '{method}' is not implemented on the GPU"):
-        ss.soft_shadow_map(scene, light, resolution=16, method=method, backend="gpu")
+def test_depth_maps_are_not_traced_on_either_backend():
+    z = np.full((8, 8), 2.0, np.float32)
+    for backend in ("cpu", "gpu"):
+        with pytest.raises(ValueError, match="method: traces the occluder triangles"):
+            ss.soft_shadow_map_from_depth(z, z * 2, light_size=1.0, extent=0.5, method="exact", backend=backend)
 
 
-@pytest.mark.parametrize("method, samples", GPU_METHODS)
+@pytest.mark.parametrize("method, samples", MAP_METHODS)
 def test_depth_maps_shaded_on_the_gpu_match_the_cpu(gpu, method, samples):
     scene, light = scenes.bunny_floating()
     sm = ss.soft_shadow_map(scene, light, resolution=(48, 40), occluder_resolution=32, passes=2)

@@ -42,8 +42,8 @@ def shadow_map_from_meshes(
     for methods that trace triangles), ``occluder_depth_middle`` (the peeled
     layers, a list; empty below 3 passes), ``extent``: (tx, ty) and
     ``timings``: {stage: seconds}. ``samples`` is for the sampling methods
-    only. ``backend``: "cpu" or "gpu" (the GPU runs "ssm"; any other method
-    raises ValueError, no adapter GpuUnavailableError)."""
+    only. ``backend``: "cpu" or "gpu" (every method; no adapter raises
+    GpuUnavailableError)."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],

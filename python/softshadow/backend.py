@@ -1,9 +1,10 @@
 """Which backend runs a shadow map: the CPU (all cores) or the GPU (wgpu).
 
 ``backend="gpu"`` runs the mesh pipeline on the GPU and never falls back:
-without an adapter it raises :class:`GpuUnavailableError`, and a method not
-on the GPU yet raises ValueError. ``backend="auto"`` takes the GPU when a real
-(non-software) adapter is present and the method runs there, else the CPU.
+without an adapter it raises :class:`GpuUnavailableError`, and a method
+without a GPU kernel would raise ValueError (every method has one in this
+version). ``backend="auto"`` takes the GPU when a real (non-software) adapter
+is present and the method runs there, else the CPU.
 ``SOFTSHADOW_GPU=off`` in the environment hides every adapter.
 """
 
@@ -18,7 +19,7 @@ GpuUnavailableError = _core.GpuUnavailableError
 
 BACKENDS = ("cpu", "gpu", "auto")
 # Methods with a GPU kernel; keep in sync with method_source in src/gpu/gather.rs.
-GPU_METHODS = ("ssm", "bitmask")
+GPU_METHODS = ("ssm", "bitmask", "exact")
 
 
 def gpu_available() -> bool:

@@ -208,12 +208,11 @@ def soft_shadow_map(
         paper notes that large lights need fewer occluder texels).
     backend
         ``"cpu"`` (all cores); ``"gpu"``: rasterization, shading and the
-        merge of the layers on the GPU (wgpu, Vulkan), one upload of the
-        set-up triangles and one readback; methods on the GPU:
-        ``"ssm"``. It never falls back: no adapter raises
-        ``GpuUnavailableError``, another method ValueError. ``"auto"``: the
-        GPU when a real (non-software) one is present and runs ``method``,
-        else the CPU. ``timings`` then hold the device's stages
+        merge of the layers on the GPU (wgpu, Vulkan), for every method, with
+        one upload of the set-up triangles (and, for ``"exact"``, of the BVH
+        built on the CPU) and one readback. It never falls back: no adapter
+        raises ``GpuUnavailableError``. ``"auto"``: the GPU when a real
+        (non-software) one is present, else the CPU. ``timings`` then hold the device's stages
         (``gpu_*``, from timestamp queries where the adapter has them).
     """
     if not isinstance(scene, Scene):

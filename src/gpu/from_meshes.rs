@@ -9,6 +9,7 @@
 
 use super::context::gpu;
 use super::dispatch::storage;
+use super::exact::ExactShading;
 use super::gather;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
@@ -17,7 +18,10 @@ use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::light::RectLight;
 use crate::mesh::MeshRef;
-use crate::pipeline::{frame_scene, FramedScene, MapSettings, ShadowResult, Stopwatch};
+use crate::methods::Method;
+use crate::pipeline::{
+    frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
+};
 use crate::raster::setup_triangles;
 
 /// The largest map side on the GPU: fixed-point coordinates ((side + 2
@@ -40,6 +44,12 @@ pub fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
     Ok(())
 }
 
+/// The shading stage of a method: over occluder maps, or over triangles.
+enum Stage {
+    Maps(Shading),
+    Rays(ExactShading),
+}
+
 /// Soft shadow map from meshes on the GPU; the same result type, maps and
 /// stage names (plus the device's) as `pipeline::from_meshes`.
 pub fn from_meshes(
@@ -48,7 +58,11 @@ pub fn from_meshes(
     light: &RectLight,
     s: &MapSettings,
 ) -> Result<ShadowResult> {
-    gather::check_method(s.method)?;
+    // Map methods shade occluder maps; `exact` traces the triangles.
+    let traced = s.method.traces_triangles();
+    if !traced {
+        gather::check_method(s.method)?;
+    }
     check_side("resolution", (s.width, s.height))?;
     if let Some(o) = s.occluder_resolution {
         check_side("occluder_resolution", o)?;
@@ -62,30 +76,42 @@ pub fn from_meshes(
         occluder_grid,
         near,
     } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
-    let passes = s.passes as usize;
-    check_size(g, s.method, &grid, &occluder_grid, s.passes)?;
+    // Occluder depth layers in `maps` after the receiver's (none when traced).
+    let layers = if traced { 0 } else { s.passes };
+    let passes = layers as usize;
+    check_size(g, s.method, &grid, &occluder_grid, layers)?;
     let rec_tris: Vec<GpuTri> = setup_triangles(&grid, &rec_ls, receivers.faces, near)
         .iter()
         .map(GpuTri::from_setup)
         .collect();
-    let occ_tris: Vec<GpuTri> = setup_triangles(&occluder_grid, &occ_ls, occluders.faces, near)
-        .iter()
-        .map(GpuTri::from_setup)
-        .collect();
+    let occ_tris: Vec<GpuTri> = if traced {
+        vec![]
+    } else {
+        setup_triangles(&occluder_grid, &occ_ls, occluders.faces, near)
+            .iter()
+            .map(GpuTri::from_setup)
+            .collect()
+    };
     sw.lap("setup");
     // The occluders' largest 1/depth, from their vertices in front of the near plane.
     let w_max = occ_ls.iter().fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
     let maps_len = grid.len() + passes * occluder_grid.len();
     let out = with_error_scopes(g, || {
-        let shading = Shading::new(
-            g,
-            s.method,
-            &grid,
-            &occluder_grid,
-            light.size,
-            s.passes,
-            w_max,
-        );
+        let shading = match s.method {
+            Method::Exact { samples } => {
+                let t = light_space_triangles(&occ_ls, occluders.faces);
+                Stage::Rays(ExactShading::new(g, &grid, t, samples, light.size))
+            }
+            _ => Stage::Maps(Shading::new(
+                g,
+                s.method,
+                &grid,
+                &occluder_grid,
+                light.size,
+                layers,
+                w_max,
+            )),
+        };
         let maps = storage(
             &g.device,
             "maps",
@@ -100,19 +126,27 @@ pub fn from_meshes(
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("softshadow"),
             });
-        tris.record(g, &mut enc, &timer, &maps, &grid, &occluder_grid, s.passes);
-        shading.record(g, &mut enc, &timer, &maps)?;
-        submit_and_read(
-            g,
-            enc,
-            &timer,
-            &[
-                (&maps, maps_len as u64 * 4),
-                (&shading.vis, shading.vis_bytes),
-            ],
-            &mut sw,
-        )
+        tris.record(g, &mut enc, &timer, &maps, &grid, &occluder_grid, layers);
+        let mut sources = vec![(&maps, maps_len as u64 * 4)];
+        match &shading {
+            Stage::Maps(sh) => {
+                sh.record(g, &mut enc, &timer, &maps)?;
+                sources.push((&sh.vis, sh.vis_bytes));
+            }
+            Stage::Rays(sh) => {
+                sh.record(g, &mut enc, &timer, &maps);
+                sources.push((&sh.vis, sh.vis_bytes));
+                sources.push((&sh.status, 4));
+            }
+        }
+        submit_and_read(g, enc, &timer, &sources, &mut sw)
     })?;
+    if out.buffers.get(2).is_some_and(|b| words(b)[0] != 0) {
+        return Err(Error::gpu(
+            "a ray visited more BVH nodes than one invocation may (lavapipe stops an \
+             invocation after 65535 loop iterations); use backend=\"cpu\" for this scene",
+        ));
+    }
     let maps = words(&out.buffers[0]);
     let visibility = visibility(&out.buffers[1])?;
     let mut timings = sw.timings;
@@ -133,7 +167,7 @@ pub fn from_meshes(
             .collect()
     };
     let receiver: Vec<f32> = maps[..rec_len].iter().map(|&b| f32::from_bits(b)).collect();
-    let front = map_of(0, false);
+    let front = (!traced).then(|| map_of(0, false));
     let middle: Vec<Vec<f32>> = (1..passes.saturating_sub(1))
         .map(|k| map_of(k, false))
         .collect();
@@ -144,7 +178,7 @@ pub fn from_meshes(
         occluder_grid,
         visibility,
         receiver,
-        occluder_front: Some(front),
+        occluder_front: front,
         occluder_middle: middle,
         occluder_back: back,
         timings,

@@ -111,7 +111,8 @@ struct MethodPipelines {
     resolve: wgpu::ComputePipeline,
 }
 
-/// The methods that run on the GPU, and the error for the others.
+/// The methods that run on occluder maps, and the error for the others
+/// (`exact` traces triangles: `exact.rs`, never through here).
 fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
     match method {
         Method::Ssm => Ok(("ssm", SSM_SOURCE)),
@@ -119,7 +120,7 @@ fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
         Method::Exact { .. } => Err(Error::invalid(
             "method",
             format!(
-                "{:?} is not implemented on the GPU backend yet; use backend=\"cpu\" (GPU methods: \"ssm\", \"bitmask\")",
+                "{:?} does not shade occluder maps (GPU map methods: \"ssm\", \"bitmask\")",
                 method.name()
             ),
         )),

@@ -6,6 +6,10 @@
 //!   `crate::raster` (same fixed-point coverage, same f32 depth plane).
 //! * `gather.wgsl` + `ssm.wgsl` (`gather.rs`): row statistics and the
 //!   published soft shadow map; twin `crate::methods::{gather, ssm}`.
+//! * `gather.wgsl` + `bitmask.wgsl` (`gather.rs`): the bitmask method; twin
+//!   `crate::methods::bitmask`.
+//! * `exact.wgsl` (`exact.rs`): ray casting through the CPU-built BVH; twin
+//!   `crate::methods::exact`.
 //!
 //! Entry points: `from_meshes` (the whole mesh pipeline) and `from_depth`
 //! (the user's depth maps, shaded). Device, queue and pipelines are made once
@@ -15,6 +19,7 @@ mod context;
 #[cfg(test)]
 mod device_tests;
 mod dispatch;
+mod exact;
 mod from_depth;
 mod from_meshes;
 mod gather;

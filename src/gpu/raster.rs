@@ -213,7 +213,8 @@ impl RasterInput {
 
     /// Records the passes "raster_receivers" (the receiver map at 0 in
     /// `maps`) and "raster_occluders" (`passes` layers after it: front, the
-    /// peeled ones, back), as `pipeline::from_meshes` makes them.
+    /// peeled ones, back), as `pipeline::from_meshes` makes them; no
+    /// occluder pass with `passes` = 0 (a method that traces triangles).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -249,6 +250,9 @@ impl RasterInput {
                     _pad: 0,
                 },
             );
+        }
+        if passes == 0 {
+            return;
         }
         let mut pass = enc.begin_compute_pass(&timer.pass("raster_occluders"));
         let layer = |k: u32| rec_len + k * occ_len;

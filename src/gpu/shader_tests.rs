@@ -2,6 +2,7 @@
 //! naga (what wgpu runs on it), and every parameter struct shared by Rust and
 //! WGSL has the same member offsets and sizes on both sides.
 
+use super::exact::{ExactParams, SOURCE as EXACT_SOURCE};
 use super::gather::{
     module_source, ChunkParams, GatherParams, RowSpan, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
@@ -14,6 +15,7 @@ fn modules() -> Vec<(&'static str, String)> {
         ("raster.wgsl", RASTER_SOURCE.to_string()),
         ("gather.wgsl + ssm.wgsl", module_source(SSM_SOURCE)),
         ("gather.wgsl + bitmask.wgsl", module_source(BITMASK_SOURCE)),
+        ("exact.wgsl", EXACT_SOURCE.to_string()),
     ]
 }
 
@@ -26,7 +28,13 @@ fn parse(name: &str, src: &str) -> naga::Module {
 fn every_wgsl_file_is_used_by_a_module() {
     // Files on disk beside this module: each must be part of a checked module.
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/gpu");
-    let sources = [RASTER_SOURCE, GATHER_SOURCE, SSM_SOURCE, BITMASK_SOURCE];
+    let sources = [
+        RASTER_SOURCE,
+        GATHER_SOURCE,
+        SSM_SOURCE,
+        BITMASK_SOURCE,
+        EXACT_SOURCE,
+    ];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "wgsl") {
@@ -193,6 +201,28 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             first,
             last,
             _pad
+        }),
+    );
+    assert_same(
+        EXACT_SOURCE,
+        "ExactParams",
+        rust_layout!(ExactParams {
+            rec_w,
+            rec_h,
+            na,
+            nb,
+            chunk_start,
+            chunk_len,
+            budget,
+            has_tris,
+            size_x,
+            size_y,
+            t0,
+            t1,
+            ax_rec_x,
+            ax_rec_y,
+            _pad0,
+            _pad1
         }),
     );
 }
