@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # Installs everything softshadow needs on a fresh Debian machine (run as root):
 # Debian's libLLVM 19 (Mitsuba's llvm variants need LLVM >= 16; Debian's 15
-# crashes Dr.Jit), a virtual environment in .venv, and the package built from
-# source (Rust, through maturin) with the extras given as arguments.
+# crashes Dr.Jit), the Vulkan loader and Mesa's Vulkan drivers (lavapipe, a
+# CPU Vulkan device, so that the GPU backend runs and is tested without a
+# GPU), a virtual environment in .venv, and the package built from source
+# (Rust, through maturin) with the extras given as arguments.
 #   scripts/setup.sh            -> the package only
 #   scripts/setup.sh test       -> the package, Mitsuba, trimesh, OpenEXR, pytest
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need=()
-for pkg in libllvm19; do
+for pkg in libllvm19 libvulkan1 mesa-vulkan-drivers; do
     dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then

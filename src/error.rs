@@ -16,6 +16,13 @@ pub enum Error {
     /// The request would allocate more than we are willing to before starting.
     #[error("{arg}: {msg}")]
     TooLarge { arg: String, msg: String },
+    /// `backend="gpu"` was asked for and no GPU adapter can be opened (none
+    /// present, no driver, or switched off by SOFTSHADOW_GPU=off).
+    #[error("no GPU available: {msg}")]
+    GpuUnavailable { msg: String },
+    /// The GPU device failed while running (out of memory, lost device).
+    #[error("GPU failure: {msg}")]
+    Gpu { msg: String },
 }
 
 impl Error {
@@ -30,6 +37,12 @@ impl Error {
             arg: arg.into(),
             msg: msg.into(),
         }
+    }
+    pub fn gpu_unavailable(msg: impl Into<String>) -> Self {
+        Error::GpuUnavailable { msg: msg.into() }
+    }
+    pub fn gpu(msg: impl Into<String>) -> Self {
+        Error::Gpu { msg: msg.into() }
     }
     pub fn too_large(arg: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::TooLarge {

@@ -7,8 +7,11 @@
 // comparison is the point, not an accident.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod depth_plane;
 pub mod error;
 pub mod extent;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod light;
 pub mod mesh;
 pub mod methods;

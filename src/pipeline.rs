@@ -60,19 +60,20 @@ pub struct MapSettings {
     pub method: Method,
 }
 
-struct Stopwatch {
+pub(crate) struct Stopwatch {
     t: Instant,
-    timings: Timings,
+    pub timings: Timings,
 }
 
 impl Stopwatch {
-    fn new() -> Self {
+    pub fn new() -> Self {
         Stopwatch {
             t: Instant::now(),
             timings: Vec::new(),
         }
     }
-    fn lap(&mut self, name: &'static str) {
+    /// Records the time since the last lap as stage `name`.
+    pub fn lap(&mut self, name: &'static str) {
         let now = Instant::now();
         self.timings.push((name, (now - self.t).as_secs_f64()));
         self.t = now;
@@ -86,13 +87,25 @@ fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
     (far * 1e-9).max(f64::MIN_POSITIVE)
 }
 
-/// Soft shadow map from meshes.
-pub fn from_meshes(
-    occluders: MeshRef,
-    receivers: MeshRef,
+/// A scene moved to light space with its map grids fitted: what both
+/// backends start from.
+pub(crate) struct FramedScene {
+    pub occ_ls: Vec<DVec3>,
+    pub rec_ls: Vec<DVec3>,
+    pub grid: MapGrid,
+    pub occluder_grid: MapGrid,
+    pub near: f64,
+}
+
+/// Checks the input, moves the meshes to light space and fits the grids
+/// (stages "transform" and "extent").
+pub(crate) fn frame_scene(
+    occluders: &MeshRef,
+    receivers: &MeshRef,
     light: &RectLight,
     s: &MapSettings,
-) -> Result<ShadowResult> {
+    sw: &mut Stopwatch,
+) -> Result<FramedScene> {
     check_passes(s.passes)?;
     if occluders.is_empty() {
         return Err(Error::invalid(
@@ -114,7 +127,6 @@ pub fn from_meshes(
     occluders.validate("occluders")?;
     receivers.validate("receivers")?;
 
-    let mut sw = Stopwatch::new();
     let occ_ls = occluders.to_light_space(light);
     let rec_ls = receivers.to_light_space(light);
     sw.lap("transform");
@@ -126,6 +138,30 @@ pub fn from_meshes(
     let occluder_grid = MapGrid::new(ow, oh, extent)?;
     sw.lap("extent");
     let near = near_plane(&occ_ls, &rec_ls);
+    Ok(FramedScene {
+        occ_ls,
+        rec_ls,
+        grid,
+        occluder_grid,
+        near,
+    })
+}
+
+/// Soft shadow map from meshes.
+pub fn from_meshes(
+    occluders: MeshRef,
+    receivers: MeshRef,
+    light: &RectLight,
+    s: &MapSettings,
+) -> Result<ShadowResult> {
+    let mut sw = Stopwatch::new();
+    let FramedScene {
+        occ_ls,
+        rec_ls,
+        grid,
+        occluder_grid,
+        near,
+    } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
     let receiver = rasterize(&grid, &rec_ls, receivers.faces, near, false).nearest;
     sw.lap("raster_receivers");
     // Only what the method reads: occluder maps for the map methods, light-space
@@ -205,8 +241,9 @@ pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
     Ok(())
 }
 
-/// Soft shadow map from depth maps the user rendered.
-pub fn from_depth(
+/// Checks the inputs of `from_depth` (both backends): the light size, a
+/// method that reads maps, each map's size and depths. Returns the light size.
+pub(crate) fn check_depth_inputs(
     grid: &MapGrid,
     occluder_grid: &MapGrid,
     light_size: [f64; 2],
@@ -214,7 +251,7 @@ pub fn from_depth(
     back: Option<&[f32]>,
     receiver: &[f32],
     method: Method,
-) -> Result<(Vec<f32>, Timings)> {
+) -> Result<[f64; 2]> {
     let light_size = check_light_size("light_size", light_size)?;
     if method.traces_triangles() {
         return Err(Error::invalid(
@@ -237,6 +274,28 @@ pub fn from_depth(
             check_depth(arg, d)?;
         }
     }
+    Ok(light_size)
+}
+
+/// Soft shadow map from depth maps the user rendered.
+pub fn from_depth(
+    grid: &MapGrid,
+    occluder_grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> Result<(Vec<f32>, Timings)> {
+    let light_size = check_depth_inputs(
+        grid,
+        occluder_grid,
+        light_size,
+        front,
+        back,
+        receiver,
+        method,
+    )?;
     let mut sw = Stopwatch::new();
     let mut layers = vec![front];
     if let Some(b) = back {

@@ -1,7 +1,8 @@
 //! CPU rasterizer of triangle meshes into light-view depth maps.
 //!
 //! * Sampling at texel centers; the depth is planar (light-space Z), which is
-//!   interpolated as 1/Z, the quantity that is linear in the map's plane.
+//!   interpolated as 1/Z, the quantity that is linear in the map's plane, in
+//!   the f32 form of `depth_plane.rs` that the GPU rasterizer shares.
 //! * Watertight: vertices are snapped to a fixed-point grid (1/256 texel) and edge
 //!   functions are evaluated exactly in i64, with a tie rule that gives a texel
 //!   center lying exactly on a shared edge to exactly one of the two triangles.
@@ -12,13 +13,14 @@
 //! * Parallel without locks: the map is cut into bands of rows; triangles are
 //!   binned by band, and each band is rasterized by one task.
 
+use crate::depth_plane::DepthPlane;
 use crate::light::MapGrid;
 use glam::DVec3;
 use rayon::prelude::*;
 
 /// Sub-texel precision of snapped vertex coordinates.
-const SUBPIXEL_BITS: u32 = 8;
-const ONE: i64 = 1 << SUBPIXEL_BITS;
+pub(crate) const SUBPIXEL_BITS: u32 = 8;
+pub(crate) const ONE: i64 = 1 << SUBPIXEL_BITS;
 /// The guard band in texels on each side of the map. Coordinates stay below
 /// (W + 2G) * 256 < 2^26 for W <= 2^16, so edge products fit in i64 exactly.
 const GUARD: f64 = 4096.0;
@@ -32,19 +34,19 @@ pub struct DepthLayers {
     pub farthest: Option<Vec<f32>>,
 }
 
-/// A triangle ready to rasterize: snapped pixel coordinates, 1/Z per vertex,
+/// A triangle ready to rasterize: snapped pixel coordinates, its 1/Z plane,
 /// counter-clockwise in the sense that its edge functions are >= 0 inside.
 #[derive(Debug, Clone, Copy)]
-struct SetupTri {
-    x: [i64; 3],
-    y: [i64; 3],
-    w: [f64; 3],
-    inv_area: f64,
+pub(crate) struct SetupTri {
+    pub x: [i64; 3],
+    pub y: [i64; 3],
+    /// 1/Z from the center of texel (i0, j0) on.
+    pub depth: DepthPlane,
     /// Inclusive texel ranges covered by the bounding box, clamped to the map.
-    i0: u32,
-    i1: u32,
-    j0: u32,
-    j1: u32,
+    pub i0: u32,
+    pub i1: u32,
+    pub j0: u32,
+    pub j1: u32,
 }
 
 /// A vertex snapped to the fixed-point grid, with its 1/Z.
@@ -237,11 +239,25 @@ impl Projector {
         ) else {
             return;
         };
+        // 1/Z at the center of texel (i0, j0) from the exact edge functions
+        // there (barycentric, well conditioned), and its gradient per texel.
+        let (cx, cy) = (i0 as i64 * ONE + ONE / 2, j0 as i64 * ONE + ONE / 2);
+        let mut w_ref = 0f64;
+        for (k, wk) in w.iter().enumerate() {
+            let (s, e) = ((k + 1) % 3, (k + 2) % 3);
+            let edge = (x[e] - x[s]) * (cy - y[s]) - (y[e] - y[s]) * (cx - x[s]);
+            w_ref += edge as f64 * wk;
+        }
+        let area_f = area as f64;
+        let (dx1, dy1) = ((x[1] - x[0]) as f64, (y[1] - y[0]) as f64);
+        let (dx2, dy2) = ((x[2] - x[0]) as f64, (y[2] - y[0]) as f64);
+        let (dw1, dw2) = (w[1] - w[0], w[2] - w[0]);
+        let grad_i = (dw1 * dy2 - dw2 * dy1) / area_f * ONE as f64;
+        let grad_j = (dx1 * dw2 - dx2 * dw1) / area_f * ONE as f64;
         out.push(SetupTri {
             x,
             y,
-            w,
-            inv_area: 1.0 / area as f64,
+            depth: DepthPlane::new(w_ref / area_f, grad_i, grad_j),
             i0,
             i1,
             j0,
@@ -301,15 +317,40 @@ fn raster_tri(
         let row = (j - rows.start) * w;
         for i in t.i0 as usize..=t.i1 as usize {
             if e[0] + bias[0] > 0 && e[1] + bias[1] > 0 && e[2] + bias[2] > 0 {
-                let inv_z = (e[0] as f64 * t.w[0] + e[1] as f64 * t.w[1] + e[2] as f64 * t.w[2])
-                    * t.inv_area;
-                write(row + i, (1.0 / inv_z) as f32);
+                if let Some(z) = t.depth.depth(i as u32 - t.i0, j as u32 - t.j0) {
+                    write(row + i, z);
+                }
             }
             e[0] += a[0];
             e[1] += a[1];
             e[2] += a[2];
         }
     }
+}
+
+/// Projects, clips and snaps a mesh whose vertices are already in light space
+/// (f64) into triangles ready to rasterize; the GPU backend uploads these.
+pub(crate) fn setup_triangles(
+    grid: &MapGrid,
+    verts: &[DVec3],
+    faces: &[[u32; 3]],
+    near: f64,
+) -> Vec<SetupTri> {
+    let proj = Projector::new(grid, near);
+    // Each vertex is projected and snapped once, however many faces share it.
+    let snapped: Vec<Snapped> = verts.par_iter().map(|&q| proj.snap(q)).collect();
+    faces
+        .par_chunks(4096)
+        .flat_map_iter(|chunk| {
+            let mut out = Vec::with_capacity(chunk.len());
+            for f in chunk {
+                let tri = f.map(|i| verts[i as usize]);
+                let sn = f.map(|i| snapped[i as usize]);
+                proj.setup(tri, sn, &mut out);
+            }
+            out
+        })
+        .collect()
 }
 
 /// A mesh set up for rasterization: triangles snapped and binned by band.
@@ -324,28 +365,14 @@ pub struct Prepared<'g> {
 
 /// Relative depth gap under which a surface counts as the layer already peeled
 /// (interpolated depths of one surface differ by a few f32 ulps).
-const PEEL_GAP: f32 = 1e-5;
+pub(crate) const PEEL_GAP: f32 = 1e-5;
 
 impl<'g> Prepared<'g> {
     /// Sets up a mesh whose vertices are already in light space. `near` is
     /// the clip distance from the light's plane: geometry closer than it (or
     /// behind the light) is cut away.
     pub fn new(grid: &'g MapGrid, verts: &[DVec3], faces: &[[u32; 3]], near: f64) -> Prepared<'g> {
-        let proj = Projector::new(grid, near);
-        // Each vertex is projected and snapped once, however many faces share it.
-        let snapped: Vec<Snapped> = verts.par_iter().map(|&q| proj.snap(q)).collect();
-        let tris: Vec<SetupTri> = faces
-            .par_chunks(4096)
-            .flat_map_iter(|chunk| {
-                let mut out = Vec::with_capacity(chunk.len());
-                for f in chunk {
-                    let tri = f.map(|i| verts[i as usize]);
-                    let sn = f.map(|i| snapped[i as usize]);
-                    proj.setup(tri, sn, &mut out);
-                }
-                out
-            })
-            .collect();
+        let tris = setup_triangles(grid, verts, faces, near);
 
         // Bin triangle indices by band (counting sort).
         let rows_per_band = band_rows(grid.height);

@@ -37,7 +37,7 @@ def good_depth(n=8):
         (dict(passes=0), ValueError, "passes"),
         (dict(passes=1.0), TypeError, "passes"),
         (dict(method="bogus"), ValueError, "method"),
-        (dict(backend="gpu"), ValueError, "backend"),
+        (dict(backend="tpu"), ValueError, "backend"),
         (dict(backend=3), TypeError, "backend"),
     ],
 )

@@ -35,6 +35,7 @@ def shadow_map_from_meshes(
     hierarchy: bool | None = None,
     precision: str | None = None,
     occluder_resolution: tuple[int, int] | None = None,
+    backend: str = "cpu",
 ) -> dict[str, Any]:
     """Rasterizes the receivers (and, for the map methods, the occluders) into
     light-view maps and computes the visibility. Returns a dict with
@@ -45,7 +46,9 @@ def shadow_map_from_meshes(
     ``timings``: {stage: seconds}. ``samples`` is for the sampling methods
     only, ``hierarchy`` (None: the method's default) for the occluder-map
     methods, ``precision`` ("f32", "f64", "f16", "f16-batched"; None: "f32")
-    for "ssm"."""
+    for "ssm". ``backend``: "cpu" or "gpu" (every method; no adapter raises
+    GpuUnavailableError; the GPU has no hierarchy and sums in f32, and
+    refuses ``hierarchy=True`` and other precisions)."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
@@ -57,10 +60,11 @@ def shadow_map_from_depth(
     samples: int | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
+    backend: str = "cpu",
 ) -> dict[str, Any]:
     """Visibility from depth maps (the occluder maps may have their own
     resolution; the output has the receiver map's). Returns ``visibility`` and
-    ``timings``."""
+    ``timings``. ``backend``: "cpu" or "gpu" (as for shadow_map_from_meshes)."""
 
 def sample_points(
     light: Light,
@@ -88,3 +92,17 @@ def receiver_points(
     extent: tuple[float, float],
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64]]:
     """World points (M, 3) of the texels with a receiver, and their flat indices."""
+
+class GpuUnavailableError(RuntimeError):
+    """backend="gpu" was asked for and no GPU adapter can be opened (none
+    present, no Vulkan driver, or SOFTSHADOW_GPU=off)."""
+
+def gpu_available() -> bool:
+    """Whether a GPU adapter opens (software ones such as lavapipe count).
+    The device is opened once per process and kept."""
+
+def gpu_info() -> dict[str, Any]:
+    """The adapter backend="gpu" uses: ``name``, ``backend`` ("vulkan"),
+    ``device_type`` ("discrete_gpu", "integrated_gpu", "virtual_gpu", "cpu"
+    or "other"), ``driver`` and ``software`` (bool: a CPU renderer). Raises
+    GpuUnavailableError when there is none."""

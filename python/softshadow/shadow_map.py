@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
+from . import backend as backends
 from .light import RectLight
 from .scene import Scene
 
@@ -28,8 +29,6 @@ DEFAULT_HIERARCHY = {"ssm": False, "bitmask": True}
 PRECISIONS = ("f32", "f64", "f16", "f16-batched")
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 MAX_PASSES = 8  # keep in sync with MAX_PASSES in src/pipeline.rs
-BACKENDS = ("cpu",)
-LATER_BACKENDS = ("gpu", "auto")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -181,23 +180,30 @@ def auto_settings(resolution: tuple[int, int]) -> tuple[str, tuple[int, int]]:
     return "ssm", tuple(min(n, max(64, n // 4)) for n in resolution)
 
 
-def _check_precision(precision: Any, method: str) -> str | None:
+def _check_precision(precision: Any, method: str, run_on: str) -> str | None:
     if precision is None:
         return "f32" if method == "ssm" else None
     precision = check.choice("precision", precision, PRECISIONS)
     if method != "ssm":
         raise ValueError(f"precision: applies to 'ssm' (sums of occlusions), not to {method!r}")
+    if run_on == "gpu" and precision != "f32":
+        raise ValueError(f'precision: the GPU backend sums in "f32" only, got {precision!r}; use backend="cpu"')
     return precision
 
 
-def _check_hierarchy(hierarchy: Any, method: str) -> bool | None:
+def _check_hierarchy(hierarchy: Any, method: str, run_on: str) -> bool | None:
     if hierarchy is None:
-        return DEFAULT_HIERARCHY.get(method)
+        if method not in DEFAULT_HIERARCHY:
+            return None
+        # The GPU kernels have no hierarchy yet: off there by default.
+        return DEFAULT_HIERARCHY[method] and run_on == "cpu"
     if not isinstance(hierarchy, (bool, np.bool_)):
         raise TypeError(f"hierarchy: must be a bool or None, got {type(hierarchy).__name__}")
     if method not in DEFAULT_HIERARCHY:
         allowed = tuple(DEFAULT_HIERARCHY)
         raise ValueError(f"hierarchy: applies to the occluder-map methods {allowed}, not to {method!r}")
+    if hierarchy and run_on == "gpu":
+        raise ValueError('hierarchy: the GPU backend has no occluder hierarchy yet; use backend="cpu"')
     return bool(hierarchy)
 
 
@@ -272,8 +278,9 @@ def soft_shadow_map(
         texels, back-projected onto the light from the nearest occluder that
         can reach the tile, cover at most 3% of the light's width: wide
         penumbrae read few coarse texels, contact shadows keep the finest.
-        Default: on for ``"bitmask"``, off for ``"ssm"`` (the paper's
-        method, reproduced as published).
+        Default: on for ``"bitmask"`` on the CPU, off for ``"ssm"`` (the
+        paper's method, reproduced as published) and on the GPU, which has
+        no hierarchy yet (``True`` there raises ValueError).
     precision
         How ``"ssm"`` sums the micro-patch occlusions (Appendix A of the
         paper): ``"f32"`` (default; each occluder row is summed on its own
@@ -286,9 +293,15 @@ def soft_shadow_map(
         docs/precision/fp16.md) and ``"f16-batched"`` (the paper's workaround:
         FP16 sums over batches of about sqrt(M) micro-patches, the batches
         added in f32). Refused for the other methods, which count samples
-        exactly.
+        exactly. The GPU backend sums in ``"f32"`` (one level) only.
     backend
-        ``"cpu"`` (all cores).
+        ``"cpu"`` (all cores); ``"gpu"``: rasterization, shading and the
+        merge of the layers on the GPU (wgpu, Vulkan), for every method, with
+        one upload of the set-up triangles (and, for ``"exact"``, of the BVH
+        built on the CPU) and one readback. It never falls back: no adapter
+        raises ``GpuUnavailableError``. ``"auto"``: the GPU when a real
+        (non-software) one is present, else the CPU. ``timings`` then hold the device's stages
+        (``gpu_*``, from timestamp queries where the adapter has them).
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
@@ -305,14 +318,14 @@ def soft_shadow_map(
         method, auto_occ = auto_settings((w, h))
         occ_res = auto_occ if occ_res is None else occ_res
     samples = _check_samples(samples, method)
-    hierarchy = _check_hierarchy(hierarchy, method)
-    precision = _check_precision(precision, method)
-    check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
+    run_on = backends.resolve(backend, method)
+    hierarchy = _check_hierarchy(hierarchy, method, run_on)
+    precision = _check_precision(precision, method, run_on)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
     if occ_res is not None and method in TRACING_METHODS:
         raise ValueError(f"occluder_resolution: {method!r} reads no occluder maps")
     r = _core.shadow_map_from_meshes(
-        ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, hierarchy, precision, occ_res
+        ov, of, rv, rf, light._core_args(), w, h, ext, passes, method, samples, hierarchy, precision, occ_res, run_on
     )
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
@@ -358,8 +371,9 @@ def soft_shadow_map_from_depth(
     light's (width, height) in the depth's units; ``extent`` the maps' tangent
     half-extents. The result's ``light`` is the canonical light of that size
     (center at the origin, normal +z, up +y), so ``sample`` takes points in that
-    frame. ``method``, ``samples``, ``hierarchy`` and ``precision`` are as for
-    :func:`soft_shadow_map`.
+    frame. ``method``, ``samples``, ``hierarchy``, ``precision`` and
+    ``backend`` are as for :func:`soft_shadow_map` (``"gpu"``: the maps go up
+    once, the shading runs on the device, the visibility comes back).
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
@@ -376,10 +390,10 @@ def soft_shadow_map_from_depth(
     if method == AUTO:
         method = auto_settings(rec.shape[::-1])[0]
     samples = _check_samples(samples, method)
-    hierarchy = _check_hierarchy(hierarchy, method)
-    precision = _check_precision(precision, method)
-    check.choice("backend", backend, BACKENDS, LATER_BACKENDS)
-    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples, hierarchy, precision)
+    run_on = backends.resolve(backend, method)
+    hierarchy = _check_hierarchy(hierarchy, method, run_on)
+    precision = _check_precision(precision, method, run_on)
+    r = _core.shadow_map_from_depth(front, back, rec, size, ext, method, samples, hierarchy, precision, run_on)
     if method in SAMPLING_METHODS and samples is None:
         samples = DEFAULT_SAMPLES
     return ShadowMap(

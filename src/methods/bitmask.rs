@@ -157,6 +157,19 @@ impl RankBounds {
 }
 
 impl Bitmask {
+    /// The rank tables as the GPU twin (`gpu/bitmask.wgsl`) reads them: x_ge
+    /// then y_ge, each entry 8 u32 words (bit b of the mask is bit b % 32 of
+    /// word b / 32, as in the u64 words here).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn rank_tables(&self) -> Vec<u32> {
+        let p = &self.pattern;
+        p.x_ge
+            .iter()
+            .chain(&p.y_ge)
+            .flat_map(|m| m.iter().flat_map(|w| [*w as u32, (*w >> 32) as u32]))
+            .collect()
+    }
+
     /// `samples` must be one of SAMPLE_COUNTS (checked by `Method::parse`).
     pub fn new(samples: u32, hierarchy: Option<Hierarchy>) -> Bitmask {
         let n = (samples as f64).sqrt().round() as usize;

@@ -25,7 +25,7 @@ const LEAF: usize = 4;
 /// Shadow rays start this fraction of the way from the receiver and stop this
 /// fraction short of the light: occluders touching the receiver or the light
 /// are not hit by rounding alone.
-const RAY_EPS: f32 = 1e-5;
+pub(crate) const RAY_EPS: f32 = 1e-5;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -61,6 +61,36 @@ fn centroid(t: &[Vec3; 3]) -> Vec3 {
 }
 
 impl Bvh {
+    /// The nodes as the GPU twin (`gpu/exact.wgsl`) reads them: min xyz,
+    /// max xyz (f32 bits), start, count: 8 words a node.
+    #[cfg(feature = "gpu")]
+    pub(crate) fn node_words(&self) -> Vec<u32> {
+        self.nodes
+            .iter()
+            .flat_map(|n| {
+                [
+                    n.min.x.to_bits(),
+                    n.min.y.to_bits(),
+                    n.min.z.to_bits(),
+                    n.max.x.to_bits(),
+                    n.max.y.to_bits(),
+                    n.max.z.to_bits(),
+                    n.start,
+                    n.count,
+                ]
+            })
+            .collect()
+    }
+
+    /// The triangles in BVH order, 9 floats each.
+    #[cfg(feature = "gpu")]
+    pub(crate) fn triangle_floats(&self) -> Vec<f32> {
+        self.tris
+            .iter()
+            .flat_map(|t| t.iter().flat_map(|v| v.to_array()))
+            .collect()
+    }
+
     pub fn build(mut tris: Vec<[Vec3; 3]>) -> Bvh {
         let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
         let (lo, hi) = bounds(&tris);

@@ -155,6 +155,15 @@ impl Method {
         }
     }
 
+    /// The name a user passes as `method=`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Ssm { .. } => "ssm",
+            Method::Exact { .. } => "exact",
+            Method::Bitmask { .. } => "bitmask",
+        }
+    }
+
     /// Whether the method reads the occluder triangles (not the occluder maps).
     pub fn traces_triangles(&self) -> bool {
         matches!(self, Method::Exact { .. })

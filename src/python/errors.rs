@@ -1,8 +1,15 @@
 //! The one place where core errors become Python exceptions.
 
 use crate::error::Error;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::PyErr;
+
+pyo3::create_exception!(
+    _core,
+    GpuUnavailableError,
+    PyRuntimeError,
+    "backend=\"gpu\" was asked for and no GPU adapter can be opened (none present, no Vulkan driver, or SOFTSHADOW_GPU=off)."
+);
 
 impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
@@ -12,6 +19,8 @@ impl From<Error> for PyErr {
             Error::InvalidArgument { .. }
             | Error::ShapeMismatch { .. }
             | Error::TooLarge { .. } => PyValueError::new_err(e.to_string()),
+            Error::GpuUnavailable { .. } => GpuUnavailableError::new_err(e.to_string()),
+            Error::Gpu { .. } => PyRuntimeError::new_err(e.to_string()),
         }
     }
 }

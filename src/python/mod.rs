@@ -3,6 +3,7 @@
 //! dtypes live in the Python package; value checks live in the core.
 
 mod errors;
+mod gpu;
 
 use crate::light::{MapGrid, RectLight};
 use crate::mesh::MeshRef;
@@ -79,7 +80,7 @@ fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, hierarchy=None, precision=None, occluder_resolution=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, width, height, extent, passes, method, samples=None, hierarchy=None, precision=None, occluder_resolution=None, backend="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -97,6 +98,7 @@ fn shadow_map_from_meshes<'py>(
     hierarchy: Option<bool>,
     precision: Option<&str>,
     occluder_resolution: Option<(usize, usize)>,
+    backend: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let light = light_of(light)?;
     let method = Method::parse(method, samples, hierarchy, precision)?;
@@ -116,7 +118,7 @@ fn shadow_map_from_meshes<'py>(
         passes,
         method,
     };
-    let r = py.detach(|| pipeline::from_meshes(occ, rec, &light, &settings))?;
+    let r = py.detach(|| gpu::from_meshes(backend, occ, rec, &light, &settings))?;
     let d = PyDict::new(py);
     d.set_item("extent", (r.grid.tx, r.grid.ty))?;
     d.set_item("timings", timings_dict(py, &r.timings)?)?;
@@ -142,7 +144,7 @@ fn shadow_map_from_meshes<'py>(
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None, hierarchy=None, precision=None))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, samples=None, hierarchy=None, precision=None, backend="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn shadow_map_from_depth<'py>(
     py: Python<'py>,
@@ -155,6 +157,7 @@ fn shadow_map_from_depth<'py>(
     samples: Option<u32>,
     hierarchy: Option<bool>,
     precision: Option<&str>,
+    backend: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::parse(method, samples, hierarchy, precision)?;
     let shape = receiver_depth.shape();
@@ -172,7 +175,8 @@ fn shadow_map_from_depth<'py>(
     };
     let receiver = slice("receiver_depth", &receiver_depth)?;
     let (v, t) = py.detach(|| {
-        pipeline::from_depth(
+        gpu::from_depth(
+            backend,
             &grid,
             &occluder_grid,
             light_size,
@@ -281,6 +285,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(shadow_map_from_depth, m)?)?;
     m.add_function(wrap_pyfunction!(sample_points, m)?)?;
     m.add_function(wrap_pyfunction!(receiver_points, m)?)?;
+    m.add_function(wrap_pyfunction!(gpu::gpu_available, m)?)?;
+    m.add_function(wrap_pyfunction!(gpu::gpu_info, m)?)?;
+    m.add(
+        "GpuUnavailableError",
+        m.py().get_type::<errors::GpuUnavailableError>(),
+    )?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,0 +1,191 @@
+//! The `exact` method on the GPU: the BVH is built on the CPU (as
+//! `methods/exact.rs` builds it) and uploaded with the triangles; `exact.wgsl`
+//! casts the stratified samples of each receiver texel through it, a chunk of
+//! samples per dispatch, then resolves the counts into visibility.
+
+use super::context::Gpu;
+use super::dispatch::{bind, module, pipeline, storage, uniform, upload};
+use super::timing::StageTimer;
+use crate::light::MapGrid;
+use crate::methods::exact::{sample_grid, Bvh, RAY_EPS};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use std::sync::OnceLock;
+
+pub const SOURCE: &str = include_str!("exact.wgsl");
+
+/// Loop iterations (BVH nodes visited and triangles tested) one invocation
+/// may run per dispatch; lavapipe stops an invocation after 65535.
+const BUDGET: u32 = 50_000;
+/// Samples per dispatch: BUDGET / SAMPLES_PER_CHUNK iterations a ray.
+const SAMPLES_PER_CHUNK: u32 = 4;
+
+/// `ExactParams` of exact.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct ExactParams {
+    pub rec_w: u32,
+    pub rec_h: u32,
+    pub na: u32,
+    pub nb: u32,
+    pub chunk_start: u32,
+    pub chunk_len: u32,
+    pub budget: u32,
+    pub has_tris: u32,
+    pub size_x: f32,
+    pub size_y: f32,
+    pub t0: f32,
+    pub t1: f32,
+    pub ax_rec_x: u32,
+    pub ax_rec_y: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+struct ExactPipelines {
+    cast: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+fn pipelines(device: &wgpu::Device) -> &'static ExactPipelines {
+    static P: OnceLock<ExactPipelines> = OnceLock::new();
+    P.get_or_init(|| {
+        let m = module(device, "exact.wgsl", SOURCE);
+        ExactPipelines {
+            cast: pipeline(device, &m, "exact"),
+            resolve: pipeline(device, &m, "exact_resolve"),
+        }
+    })
+}
+
+/// The buffers and parameters of the ray-casting stage.
+pub struct ExactShading {
+    params: ExactParams,
+    samples: u32,
+    nodes: wgpu::Buffer,
+    tris: wgpu::Buffer,
+    axes: wgpu::Buffer,
+    seen: wgpu::Buffer,
+    pub status: wgpu::Buffer,
+    pub vis: wgpu::Buffer,
+    pub vis_bytes: u64,
+}
+
+impl ExactShading {
+    /// Builds the BVH over the light-space triangles and uploads it.
+    pub fn new(
+        g: &Gpu,
+        grid: &MapGrid,
+        tris: Vec<[Vec3; 3]>,
+        samples: u32,
+        light_size: [f64; 2],
+    ) -> ExactShading {
+        let device = &g.device;
+        let has_tris = !tris.is_empty();
+        let bvh = Bvh::build(tris);
+        let (na, nb) = sample_grid(samples, light_size);
+        let axes: Vec<f32> = (0..grid.width)
+            .map(|i| grid.x_of(i) as f32)
+            .chain((0..grid.height).map(|j| grid.y_of(j) as f32))
+            .collect();
+        let vis_bytes = grid.len() as u64 * 4;
+        ExactShading {
+            params: ExactParams {
+                rec_w: grid.width as u32,
+                rec_h: grid.height as u32,
+                na,
+                nb,
+                budget: BUDGET,
+                has_tris: has_tris as u32,
+                size_x: light_size[0] as f32,
+                size_y: light_size[1] as f32,
+                t0: RAY_EPS,
+                t1: 1.0 - RAY_EPS,
+                ax_rec_x: 0,
+                ax_rec_y: grid.width as u32,
+                ..Default::default()
+            },
+            samples: na * nb,
+            nodes: upload(device, "bvh nodes", &bvh.node_words()),
+            tris: upload(device, "bvh triangles", &bvh.triangle_floats()),
+            axes: upload(device, "axes", &axes),
+            seen: storage(
+                device,
+                "seen samples",
+                vis_bytes,
+                wgpu::BufferUsages::COPY_DST,
+            ),
+            status: storage(
+                device,
+                "status",
+                4,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            ),
+            vis: storage(
+                device,
+                "visibility",
+                vis_bytes,
+                wgpu::BufferUsages::COPY_SRC,
+            ),
+            vis_bytes,
+        }
+    }
+
+    /// Records the pass "shadow": one dispatch per chunk of samples, then
+    /// the resolve.
+    pub fn record(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+    ) {
+        let device = &g.device;
+        let p = pipelines(device);
+        enc.clear_buffer(&self.seen, 0, None);
+        enc.clear_buffer(&self.status, 0, None);
+        let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
+        let groups = (self.params.rec_w.div_ceil(8), self.params.rec_h.div_ceil(8));
+        pass.set_pipeline(&p.cast);
+        for chunk_start in (0..self.samples).step_by(SAMPLES_PER_CHUNK as usize) {
+            let u = uniform(
+                device,
+                "exact params",
+                &ExactParams {
+                    chunk_start,
+                    chunk_len: SAMPLES_PER_CHUNK.min(self.samples - chunk_start),
+                    ..self.params
+                },
+            );
+            let refs = [
+                Some(maps),
+                Some(&self.nodes),
+                Some(&self.tris),
+                Some(&u),
+                Some(&self.axes),
+                None,
+                Some(&self.seen),
+                Some(&self.status),
+            ];
+            pass.set_bind_group(0, &bind(device, &p.cast, &refs), &[]);
+            pass.dispatch_workgroups(groups.0, groups.1, 1);
+        }
+        let u = uniform(device, "exact params", &self.params);
+        let bg = bind(
+            device,
+            &p.resolve,
+            &[
+                Some(maps),
+                None,
+                None,
+                Some(&u),
+                Some(&self.axes),
+                Some(&self.vis),
+                Some(&self.seen),
+            ],
+        );
+        pass.set_pipeline(&p.resolve);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(groups.0, groups.1, 1);
+    }
+}

@@ -1,0 +1,266 @@
+// Ray casting on the GPU: the twin of src/methods/exact.rs. One invocation
+// per receiver texel casts its chunk of the stratified light samples through
+// the BVH built on the CPU (median split), counting the samples that see the
+// light into `seen` (a gather: each invocation owns its receiver's count);
+// then a resolve divides by the sample count. The jitter is exact.rs's u64
+// hash, emulated with u32 pairs; the ray-triangle test is its Möller-Trumbore
+// written in the same order of operations (explicit cross and dot products).
+
+// Shared with Rust (`ExactParams` in exact.rs; a test compares layouts).
+struct ExactParams {
+    rec_w: u32,
+    rec_h: u32,
+    // The stratification na x nb (exact.rs's sample_grid).
+    na: u32,
+    nb: u32,
+    // Samples [chunk_start, chunk_start + chunk_len) of na * nb in this dispatch.
+    chunk_start: u32,
+    chunk_len: u32,
+    // Loop iterations an invocation may run before it gives up and raises
+    // `status` (lavapipe stops an invocation after 65535).
+    budget: u32,
+    has_tris: u32,
+    size_x: f32,
+    size_y: f32,
+    t0: f32,
+    t1: f32,
+    // Offsets in `axes`: receiver column x, receiver row y (tangent).
+    ax_rec_x: u32,
+    ax_rec_y: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+struct Node {
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+    start: u32,
+    count: u32,
+}
+
+@group(0) @binding(0) var<storage, read> maps: array<u32>;
+@group(0) @binding(1) var<storage, read> nodes: array<u32>;
+@group(0) @binding(2) var<storage, read> tris: array<f32>;
+@group(0) @binding(3) var<uniform> ep: ExactParams;
+@group(0) @binding(4) var<storage, read> axes: array<f32>;
+@group(0) @binding(5) var<storage, read_write> vis: array<f32>;
+@group(0) @binding(6) var<storage, read_write> seen: array<u32>;
+@group(0) @binding(7) var<storage, read_write> status: array<atomic<u32>>;
+
+// u64 as vec2(lo, hi).
+fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = a.x + b.x;
+    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
+}
+
+// The full 64-bit product of two u32 (16-bit halves).
+fn mul32(a: u32, b: u32) -> vec2<u32> {
+    let a0 = a & 0xffffu;
+    let a1 = a >> 16u;
+    let b0 = b & 0xffffu;
+    let b1 = b >> 16u;
+    let p00 = a0 * b0;
+    let p01 = a0 * b1;
+    let p10 = a1 * b0;
+    let p11 = a1 * b1;
+    let mid = p01 + p10;
+    let mid_carry = select(0u, 0x10000u, mid < p01);
+    let lo = p00 + (mid << 16u);
+    let hi = p11 + (mid >> 16u) + mid_carry + select(0u, 1u, lo < p00);
+    return vec2<u32>(lo, hi);
+}
+
+// Wrapping u64 product.
+fn mul64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let p = mul32(a.x, b.x);
+    return vec2<u32>(p.x, p.y + a.x * b.y + a.y * b.x);
+}
+
+// u64 >> s for 0 < s < 32.
+fn shr64(a: vec2<u32>, s: u32) -> vec2<u32> {
+    return vec2<u32>((a.x >> s) | (a.y << (32u - s)), a.y >> s);
+}
+
+// exact.rs's hash (splitmix64's finalizer).
+fn hash(x0: vec2<u32>) -> vec2<u32> {
+    var x = add64(x0, vec2<u32>(0x7F4A7C15u, 0x9E3779B9u));
+    x = mul64(x ^ shr64(x, 30u), vec2<u32>(0x1CE4E5B9u, 0xBF58476Du));
+    x = mul64(x ^ shr64(x, 27u), vec2<u32>(0x133111EBu, 0x94D049BBu));
+    return x ^ shr64(x, 31u);
+}
+
+// exact.rs's unit: the top 24 bits in [0, 1).
+fn unit(h: vec2<u32>) -> f32 {
+    return f32(h.y >> 8u) * (1.0 / 16777216.0);
+}
+
+fn node(k: u32) -> Node {
+    let b = k * 8u;
+    return Node(
+        vec3<f32>(bitcast<f32>(nodes[b]), bitcast<f32>(nodes[b + 1u]), bitcast<f32>(nodes[b + 2u])),
+        vec3<f32>(bitcast<f32>(nodes[b + 3u]), bitcast<f32>(nodes[b + 4u]), bitcast<f32>(nodes[b + 5u])),
+        nodes[b + 6u],
+        nodes[b + 7u],
+    );
+}
+
+fn vertex(t: u32, v: u32) -> vec3<f32> {
+    let b = t * 9u + v * 3u;
+    return vec3<f32>(tris[b], tris[b + 1u], tris[b + 2u]);
+}
+
+// glam's Vec3::cross and dot, operation for operation.
+fn cross3(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y);
+}
+
+fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+// exact.rs's hits: Möller-Trumbore, any hit with t in (t0, t1).
+fn hits(t: u32, o: vec3<f32>, d: vec3<f32>) -> bool {
+    let v0 = vertex(t, 0u);
+    let e1 = vertex(t, 1u) - v0;
+    let e2 = vertex(t, 2u) - v0;
+    let p = cross3(d, e2);
+    let det = dot3(e1, p);
+    if det == 0.0 || !(abs(det) < bitcast<f32>(0x7f800000u)) {
+        return false;
+    }
+    let inv = 1.0 / det;
+    let s = o - v0;
+    let u = dot3(s, p) * inv;
+    if !(u >= 0.0 && u <= 1.0) {
+        return false;
+    }
+    let q = cross3(s, e1);
+    let v = dot3(d, q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    let tt = dot3(e2, q) * inv;
+    return tt > ep.t0 && tt < ep.t1;
+}
+
+// f32::min / f32::max: the non-NaN operand wins.
+fn fmin(a: f32, b: f32) -> f32 {
+    if a != a {
+        return b;
+    }
+    if b != b {
+        return a;
+    }
+    return min(a, b);
+}
+
+fn fmax(a: f32, b: f32) -> f32 {
+    if a != a {
+        return b;
+    }
+    if b != b {
+        return a;
+    }
+    return max(a, b);
+}
+
+// Loop iterations this invocation has run (see ExactParams::budget).
+var<private> iterations: u32 = 0u;
+
+// exact.rs's Bvh::occluded: whether o + t d, t in (t0, t1), hits a triangle.
+fn occluded(o: vec3<f32>, d: vec3<f32>) -> bool {
+    let inv = vec3<f32>(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    var stack: array<u32, 64>;
+    var sp = 1u;
+    stack[0] = 0u;
+    while sp > 0u {
+        iterations += 1u;
+        if iterations > ep.budget {
+            atomicOr(&status[0], 1u);
+            return false;
+        }
+        sp -= 1u;
+        let n = node(stack[sp]);
+        let a = (n.lo - o) * inv;
+        let b = (n.hi - o) * inv;
+        let mn = vec3<f32>(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z));
+        let mx = vec3<f32>(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z));
+        let tmin = fmax(fmax(mn.x, fmax(mn.y, mn.z)), ep.t0);
+        let tmax = fmin(fmin(mx.x, fmin(mx.y, mx.z)), ep.t1);
+        if tmin > tmax {
+            continue;
+        }
+        if n.count > 0u {
+            iterations += n.count;
+            for (var k = 0u; k < n.count; k++) {
+                if hits(n.start + k, o, d) {
+                    return true;
+                }
+            }
+        } else if sp + 2u <= 64u {
+            stack[sp] = n.start;
+            stack[sp + 1u] = n.start + 1u;
+            sp += 2u;
+        }
+    }
+    return false;
+}
+
+fn receiver_point(gid: vec3<u32>) -> vec4<f32> {
+    let idx = gid.y * ep.rec_w + gid.x;
+    let z = bitcast<f32>(maps[idx]);
+    if !(z > 0.0 && z < bitcast<f32>(0x7f800000u)) {
+        return vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
+    let x = axes[ep.ax_rec_x + gid.x];
+    let y = axes[ep.ax_rec_y + gid.y];
+    return vec4<f32>(x * z, y * z, z, 1.0);
+}
+
+// Adds this dispatch's chunk of samples to each receiver's count.
+@compute @workgroup_size(8, 8)
+fn exact(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= ep.rec_w || gid.y >= ep.rec_h || ep.has_tris == 0u {
+        return;
+    }
+    let pr = receiver_point(gid);
+    if pr.w == 0.0 {
+        return;
+    }
+    let p = pr.xyz;
+    let idx = gid.y * ep.rec_w + gid.x;
+    // exact.rs's key: the texel index as a u64.
+    let key = vec2<u32>(idx, 0u);
+    var count = 0u;
+    for (var s = ep.chunk_start; s < ep.chunk_start + ep.chunk_len; s++) {
+        let sa = s % ep.na;
+        let sb = s / ep.na;
+        // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
+        let h = hash(key ^ hash(vec2<u32>(s << 1u, 0u)));
+        let x = ((f32(sa) + unit(h)) / f32(ep.na) - 0.5) * ep.size_x;
+        let y = ((f32(sb) + unit(hash(h))) / f32(ep.nb) - 0.5) * ep.size_y;
+        let d = vec3<f32>(x, y, 0.0) - p;
+        if !occluded(p, d) {
+            count += 1u;
+        }
+    }
+    seen[idx] += count;
+}
+
+@compute @workgroup_size(8, 8)
+fn exact_resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= ep.rec_w || gid.y >= ep.rec_h {
+        return;
+    }
+    let idx = gid.y * ep.rec_w + gid.x;
+    let pr = receiver_point(gid);
+    if pr.w == 0.0 {
+        vis[idx] = 1.0;
+        return;
+    }
+    if ep.has_tris == 0u {
+        vis[idx] = 1.0;
+        return;
+    }
+    vis[idx] = f32(seen[idx]) / f32(ep.na * ep.nb);
+}

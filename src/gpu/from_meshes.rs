@@ -1,0 +1,186 @@
+//! Meshes -> light-view maps -> visibility, every per-texel stage on the
+//! device: the set-up triangles go up once, the receiver map, the occluder
+//! layers (front, peeled, back), their row statistics and the method's
+//! shading run in one command buffer, and the maps and the visibility come
+//! back in one readback.
+//!
+//! On the CPU stay the f64 work WGSL cannot do: the light-space transform,
+//! the extent fit and the triangle set-up (clip, project, snap).
+
+use super::context::gpu;
+use super::dispatch::storage;
+use super::exact::ExactShading;
+use super::gather;
+use super::raster::{GpuTri, RasterInput};
+use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::shading::{check_size, Shading};
+use super::timing::StageTimer;
+use crate::error::{Error, Result};
+use crate::light::RectLight;
+use crate::mesh::MeshRef;
+use crate::methods::Method;
+use crate::pipeline::{
+    frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
+};
+use crate::raster::setup_triangles;
+
+/// The largest map side on the GPU: fixed-point coordinates ((side + 2
+/// guard bands) x 256) must fit in i32 for the shader's edge functions,
+/// texel offsets below 2^16 keep the depth plane's limb products exact, and
+/// a row's statistics (one invocation a row) stay within lavapipe's 65535
+/// loop iterations.
+pub const MAX_SIDE: usize = 1 << 14;
+
+pub fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
+    if g.0 > MAX_SIDE || g.1 > MAX_SIDE {
+        return Err(Error::too_large(
+            arg,
+            format!(
+                "{}x{} exceeds the GPU backend's largest side {MAX_SIDE}; use backend=\"cpu\"",
+                g.0, g.1
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The shading stage of a method: over occluder maps, or over triangles.
+enum Stage {
+    Maps(Shading),
+    Rays(ExactShading),
+}
+
+/// Soft shadow map from meshes on the GPU; the same result type, maps and
+/// stage names (plus the device's) as `pipeline::from_meshes`.
+pub fn from_meshes(
+    occluders: MeshRef,
+    receivers: MeshRef,
+    light: &RectLight,
+    s: &MapSettings,
+) -> Result<ShadowResult> {
+    // Map methods shade occluder maps; `exact` traces the triangles.
+    let traced = s.method.traces_triangles();
+    if !traced {
+        gather::check_method(s.method)?;
+    }
+    check_side("resolution", (s.width, s.height))?;
+    if let Some(o) = s.occluder_resolution {
+        check_side("occluder_resolution", o)?;
+    }
+    let g = gpu()?;
+    let mut sw = Stopwatch::new();
+    let FramedScene {
+        occ_ls,
+        rec_ls,
+        grid,
+        occluder_grid,
+        near,
+    } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
+    // Occluder depth layers in `maps` after the receiver's (none when traced).
+    let layers = if traced { 0 } else { s.passes };
+    let passes = layers as usize;
+    check_size(g, s.method, &grid, &occluder_grid, layers)?;
+    let rec_tris: Vec<GpuTri> = setup_triangles(&grid, &rec_ls, receivers.faces, near)
+        .iter()
+        .map(GpuTri::from_setup)
+        .collect();
+    let occ_tris: Vec<GpuTri> = if traced {
+        vec![]
+    } else {
+        setup_triangles(&occluder_grid, &occ_ls, occluders.faces, near)
+            .iter()
+            .map(GpuTri::from_setup)
+            .collect()
+    };
+    sw.lap("setup");
+    // The occluders' largest 1/depth, from their vertices in front of the near plane.
+    let w_max = occ_ls.iter().fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
+    let maps_len = grid.len() + passes * occluder_grid.len();
+    let out = with_error_scopes(g, || {
+        let shading = match s.method {
+            Method::Exact { samples } => {
+                let t = light_space_triangles(&occ_ls, occluders.faces);
+                Stage::Rays(ExactShading::new(g, &grid, t, samples, light.size))
+            }
+            _ => Stage::Maps(Shading::new(
+                g,
+                s.method,
+                &grid,
+                &occluder_grid,
+                light.size,
+                layers,
+                w_max,
+            )),
+        };
+        let maps = storage(
+            &g.device,
+            "maps",
+            maps_len as u64 * 4,
+            wgpu::BufferUsages::COPY_SRC,
+        );
+        let tris = RasterInput::upload(g, &rec_tris, &occ_tris);
+        sw.lap("upload");
+        let timer = StageTimer::new(g, 4);
+        let mut enc = g
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("softshadow"),
+            });
+        tris.record(g, &mut enc, &timer, &maps, &grid, &occluder_grid, layers);
+        let mut sources = vec![(&maps, maps_len as u64 * 4)];
+        match &shading {
+            Stage::Maps(sh) => {
+                sh.record(g, &mut enc, &timer, &maps)?;
+                sources.push((&sh.vis, sh.vis_bytes));
+            }
+            Stage::Rays(sh) => {
+                sh.record(g, &mut enc, &timer, &maps);
+                sources.push((&sh.vis, sh.vis_bytes));
+                sources.push((&sh.status, 4));
+            }
+        }
+        submit_and_read(g, enc, &timer, &sources, &mut sw)
+    })?;
+    if out.buffers.get(2).is_some_and(|b| words(b)[0] != 0) {
+        return Err(Error::gpu(
+            "a ray visited more BVH nodes than one invocation may (lavapipe stops an \
+             invocation after 65535 loop iterations); use backend=\"cpu\" for this scene",
+        ));
+    }
+    let maps = words(&out.buffers[0]);
+    let visibility = visibility(&out.buffers[1])?;
+    let mut timings = sw.timings;
+    timings.extend(out.device_timings);
+    let rec_len = grid.len();
+    let occ_len = occluder_grid.len();
+    let map_of = |k: usize, empty_zero: bool| -> Vec<f32> {
+        let off = rec_len + k * occ_len;
+        maps[off..off + occ_len]
+            .iter()
+            .map(|&b| {
+                if empty_zero && b == 0 {
+                    f32::INFINITY
+                } else {
+                    f32::from_bits(b)
+                }
+            })
+            .collect()
+    };
+    let receiver: Vec<f32> = maps[..rec_len].iter().map(|&b| f32::from_bits(b)).collect();
+    let front = (!traced).then(|| map_of(0, false));
+    let middle: Vec<Vec<f32>> = (1..passes.saturating_sub(1))
+        .map(|k| map_of(k, false))
+        .collect();
+    // The farthest layer starts at 0 (before the atomicMax): 0 means empty.
+    let back = (passes >= 2).then(|| map_of(passes - 1, true));
+    Ok(ShadowResult {
+        grid,
+        occluder_grid,
+        visibility,
+        receiver,
+        occluder_front: front,
+        occluder_middle: middle,
+        occluder_back: back,
+        timings,
+    })
+}

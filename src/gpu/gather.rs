@@ -1,0 +1,297 @@
+//! The occluder-map methods on the GPU: per-row statistics of the occluder
+//! layers (`row_stats`), then one invocation per receiver texel gathering the
+//! micro-patches in reach (`gather.wgsl` + the method's file). The CPU twins
+//! are `methods/gather.rs` with `methods/ssm.rs` and `methods/bitmask.rs`.
+
+use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
+use crate::error::{Error, Result};
+use crate::light::MapGrid;
+use crate::methods::ssm::Precision;
+use crate::methods::Method;
+use bytemuck::{Pod, Zeroable};
+use std::sync::OnceLock;
+
+pub const GATHER_SOURCE: &str = include_str!("gather.wgsl");
+pub const SSM_SOURCE: &str = include_str!("ssm.wgsl");
+pub const BITMASK_SOURCE: &str = include_str!("bitmask.wgsl");
+
+/// The WGSL of the module that runs `method`: the shared gather part and the
+/// method's own file.
+pub fn module_source(method_source: &str) -> String {
+    format!("{GATHER_SOURCE}\n{method_source}")
+}
+
+/// `GatherParams` of gather.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct GatherParams {
+    pub rec_w: u32,
+    pub rec_h: u32,
+    pub occ_w: u32,
+    pub occ_h: u32,
+    pub n_layers: u32,
+    pub layer0_offset: u32,
+    pub layer_stride: u32,
+    pub ax_rec_x: u32,
+    pub ax_rec_y: u32,
+    pub ax_col_x0s: u32,
+    pub ax_row_y: u32,
+    pub samples: u32,
+    pub tx: f32,
+    pub ty: f32,
+    pub hw: f32,
+    pub hh: f32,
+    pub inv_half_lx: f32,
+    pub inv_half_ly: f32,
+    pub half_lx: f32,
+    pub half_ly: f32,
+    pub wx: f32,
+    pub rows_per_chunk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// `ChunkParams` of gather.wgsl: which layer and chunk of rows a dispatch adds.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct ChunkParams {
+    pub layer: u32,
+    pub chunk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// Loop iterations we let one invocation run per dispatch: half of lavapipe's
+/// limit of 65535 (llvmpipe's loop limiter counts every iteration of every
+/// loop of an invocation), leaving room for the loops around the texel loop.
+const ITERATION_BUDGET: usize = 32768;
+
+/// How the rows in reach are cut into chunks: rows per chunk and the number
+/// of chunks that covers any receiver's rows. `w_max` bounds the occluders'
+/// 1/depth (from their vertices: 1/Z is linear over a triangle, so its
+/// largest value is at a vertex), which bounds how far a micro-patch reaches.
+pub fn chunking(og: &MapGrid, light_size: [f64; 2], w_max: f64, method: Method) -> (u32, u32) {
+    let (hw, hh) = og.half_texel();
+    // Texels in reach along a row (rows in reach along a column): a patch
+    // reaches half_texel + (L/2) w_max in tangent units, and the rounding of
+    // both ends adds up to 3 texels.
+    let reach = |half_texel: f64, light: f64, n: usize| -> usize {
+        let t = (1.0 + 0.5 * light * w_max / half_texel).ceil() + 3.0;
+        if t.is_finite() {
+            (t as usize).min(n)
+        } else {
+            n
+        }
+    };
+    let cols = reach(hw, light_size[0], og.width);
+    let rows = reach(hh, light_size[1], og.height);
+    // The bitmask's 8-word loop per texel, in case the compiler keeps it a loop.
+    let per_texel = match method {
+        Method::Bitmask { .. } => 9,
+        _ => 1,
+    };
+    let rows_per_chunk = (ITERATION_BUDGET / (cols * per_texel + 2)).max(1);
+    (rows_per_chunk as u32, rows.div_ceil(rows_per_chunk) as u32)
+}
+
+/// `RowSpan` of gather.wgsl (written by the GPU; 16 bytes a row).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct RowSpan {
+    pub w_max: f32,
+    pub first: u32,
+    pub last: u32,
+    pub _pad: u32,
+}
+
+struct MethodPipelines {
+    row_stats: wgpu::ComputePipeline,
+    /// Adds one chunk of one layer to the accumulators.
+    chunk: wgpu::ComputePipeline,
+    /// Accumulators -> visibility.
+    resolve: wgpu::ComputePipeline,
+}
+
+/// The methods that run on occluder maps, and the error for the others
+/// (`exact` traces triangles: `exact.rs`, never through here).
+/// The GPU kernels have neither the occluder hierarchy nor the other
+/// precisions of the CPU's ssm (its one-level f32 sum is the CPU's
+/// two-level one up to rounding).
+fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
+    let no_hierarchy = || {
+        Error::invalid(
+            "hierarchy",
+            "the GPU backend has no occluder hierarchy yet; use backend=\"cpu\"",
+        )
+    };
+    match method {
+        Method::Ssm {
+            hierarchy: true, ..
+        }
+        | Method::Bitmask {
+            hierarchy: true, ..
+        } => Err(no_hierarchy()),
+        Method::Ssm {
+            precision: Precision::F32,
+            ..
+        } => Ok(("ssm", SSM_SOURCE)),
+        Method::Ssm { precision, .. } => Err(Error::invalid(
+            "precision",
+            format!("the GPU backend sums in f32 only, got {precision:?}; use backend=\"cpu\""),
+        )),
+        Method::Bitmask { .. } => Ok(("bitmask", BITMASK_SOURCE)),
+        Method::Exact { .. } => Err(Error::invalid(
+            "method",
+            format!(
+                "{:?} does not shade occluder maps (GPU map methods: \"ssm\", \"bitmask\")",
+                method.name()
+            ),
+        )),
+    }
+}
+
+/// Refuses a method the GPU cannot run, before any GPU work.
+pub fn check_method(method: Method) -> Result<()> {
+    method_source(method).map(|_| ())
+}
+
+fn pipelines(device: &wgpu::Device, method: Method) -> Result<&'static MethodPipelines> {
+    static SSM: OnceLock<MethodPipelines> = OnceLock::new();
+    static BITMASK: OnceLock<MethodPipelines> = OnceLock::new();
+    let (name, source) = method_source(method)?;
+    let cell = match method {
+        Method::Ssm { .. } => &SSM,
+        Method::Bitmask { .. } => &BITMASK,
+        Method::Exact { .. } => unreachable!("method_source refused it"),
+    };
+    Ok(cell.get_or_init(|| {
+        let m = module(device, name, &module_source(source));
+        MethodPipelines {
+            row_stats: pipeline(device, &m, "row_stats"),
+            chunk: pipeline(device, &m, name),
+            resolve: pipeline(device, &m, &format!("{name}_resolve")),
+        }
+    }))
+}
+
+/// The buffers a gather stage reads and writes.
+pub struct GatherBuffers<'a> {
+    pub maps: &'a wgpu::Buffer,
+    pub rows: &'a wgpu::Buffer,
+    pub layer_w_max: &'a wgpu::Buffer,
+    pub axes: &'a wgpu::Buffer,
+    pub vis: &'a wgpu::Buffer,
+    /// The bitmask method's rank tables (None for the others).
+    pub tables: Option<&'a wgpu::Buffer>,
+    /// Per-receiver accumulators, zeroed (`accumulator_words` u32 a receiver).
+    pub acc: &'a wgpu::Buffer,
+}
+
+/// u32 words of accumulator per receiver texel: a sum per layer (ssm), or
+/// one 256-bit mask (bitmask).
+pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
+    match method {
+        Method::Bitmask { .. } => 8,
+        _ => n_layers,
+    }
+}
+
+/// The method's constant tables, as the shader reads them (bitmask's rank
+/// tables), or None.
+pub fn method_tables(method: Method) -> Option<Vec<u32>> {
+    match method {
+        Method::Bitmask { samples, .. } => {
+            Some(crate::methods::bitmask::Bitmask::new(samples, None).rank_tables())
+        }
+        _ => None,
+    }
+}
+
+/// Records the row statistics pass body.
+pub fn record_row_stats(
+    device: &wgpu::Device,
+    pass: &mut wgpu::ComputePass,
+    method: Method,
+    b: &GatherBuffers,
+    params: &GatherParams,
+) -> Result<()> {
+    let p = pipelines(device, method)?;
+    let u = uniform(device, "gather params", params);
+    let bg = bind(
+        device,
+        &p.row_stats,
+        &[Some(b.maps), Some(b.rows), Some(b.layer_w_max), Some(&u)],
+    );
+    pass.set_pipeline(&p.row_stats);
+    pass.set_bind_group(0, &bg, &[]);
+    let (x, y) = groups_1d(params.n_layers * params.occ_h, 64);
+    debug_assert_eq!(y, 1, "rows x layers stay below 65535 x 64");
+    pass.dispatch_workgroups(x, y, 1);
+    Ok(())
+}
+
+/// Records the shading pass body: for every layer and chunk of rows, one
+/// dispatch adding it to the accumulators (one invocation per receiver
+/// texel), then the resolve into visibility.
+pub fn record_shade(
+    device: &wgpu::Device,
+    pass: &mut wgpu::ComputePass,
+    method: Method,
+    b: &GatherBuffers,
+    params: &GatherParams,
+    chunks: u32,
+) -> Result<()> {
+    let p = pipelines(device, method)?;
+    let u = uniform(device, "gather params", params);
+    let groups = (params.rec_w.div_ceil(8), params.rec_h.div_ceil(8));
+    pass.set_pipeline(&p.chunk);
+    for layer in 0..params.n_layers {
+        for chunk in 0..chunks {
+            let c = uniform(
+                device,
+                "chunk params",
+                &ChunkParams {
+                    layer,
+                    chunk,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            );
+            let bg = bind(
+                device,
+                &p.chunk,
+                &[
+                    Some(b.maps),
+                    Some(b.rows),
+                    Some(b.layer_w_max),
+                    Some(&u),
+                    Some(b.axes),
+                    None,
+                    b.tables,
+                    Some(b.acc),
+                    Some(&c),
+                ],
+            );
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(groups.0, groups.1, 1);
+        }
+    }
+    let bg = bind(
+        device,
+        &p.resolve,
+        &[
+            Some(b.maps),
+            None,
+            None,
+            Some(&u),
+            Some(b.axes),
+            Some(b.vis),
+            None,
+            Some(b.acc),
+        ],
+    );
+    pass.set_pipeline(&p.resolve);
+    pass.set_bind_group(0, &bg, &[]);
+    pass.dispatch_workgroups(groups.0, groups.1, 1);
+    Ok(())
+}

@@ -1,0 +1,214 @@
+// The gather traversal on the GPU, shared by the occluder-map methods (the
+// method's file is appended to this one): one invocation per receiver texel
+// loops over the occluder texels that can reach it, like src/methods/gather.rs
+// does for groups of 64 receivers. A gather, not a scatter: each invocation
+// owns its receiver's sum (or mask), so it accumulates with no atomics. A
+// scatter (one invocation per occluder texel adding into the receivers it
+// reaches) would need float atomic adds, which WGSL lacks, and its sums would
+// depend on the scheduling order.
+//
+// The work is cut into chunks: one dispatch per (layer, chunk of occluder
+// rows), each invocation adding its chunk to its receiver's accumulator in
+// `acc`, then a resolve dispatch turning accumulators into visibility. This
+// bounds the loop iterations of an invocation (lavapipe stops an invocation
+// after 65535 in all; real GPUs reset long-running dispatches) whatever the
+// penumbra's size in texels.
+
+// Shared with Rust (`GatherParams` in gather.rs; a test compares layouts).
+struct GatherParams {
+    rec_w: u32,
+    rec_h: u32,
+    occ_w: u32,
+    occ_h: u32,
+    n_layers: u32,
+    // Layer k of the occluder maps starts at layer0_offset + k * layer_stride
+    // in `maps` (the receiver map is at 0).
+    layer0_offset: u32,
+    layer_stride: u32,
+    // Offsets in `axes`: receiver column x, receiver row y (tangent), occluder
+    // column left edge in half-light units (2 x0 / Lx), occluder row center y.
+    ax_rec_x: u32,
+    ax_rec_y: u32,
+    ax_col_x0s: u32,
+    ax_row_y: u32,
+    // Light samples (bitmask).
+    samples: u32,
+    // The occluder grid: tangent half-extents and half texel sizes.
+    tx: f32,
+    ty: f32,
+    hw: f32,
+    hh: f32,
+    inv_half_lx: f32,
+    inv_half_ly: f32,
+    half_lx: f32,
+    half_ly: f32,
+    // Texel width in half-light units.
+    wx: f32,
+    // Occluder rows per chunk (of a receiver's rows in reach).
+    rows_per_chunk: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// Which chunk a dispatch adds. Shared with Rust (`ChunkParams` in gather.rs).
+struct ChunkParams {
+    layer: u32,
+    chunk: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// One occluder row: its nearest 1/depth and occupied columns [first, last).
+// Shared with Rust (`RowSpan` in gather.rs).
+struct RowSpan {
+    w_max: f32,
+    first: u32,
+    last: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<storage, read> maps: array<u32>;
+@group(0) @binding(1) var<storage, read_write> rows: array<RowSpan>;
+@group(0) @binding(2) var<storage, read_write> layer_w_max: array<atomic<u32>>;
+@group(0) @binding(3) var<uniform> gp: GatherParams;
+@group(0) @binding(4) var<storage, read> axes: array<f32>;
+@group(0) @binding(5) var<storage, read_write> vis: array<f32>;
+// Per-receiver accumulators (the method's layout), zeroed before the chunks.
+@group(0) @binding(7) var<storage, read_write> acc: array<u32>;
+@group(0) @binding(8) var<uniform> chunk: ChunkParams;
+
+// 1/depth of a map texel, 0 where empty (+inf, or 0 bits: a farthest layer
+// never written), as gather.rs's Layer::new.
+fn inv_depth(bits: u32) -> f32 {
+    let z = bitcast<f32>(bits);
+    if z > 0.0 && z < bitcast<f32>(0x7f800000u) {
+        return 1.0 / z;
+    }
+    return 0.0;
+}
+
+fn row_coord(y: f32) -> f32 {
+    return (1.0 - y / gp.ty) * 0.5 * f32(gp.occ_h) - 0.5;
+}
+
+fn col_coord(x: f32) -> f32 {
+    return (x / gp.tx + 1.0) * 0.5 * f32(gp.occ_w) - 0.5;
+}
+
+// floor/ceil of a texel coordinate clamped to [lo, hi] before the conversion
+// (an unbounded float does not convert to i32 portably).
+fn clamp_index(c: f32, lo: i32, hi: i32) -> i32 {
+    return i32(clamp(c, f32(lo), f32(hi)));
+}
+
+// Per occluder row: nearest 1/depth and occupied columns; per layer, the
+// nearest 1/depth of all (atomicMax on the bits of a positive float).
+@compute @workgroup_size(64)
+fn row_stats(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let n = gid.x;
+    if n >= gp.n_layers * gp.occ_h {
+        return;
+    }
+    let layer = n / gp.occ_h;
+    let j = n % gp.occ_h;
+    let base = gp.layer0_offset + layer * gp.layer_stride + j * gp.occ_w;
+    var span = RowSpan(0.0, 0u, 0u, 0u);
+    var found = false;
+    for (var i = 0u; i < gp.occ_w; i++) {
+        let w = inv_depth(maps[base + i]);
+        if w > 0.0 {
+            if !found {
+                span.first = i;
+                found = true;
+            }
+            span.last = i + 1u;
+            span.w_max = max(span.w_max, w);
+        }
+    }
+    rows[n] = span;
+    atomicMax(&layer_w_max[layer], bitcast<u32>(span.w_max));
+}
+
+// A receiver texel: its index, tangent position, 1/depth; ok = false where
+// there is no receiver.
+struct Receiver {
+    ok: bool,
+    idx: u32,
+    xr: f32,
+    yr: f32,
+    wr: f32,
+}
+
+fn receiver(gid: vec3<u32>) -> Receiver {
+    var r = Receiver(false, 0u, 0.0, 0.0, 0.0);
+    if gid.x >= gp.rec_w || gid.y >= gp.rec_h {
+        return r;
+    }
+    r.idx = gid.y * gp.rec_w + gid.x;
+    let zr = bitcast<f32>(maps[r.idx]);
+    if !(zr > 0.0 && zr < bitcast<f32>(0x7f800000u)) {
+        return r;
+    }
+    r.ok = true;
+    r.wr = 1.0 / zr;
+    r.xr = axes[gp.ax_rec_x + gid.x];
+    r.yr = axes[gp.ax_rec_y + gid.y];
+    return r;
+}
+
+// What one occluder row offers a receiver: the columns in reach and the row's
+// y-interval relative to the receiver in half-light units, [-nay0, ay1].
+struct RowReach {
+    ok: bool,
+    i_lo: u32,
+    i_hi: u32,
+    nay0: f32,
+    ay1: f32,
+}
+
+fn row_reach(layer: u32, j: u32, xr: f32, yr: f32, wr: f32) -> RowReach {
+    var r = RowReach(false, 0u, 0u, 0.0, 0.0);
+    let span = rows[layer * gp.occ_h + j];
+    if span.first >= span.last || span.w_max <= wr {
+        return r;
+    }
+    let dw = span.w_max - wr;
+    let yc = axes[gp.ax_row_y + j];
+    let dy = max(max(yr - yc, yc - yr), 0.0);
+    if dy >= gp.hh + gp.half_ly * dw {
+        return r;
+    }
+    let reach_x = gp.hw + gp.half_lx * dw;
+    let w_i = i32(gp.occ_w);
+    let i_lo = max(clamp_index(floor(col_coord(xr - reach_x)), -1, w_i), i32(span.first));
+    let i_hi = min(clamp_index(ceil(col_coord(xr + reach_x)), -1, w_i) + 1, i32(span.last));
+    if i_lo >= i_hi {
+        return r;
+    }
+    r.ok = true;
+    r.i_lo = u32(i_lo);
+    r.i_hi = u32(i_hi);
+    r.nay0 = (yr - (yc - gp.hh)) * gp.inv_half_ly;
+    r.ay1 = (yc + gp.hh - yr) * gp.inv_half_ly;
+    return r;
+}
+
+// The occluder rows of this dispatch's chunk that a receiver at (yr, wr) can
+// see in this dispatch's layer: [x, y], empty when x > y. The rows in reach
+// are those of gather.rs's add_layer, the chunk a slice of rows_per_chunk.
+fn chunk_rows(yr: f32, wr: f32) -> vec2<i32> {
+    let w_max = bitcast<f32>(atomicLoad(&layer_w_max[chunk.layer]));
+    if w_max <= wr {
+        return vec2<i32>(1, 0);
+    }
+    let reach_y = gp.hh + gp.half_ly * (w_max - wr);
+    let last = i32(gp.occ_h) - 1;
+    let j_lo = clamp_index(floor(row_coord(yr + reach_y)), 0, last);
+    let j_hi = clamp_index(ceil(row_coord(yr - reach_y)), 0, last);
+    let start = j_lo + i32(chunk.chunk * gp.rows_per_chunk);
+    return vec2<i32>(start, min(j_hi, start + i32(gp.rows_per_chunk) - 1));
+}
+
+fn layer_offset(layer: u32) -> u32 {
+    return gp.layer0_offset + layer * gp.layer_stride;
+}

@@ -1,0 +1,48 @@
+//! The wgpu backend (cargo feature `gpu`): the mesh pipeline with every
+//! per-texel stage as a WGSL compute shader. Each `.wgsl` file sits beside
+//! the Rust module that drives it and has a CPU twin that reads the same way:
+//!
+//! * `raster.wgsl` (`raster.rs`): triangles into depth layers; twin
+//!   `crate::raster` (same fixed-point coverage, same f32 depth plane).
+//! * `gather.wgsl` + `ssm.wgsl` (`gather.rs`): row statistics and the
+//!   published soft shadow map; twin `crate::methods::{gather, ssm}`.
+//! * `gather.wgsl` + `bitmask.wgsl` (`gather.rs`): the bitmask method; twin
+//!   `crate::methods::bitmask`.
+//! * `exact.wgsl` (`exact.rs`): ray casting through the CPU-built BVH; twin
+//!   `crate::methods::exact`.
+//!
+//! Entry points: `from_meshes` (the whole mesh pipeline) and `from_depth`
+//! (the user's depth maps, shaded). Device, queue and pipelines are made once
+//! per process (`context.rs`).
+
+mod context;
+#[cfg(test)]
+mod device_tests;
+mod dispatch;
+mod exact;
+mod from_depth;
+mod from_meshes;
+mod gather;
+mod raster;
+mod readback;
+#[cfg(test)]
+mod shader_tests;
+mod shading;
+mod timing;
+
+pub use context::{GpuInfo, ENV_SWITCH};
+pub use from_depth::from_depth;
+pub use from_meshes::{from_meshes, MAX_SIDE};
+
+use crate::error::Result;
+
+/// The adapter the GPU backend uses, opening it if needed;
+/// `Error::GpuUnavailable` when there is none.
+pub fn info() -> Result<GpuInfo> {
+    context::gpu().map(|g| g.info.clone())
+}
+
+/// Whether `backend="gpu"` can run here (an adapter opens, software or not).
+pub fn available() -> bool {
+    context::gpu().is_ok()
+}

@@ -1,0 +1,228 @@
+//! Checks that need no device: every WGSL module parses and validates with
+//! naga (what wgpu runs on it), and every parameter struct shared by Rust and
+//! WGSL has the same member offsets and sizes on both sides.
+
+use super::exact::{ExactParams, SOURCE as EXACT_SOURCE};
+use super::gather::{
+    module_source, ChunkParams, GatherParams, RowSpan, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
+};
+use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
+use std::mem::{offset_of, size_of};
+
+/// Every shader module the backend builds, by name.
+fn modules() -> Vec<(&'static str, String)> {
+    vec![
+        ("raster.wgsl", RASTER_SOURCE.to_string()),
+        ("gather.wgsl + ssm.wgsl", module_source(SSM_SOURCE)),
+        ("gather.wgsl + bitmask.wgsl", module_source(BITMASK_SOURCE)),
+        ("exact.wgsl", EXACT_SOURCE.to_string()),
+    ]
+}
+
+fn parse(name: &str, src: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(src)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)))
+}
+
+#[test]
+fn every_wgsl_file_is_used_by_a_module() {
+    // Files on disk beside this module: each must be part of a checked module.
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/gpu");
+    let sources = [
+        RASTER_SOURCE,
+        GATHER_SOURCE,
+        SSM_SOURCE,
+        BITMASK_SOURCE,
+        EXACT_SOURCE,
+    ];
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "wgsl") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(sources.contains(&text.as_str()), "{path:?} is not checked");
+        }
+    }
+}
+
+#[test]
+fn every_wgsl_module_parses_and_validates() {
+    for (name, src) in modules() {
+        let module = parse(name, &src);
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+    }
+}
+
+/// (member name, offset, size) of WGSL struct `name` in `module`, and its size.
+fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32, u32)>, u32) {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                let m = members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap(), m.offset, layouter[m.ty].size))
+                    .collect();
+                return (m, *span);
+            }
+        }
+    }
+    panic!("struct {name} not found");
+}
+
+/// Rust's (member name, offset, size) for a #[repr(C)] struct.
+macro_rules! rust_layout {
+    ($t:ty { $($f:ident),* $(,)? }) => {{
+        let v: Vec<(String, u32, u32)> = vec![$((
+            stringify!($f).to_string(),
+            offset_of!($t, $f) as u32,
+            {
+                // Size of the field's type, from a zeroed value.
+                let z: $t = bytemuck::Zeroable::zeroed();
+                std::mem::size_of_val(&z.$f) as u32
+            },
+        )),*];
+        (v, size_of::<$t>() as u32)
+    }};
+}
+
+fn assert_same(wgsl_src: &str, name: &str, rust: (Vec<(String, u32, u32)>, u32)) {
+    let module = parse(name, wgsl_src);
+    let wgsl = wgsl_layout(&module, name);
+    assert_eq!(
+        wgsl, rust,
+        "{name}: WGSL (left) and Rust (right) layouts differ"
+    );
+}
+
+#[test]
+fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
+    assert_same(
+        RASTER_SOURCE,
+        "RasterParams",
+        rust_layout!(RasterParams {
+            tile_count,
+            width,
+            height,
+            out_offset,
+            far_offset,
+            prev_offset,
+            peel_factor,
+            _pad
+        }),
+    );
+    assert_same(
+        RASTER_SOURCE,
+        "Tri",
+        rust_layout!(GpuTri {
+            x,
+            y,
+            i0,
+            i1,
+            j0,
+            j1,
+            w_ref,
+            gx,
+            gy
+        }),
+    );
+    assert_same(
+        RASTER_SOURCE,
+        "Tile",
+        rust_layout!(RasterTile {
+            tri,
+            i0,
+            i1,
+            j0,
+            j1
+        }),
+    );
+    assert_same(
+        RASTER_SOURCE,
+        "FillParams",
+        rust_layout!(FillParams {
+            offset,
+            len,
+            value,
+            _pad
+        }),
+    );
+    let gather = module_source(SSM_SOURCE);
+    assert_same(
+        &gather,
+        "GatherParams",
+        rust_layout!(GatherParams {
+            rec_w,
+            rec_h,
+            occ_w,
+            occ_h,
+            n_layers,
+            layer0_offset,
+            layer_stride,
+            ax_rec_x,
+            ax_rec_y,
+            ax_col_x0s,
+            ax_row_y,
+            samples,
+            tx,
+            ty,
+            hw,
+            hh,
+            inv_half_lx,
+            inv_half_ly,
+            half_lx,
+            half_ly,
+            wx,
+            rows_per_chunk,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        &gather,
+        "ChunkParams",
+        rust_layout!(ChunkParams {
+            layer,
+            chunk,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        &gather,
+        "RowSpan",
+        rust_layout!(RowSpan {
+            w_max,
+            first,
+            last,
+            _pad
+        }),
+    );
+    assert_same(
+        EXACT_SOURCE,
+        "ExactParams",
+        rust_layout!(ExactParams {
+            rec_w,
+            rec_h,
+            na,
+            nb,
+            chunk_start,
+            chunk_len,
+            budget,
+            has_tris,
+            size_x,
+            size_y,
+            t0,
+            t1,
+            ax_rec_x,
+            ax_rec_y,
+            _pad0,
+            _pad1
+        }),
+    );
+}

@@ -1,0 +1,192 @@
+//! The shading stage on the GPU, shared by both entry points (meshes, depth
+//! maps): from occluder and receiver maps already in a `maps` buffer
+//! (receiver at 0, then the occluder layers) to the visibility, in two passes
+//! ("row_stats", "shadow").
+
+use super::context::Gpu;
+use super::dispatch::{storage, upload};
+use super::gather::{self, GatherBuffers, GatherParams};
+use super::timing::StageTimer;
+use crate::error::{Error, Result};
+use crate::light::MapGrid;
+use crate::methods::Method;
+
+/// Refuses maps (and accumulators) that do not fit one buffer binding, or
+/// offsets beyond u32.
+pub fn check_size(
+    g: &Gpu,
+    method: Method,
+    grid: &MapGrid,
+    og: &MapGrid,
+    n_layers: u32,
+) -> Result<()> {
+    let texels = grid.len() as u64 + n_layers as u64 * og.len() as u64;
+    // The accumulators: a sum per layer (ssm) or a 256-bit mask (bitmask) per receiver.
+    let acc = gather::accumulator_words(method, n_layers) as u64 * grid.len() as u64;
+    let bytes = 4 * texels.max(acc);
+    if texels >= u32::MAX as u64 || bytes > g.max_storage_binding {
+        return Err(Error::too_large(
+            "resolution",
+            format!(
+                "the maps need {bytes} bytes in one GPU buffer; the device binds at most {}",
+                g.max_storage_binding
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Tangent coordinates the shaders read, computed in f64 like the CPU
+/// kernels' tables (so both sides start from the same f32 values), and
+/// their offsets.
+fn axes(grid: &MapGrid, og: &MapGrid, light_size: [f64; 2], p: &mut GatherParams) -> Vec<f32> {
+    let (hw, _) = og.half_texel();
+    let mut data = Vec::new();
+    p.ax_rec_x = data.len() as u32;
+    data.extend((0..grid.width).map(|i| grid.x_of(i) as f32));
+    p.ax_rec_y = data.len() as u32;
+    data.extend((0..grid.height).map(|j| grid.y_of(j) as f32));
+    p.ax_col_x0s = data.len() as u32;
+    data.extend((0..og.width).map(|i| ((og.x_of(i) - hw) * 2.0 / light_size[0]) as f32));
+    p.ax_row_y = data.len() as u32;
+    data.extend((0..og.height).map(|j| og.y_of(j) as f32));
+    data
+}
+
+fn gather_params(
+    grid: &MapGrid,
+    og: &MapGrid,
+    light_size: [f64; 2],
+    n_layers: u32,
+    method: Method,
+) -> GatherParams {
+    let (hw, hh) = og.half_texel();
+    // The same f32 values as methods/gather.rs's Kernel::new.
+    let inv_half_lx = (2.0 / light_size[0]) as f32;
+    GatherParams {
+        rec_w: grid.width as u32,
+        rec_h: grid.height as u32,
+        occ_w: og.width as u32,
+        occ_h: og.height as u32,
+        n_layers,
+        layer0_offset: grid.len() as u32,
+        layer_stride: og.len() as u32,
+        samples: match method {
+            Method::Bitmask { samples, .. } => samples,
+            _ => 0,
+        },
+        tx: og.tx as f32,
+        ty: og.ty as f32,
+        hw: hw as f32,
+        hh: hh as f32,
+        inv_half_lx,
+        inv_half_ly: (2.0 / light_size[1]) as f32,
+        half_lx: (0.5 * light_size[0]) as f32,
+        half_ly: (0.5 * light_size[1]) as f32,
+        wx: 2.0 * hw as f32 * inv_half_lx,
+        ..Default::default()
+    }
+}
+
+/// The buffers and parameters of the shading stage.
+pub struct Shading {
+    method: Method,
+    params: GatherParams,
+    chunks: u32,
+    rows: wgpu::Buffer,
+    layer_w_max: wgpu::Buffer,
+    acc: wgpu::Buffer,
+    axes: wgpu::Buffer,
+    tables: Option<wgpu::Buffer>,
+    pub vis: wgpu::Buffer,
+    pub vis_bytes: u64,
+}
+
+impl Shading {
+    /// Uploads the axes (and the method's tables) and makes the buffers.
+    /// `w_max` bounds the occluders' 1/depth (it sets the chunking).
+    pub fn new(
+        g: &Gpu,
+        method: Method,
+        grid: &MapGrid,
+        og: &MapGrid,
+        light_size: [f64; 2],
+        n_layers: u32,
+        w_max: f64,
+    ) -> Shading {
+        let device = &g.device;
+        let mut params = gather_params(grid, og, light_size, n_layers, method);
+        let ax = axes(grid, og, light_size, &mut params);
+        let (rows_per_chunk, chunks) = gather::chunking(og, light_size, w_max, method);
+        params.rows_per_chunk = rows_per_chunk;
+        let acc_words = gather::accumulator_words(method, n_layers) as u64 * grid.len() as u64;
+        let vis_bytes = grid.len() as u64 * 4;
+        Shading {
+            method,
+            params,
+            chunks,
+            rows: storage(
+                device,
+                "row spans",
+                n_layers as u64 * og.height as u64 * 16,
+                wgpu::BufferUsages::empty(),
+            ),
+            layer_w_max: storage(
+                device,
+                "layer w max",
+                n_layers as u64 * 4,
+                wgpu::BufferUsages::COPY_DST,
+            ),
+            acc: storage(
+                device,
+                "accumulators",
+                acc_words * 4,
+                wgpu::BufferUsages::COPY_DST,
+            ),
+            axes: upload(device, "axes", &ax),
+            tables: gather::method_tables(method).map(|t| upload(device, "method tables", &t)),
+            vis: storage(
+                device,
+                "visibility",
+                vis_bytes,
+                wgpu::BufferUsages::COPY_SRC,
+            ),
+            vis_bytes,
+        }
+    }
+
+    /// Records the passes "row_stats" and "shadow" reading `maps`.
+    pub fn record(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+    ) -> Result<()> {
+        let device = &g.device;
+        enc.clear_buffer(&self.layer_w_max, 0, None);
+        enc.clear_buffer(&self.acc, 0, None);
+        let b = GatherBuffers {
+            maps,
+            rows: &self.rows,
+            layer_w_max: &self.layer_w_max,
+            axes: &self.axes,
+            vis: &self.vis,
+            tables: self.tables.as_ref(),
+            acc: &self.acc,
+        };
+        {
+            let mut pass = enc.begin_compute_pass(&timer.pass("row_stats"));
+            gather::record_row_stats(device, &mut pass, self.method, &b, &self.params)?;
+        }
+        let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
+        gather::record_shade(
+            device,
+            &mut pass,
+            self.method,
+            &b,
+            &self.params,
+            self.chunks,
+        )
+    }
+}

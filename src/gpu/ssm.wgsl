@@ -1,0 +1,64 @@
+// The published soft shadow map on the GPU (appended to gather.wgsl): the
+// arithmetic of Sum::add_texel in src/methods/ssm.rs, per receiver texel.
+// `acc` holds one f32 sum (as bits) per layer and receiver: layer * W * H + idx.
+
+// ssm.rs's D2_MIN: keeps 0/0 away where occluder and receiver share a depth.
+const D2_MIN: f32 = 1e-36;
+
+// Adds this dispatch's chunk of rows of its layer to every receiver's sum.
+@compute @workgroup_size(8, 8)
+fn ssm(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let rc = receiver(gid);
+    if !rc.ok {
+        return;
+    }
+    let slot = chunk.layer * gp.rec_w * gp.rec_h + rc.idx;
+    var sum = bitcast<f32>(acc[slot]);
+    // Contributions are >= 0 and the occlusion is clamped: 4 is final.
+    if sum >= 4.0 {
+        return;
+    }
+    let xr_s = rc.xr * gp.inv_half_lx;
+    let js = chunk_rows(rc.yr, rc.wr);
+    let base = layer_offset(chunk.layer);
+    for (var j = js.x; j <= js.y; j++) {
+        let r = row_reach(chunk.layer, u32(j), rc.xr, rc.yr, rc.wr);
+        if !r.ok {
+            continue;
+        }
+        let row = base + u32(j) * gp.occ_w;
+        for (var i = r.i_lo; i < r.i_hi; i++) {
+            let w = inv_depth(maps[row + i]);
+            if w <= rc.wr {
+                continue;
+            }
+            let x0 = axes[gp.ax_col_x0s + i];
+            let x1 = x0 + gp.wx;
+            let d = w - rc.wr;
+            let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
+            let cy = min(r.ay1, d) + min(r.nay0, d);
+            sum += max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
+        }
+    }
+    acc[slot] = bitcast<u32>(sum);
+}
+
+// Each layer its own sum, the layers merged by max (§3.5).
+@compute @workgroup_size(8, 8)
+fn ssm_resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= gp.rec_w || gid.y >= gp.rec_h {
+        return;
+    }
+    let rc = receiver(gid);
+    let idx = gid.y * gp.rec_w + gid.x;
+    if !rc.ok {
+        vis[idx] = 1.0;
+        return;
+    }
+    var occ = 0.0;
+    for (var layer = 0u; layer < gp.n_layers; layer++) {
+        let sum = bitcast<f32>(acc[layer * gp.rec_w * gp.rec_h + idx]);
+        occ = max(occ, min(0.25 * sum, 1.0));
+    }
+    vis[idx] = 1.0 - occ;
+}

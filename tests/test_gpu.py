@@ -1,0 +1,214 @@
+"""The GPU backend against the CPU one, and its errors.
+
+GPU tests need an adapter; on a machine without one they are skipped, unless
+SOFTSHADOW_REQUIRE_GPU=1 (scripts/test.sh sets it after installing Mesa's
+lavapipe) makes a missing adapter a failure. Maps stay small: lavapipe
+renders on the CPU.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softshadow as ss
+from softshadow import scenes
+
+SCENES = ["bunny_floating", "bunny_on_floor", "square_plate", "torus_floating", "two_spheres"]
+
+
+@pytest.fixture(scope="module")
+def gpu():
+    if not ss.gpu_available():
+        if os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1":
+            pytest.fail("SOFTSHADOW_REQUIRE_GPU=1 but no GPU adapter opens (is mesa-vulkan-drivers installed?)")
+        pytest.skip("no GPU adapter")
+    return ss.gpu_info()
+
+
+def silhouette_texels(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Texels on a silhouette edge of either map: covered, with a 4-neighbour
+    that is empty or lies across a depth jump (> 1% of the depth)."""
+    mask = np.zeros(a.shape, bool)
+    for m in (a, b):
+        finite = np.isfinite(m)
+        p = np.pad(m, 1, constant_values=np.inf)
+        for nb in (p[:-2, 1:-1], p[2:, 1:-1], p[1:-1, :-2], p[1:-1, 2:]):
+            with np.errstate(invalid="ignore"):
+                jump = ~np.isfinite(nb) | (np.abs(nb - m) > 0.01 * np.abs(m))
+            mask |= finite & jump
+    return mask
+
+
+def assert_depth_maps_agree(cpu: np.ndarray, gpu: np.ndarray, name: str) -> None:
+    """Identical bits except on silhouette edges, where at most 0.5% of the
+    texels (and no more than 8) may differ (a real GPU may round 1/w
+    differently at a coverage tie; lavapipe gives identical maps)."""
+    assert cpu.shape == gpu.shape and gpu.dtype == np.float32, name
+    differ = cpu.view(np.uint32) != gpu.view(np.uint32)
+    assert differ.sum() <= max(8, differ.size // 200), f"{name}: {differ.sum()} texels differ"
+    off_edge = differ & ~silhouette_texels(cpu, gpu)
+    assert not off_edge.any(), f"{name}: {off_edge.sum()} differing texels off silhouette edges"
+
+
+def assert_visibility_agrees(cpu: np.ndarray, gpu: np.ndarray, name: str) -> None:
+    dv = np.abs(cpu.astype(np.float64) - gpu)
+    assert np.isfinite(gpu).all(), name
+    assert dv.mean() <= 1e-4 and dv.max() <= 2e-3, f"{name}: mean {dv.mean():.2e}, max {dv.max():.2e}"
+
+
+GPU_METHODS = [("ssm", None), ("bitmask", 16), ("bitmask", 256), ("exact", 16)]
+MAP_METHODS = GPU_METHODS[:3]
+
+
+@pytest.mark.parametrize("method, samples", GPU_METHODS)
+@pytest.mark.parametrize("passes", [1, 2, 3])
+@pytest.mark.parametrize("name", SCENES)
+def test_gpu_matches_cpu_on_the_scenes(gpu, name, passes, method, samples):
+    scene, light = getattr(scenes, name)()
+    kw = dict(resolution=(64, 48), passes=passes, method=method, samples=samples)
+    # The GPU has no occluder hierarchy: compare with the CPU's without one.
+    c = ss.soft_shadow_map(scene, light, backend="cpu", hierarchy=None if method == "exact" else False, **kw)
+    g = ss.soft_shadow_map(scene, light, backend="gpu", **kw)
+    assert g.extent == c.extent
+    assert_visibility_agrees(c.visibility, g.visibility, name)
+    assert_depth_maps_agree(c.receiver_depth, g.receiver_depth, f"{name} receiver")
+    if method == "exact":  # traces the triangles: no occluder maps on either backend
+        assert g.occluder_depth is None and c.occluder_depth is None
+        return
+    assert_depth_maps_agree(c.occluder_depth, g.occluder_depth, f"{name} front")
+    if passes >= 2:
+        assert_depth_maps_agree(c.occluder_depth_back, g.occluder_depth_back, f"{name} back")
+    else:
+        assert g.occluder_depth_back is None
+    assert len(g.occluder_depth_middle) == len(c.occluder_depth_middle) == max(0, passes - 2)
+    for k, (a, b) in enumerate(zip(c.occluder_depth_middle, g.occluder_depth_middle, strict=True)):
+        assert_depth_maps_agree(a, b, f"{name} middle {k}")
+
+
+@pytest.mark.parametrize("method", ["ssm", "bitmask"])
+def test_gpu_with_coarser_occluder_maps_and_an_explicit_extent(gpu, method):
+    scene, light = scenes.torus_floating()
+    kw = dict(resolution=(80, 64), occluder_resolution=32, extent=(0.6, 0.5), passes=2, method=method)
+    c = ss.soft_shadow_map(scene, light, backend="cpu", hierarchy=False, **kw)
+    g = ss.soft_shadow_map(scene, light, backend="gpu", **kw)
+    assert g.occluder_depth.shape == (32, 32)
+    assert_visibility_agrees(c.visibility, g.visibility, "torus")
+    assert_depth_maps_agree(c.occluder_depth, g.occluder_depth, "torus front")
+    assert_depth_maps_agree(c.receiver_depth, g.receiver_depth, "torus receiver")
+
+
+def test_gpu_reports_device_stage_times(gpu):
+    scene, light = scenes.square_plate()
+    g = ss.soft_shadow_map(scene, light, resolution=32, backend="gpu")
+    stages = set(g.timings)
+    assert {"setup", "upload", "device", "readback"} <= stages
+    device = {"gpu_raster_receivers", "gpu_raster_occluders", "gpu_row_stats", "gpu_shadow"}
+    assert device <= stages or "gpu" in stages
+    assert all(t >= 0 for t in g.timings.values())
+
+
+def test_gpu_info_describes_the_adapter(gpu):
+    info = ss.gpu_info()
+    assert set(info) == {"name", "backend", "device_type", "driver", "software"}
+    assert info["backend"] == "vulkan"
+    assert isinstance(info["software"], bool)
+    assert info["software"] == (info["device_type"] == "cpu")
+
+
+def test_auto_takes_the_gpu_only_when_it_is_real(gpu):
+    scene, light = scenes.square_plate()
+    sm = ss.soft_shadow_map(scene, light, resolution=32, backend="auto")
+    on_gpu = any(k.startswith("gpu") for k in sm.timings)
+    assert on_gpu == (not gpu["software"])
+
+
+def test_depth_maps_are_not_traced_on_either_backend():
+    z = np.full((8, 8), 2.0, np.float32)
+    for backend in ("cpu", "gpu"):
+        with pytest.raises(ValueError, match="method: traces the occluder triangles"):
+            ss.soft_shadow_map_from_depth(z, z * 2, light_size=1.0, extent=0.5, method="exact", backend=backend)
+
+
+@pytest.mark.parametrize("method, samples", MAP_METHODS)
+def test_depth_maps_shaded_on_the_gpu_match_the_cpu(gpu, method, samples):
+    scene, light = scenes.bunny_floating()
+    sm = ss.soft_shadow_map(scene, light, resolution=(48, 40), occluder_resolution=32, passes=2)
+    kw = dict(
+        light_size=light.size,
+        extent=sm.extent,
+        occluder_depth_back=sm.occluder_depth_back,
+        method=method,
+        samples=samples,
+    )
+    c = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="cpu", hierarchy=False, **kw)
+    g = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="gpu", **kw)
+    assert_visibility_agrees(c.visibility, g.visibility, method)
+    assert "gpu_shadow" in g.timings or "gpu" in g.timings
+    one = ss.soft_shadow_map_from_depth(
+        sm.occluder_depth, sm.receiver_depth, backend="gpu", **{**kw, "occluder_depth_back": None}
+    )
+    ref = ss.soft_shadow_map_from_depth(
+        sm.occluder_depth, sm.receiver_depth, backend="cpu", hierarchy=False, **{**kw, "occluder_depth_back": None}
+    )
+    assert_visibility_agrees(ref.visibility, one.visibility, f"{method}, one layer")
+
+
+def test_without_an_adapter_gpu_raises_and_auto_runs_on_the_cpu(monkeypatch):
+    # SOFTSHADOW_GPU=off hides every adapter (read on every call).
+    monkeypatch.setenv("SOFTSHADOW_GPU", "off")
+    scene, light = scenes.square_plate()
+    assert ss.gpu_available() is False
+    with pytest.raises(ss.GpuUnavailableError, match="SOFTSHADOW_GPU=off"):
+        ss.gpu_info()
+    with pytest.raises(ss.GpuUnavailableError, match="no GPU available"):
+        ss.soft_shadow_map(scene, light, resolution=16, backend="gpu")
+    z = np.full((8, 8), 2.0, np.float32)
+    with pytest.raises(ss.GpuUnavailableError, match="no GPU available"):
+        ss.soft_shadow_map_from_depth(z, z * 2, light_size=1.0, extent=0.5, backend="gpu")
+    assert issubclass(ss.GpuUnavailableError, RuntimeError)
+    auto = ss.soft_shadow_map(scene, light, resolution=16, backend="auto")
+    cpu = ss.soft_shadow_map(scene, light, resolution=16, backend="cpu")
+    np.testing.assert_array_equal(auto.visibility, cpu.visibility)
+
+
+def test_gpu_refuses_what_it_does_not_have_and_defaults_around_it(gpu):
+    scene, light = scenes.torus_floating()
+    with pytest.raises(ValueError, match="hierarchy: the GPU backend has no occluder hierarchy"):
+        ss.soft_shadow_map(scene, light, resolution=32, method="bitmask", hierarchy=True, backend="gpu")
+    with pytest.raises(ValueError, match='precision: the GPU backend sums in "f32" only'):
+        ss.soft_shadow_map(scene, light, resolution=32, precision="f16", backend="gpu")
+    g = ss.soft_shadow_map(scene, light, resolution=32, method="bitmask", samples=16, backend="gpu")
+    assert g.hierarchy is False
+    c = ss.soft_shadow_map(scene, light, resolution=32, method="bitmask", samples=16, backend="cpu")
+    assert c.hierarchy is True
+    # The core refuses them too, whatever the Python layer lets through.
+    from softshadow import _core
+
+    occ, rec = g.occluder_depth, g.receiver_depth
+    with pytest.raises(ValueError, match="hierarchy"):
+        _core.shadow_map_from_depth(occ, None, rec, (1.0, 1.0), g.extent, "bitmask", 16, True, None, "gpu")
+    with pytest.raises(ValueError, match="precision"):
+        _core.shadow_map_from_depth(occ, None, rec, (1.0, 1.0), g.extent, "ssm", None, None, "f64", "gpu")
+
+
+def test_bad_backends_name_the_argument():
+    scene, light = scenes.square_plate()
+    with pytest.raises(ValueError, match="backend: must be one of"):
+        ss.soft_shadow_map(scene, light, resolution=16, backend="cuda")
+    with pytest.raises(TypeError, match="backend"):
+        ss.soft_shadow_map(scene, light, resolution=16, backend=None)
+
+
+def test_the_readme_gpu_example_runs(gpu):
+    text = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    block = re.search(r"## GPU backend\n\n```python\n(.*?)```", text, re.S)
+    assert block, "the GPU example is missing from the README"
+    env: dict = {}
+    exec(compile(block.group(1), "README.md", "exec"), env)
+    assert env["sm"].visibility.shape == (128, 128)
+    assert any(k.startswith("gpu") for k in env["sm"].timings)
