@@ -14,6 +14,7 @@ pub mod mesh;
 pub mod methods;
 pub mod pipeline;
 pub mod raster;
+pub mod units;
 
 #[cfg(feature = "python")]
 mod python;

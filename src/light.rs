@@ -122,6 +122,11 @@ pub struct MapGrid {
 /// size take 4 GiB; beyond it we refuse before allocating.
 pub const MAX_TEXELS: usize = 1 << 28;
 
+/// The widest tangent half-extent we accept (89.99994 degrees off the axis).
+/// The kernels hold tangents in f32 and multiply them by depths: far beyond
+/// this, texel positions overflow and shadows silently vanish.
+pub const MAX_EXTENT: f64 = 1e6;
+
 impl MapGrid {
     pub fn new(width: usize, height: usize, extent: [f64; 2]) -> Result<Self> {
         if width == 0 || height == 0 {
@@ -145,6 +150,12 @@ impl MapGrid {
             return Err(Error::invalid(
                 "extent",
                 format!("must be two finite tangent half-extents > 0, got {extent:?}"),
+            ));
+        }
+        if extent.iter().any(|t| *t > MAX_EXTENT) {
+            return Err(Error::invalid(
+                "extent",
+                format!("tangent half-extents must be <= {MAX_EXTENT:e}, got {extent:?}"),
             ));
         }
         Ok(MapGrid {
@@ -251,5 +262,7 @@ mod tests {
             Err(Error::TooLarge { .. })
         ));
         assert!(MapGrid::new(8, 8, [0.0, 1.0]).is_err());
+        assert!(MapGrid::new(8, 8, [1.0, 2e6]).is_err());
+        assert!(MapGrid::new(8, 8, [50.0, 1e6]).is_ok());
     }
 }

@@ -7,6 +7,7 @@ use crate::light::{check_light_size, MapGrid, RectLight};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared};
+use crate::units::{check_unit, depth_unit, farthest, light_size_in, scaled_map};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -115,12 +116,22 @@ pub fn from_meshes(
     receivers.validate("receivers")?;
 
     let mut sw = Stopwatch::new();
-    let occ_ls = occluders.to_light_space(light);
-    let rec_ls = receivers.to_light_space(light);
+    let mut occ_ls = occluders.to_light_space(light);
+    let mut rec_ls = receivers.to_light_space(light);
+    // Light space in the kernels' depth unit (see units.rs); maps go back to
+    // the user's units at the end.
+    let unit = depth_unit(rec_ls.iter().fold(0f64, |m, q| m.max(q.z)));
+    check_unit("receivers", unit)?;
+    let light_size = light_size_in("size", light.size, unit)?;
+    if unit != 1.0 {
+        for q in occ_ls.iter_mut().chain(rec_ls.iter_mut()) {
+            *q /= unit;
+        }
+    }
     sw.lap("transform");
     let extent = match s.extent {
         Some(e) => e,
-        None => fit_extent(&occ_ls, &rec_ls, light.size)?,
+        None => fit_extent(&occ_ls, &rec_ls, light_size)?,
     };
     let grid = MapGrid::new(s.width, s.height, extent)?;
     let occluder_grid = MapGrid::new(ow, oh, extent)?;
@@ -158,17 +169,28 @@ pub fn from_meshes(
     let inputs = ShadowInputs {
         grid,
         occluder_grid,
-        light_size: light.size,
+        light_size,
         receiver: &receiver,
         occluder_layers: layers,
         occluder_triangles: triangles.as_deref(),
     };
     let visibility = s.method.implementation().visibility_map(&inputs);
     sw.lap("shadow");
-    let (occluder_front, occluder_back) = match occ {
+    let (mut occluder_front, mut occluder_back) = match occ {
         Some(o) => (Some(o.nearest), o.farthest),
         None => (None, None),
     };
+    let mut receiver = receiver;
+    if unit != 1.0 {
+        let maps = std::iter::once(&mut receiver)
+            .chain(occluder_front.as_mut())
+            .chain(middle.iter_mut())
+            .chain(occluder_back.as_mut());
+        for m in maps {
+            // Powers of two: exact, back in the user's units.
+            m.par_iter_mut().for_each(|z| *z *= unit as f32);
+        }
+    }
     Ok(ShadowResult {
         grid,
         occluder_grid,
@@ -215,7 +237,7 @@ pub fn from_depth(
     receiver: &[f32],
     method: Method,
 ) -> Result<(Vec<f32>, Timings)> {
-    let light_size = check_light_size("light_size", light_size)?;
+    check_light_size("light_size", light_size)?;
     if method.traces_triangles() {
         return Err(Error::invalid(
             "method",
@@ -238,15 +260,21 @@ pub fn from_depth(
         }
     }
     let mut sw = Stopwatch::new();
-    let mut layers = vec![front];
-    if let Some(b) = back {
+    // The kernels' depth unit (see units.rs): copies only far from 1.
+    let unit = depth_unit(farthest(receiver));
+    let light_size = light_size_in("light_size", light_size, unit)?;
+    let front = scaled_map(front, unit);
+    let back = back.map(|b| scaled_map(b, unit));
+    let receiver = scaled_map(receiver, unit);
+    let mut layers: Vec<&[f32]> = vec![&front];
+    if let Some(b) = &back {
         layers.push(b);
     }
     let inputs = ShadowInputs {
         grid: *grid,
         occluder_grid: *occluder_grid,
         light_size,
-        receiver,
+        receiver: &receiver,
         occluder_layers: layers,
         occluder_triangles: None,
     };
@@ -285,31 +313,39 @@ pub fn sample_points(
             format!("point {k} is not finite: {:?}", points[k]),
         ));
     }
-    let (ls, inside): (Vec<LightPoint>, Vec<bool>) = points
+    let ls_points: Vec<DVec3> = points
         .par_iter()
-        .map(|p| {
-            let q = light.to_light(DVec3::from_array(*p));
-            if !(q.z > 0.0) {
-                return (
-                    LightPoint {
-                        x: 0.0,
-                        y: 0.0,
-                        z: f32::INFINITY,
-                    },
-                    false,
-                );
+        .map(|p| light.to_light(DVec3::from_array(*p)))
+        .collect();
+    let inside_map =
+        |q: &DVec3| q.z > 0.0 && (q.x / q.z).abs() <= grid.tx && (q.y / q.z).abs() <= grid.ty;
+    // The kernels' depth unit (see units.rs), from the points inside the map.
+    let unit = depth_unit(
+        ls_points
+            .iter()
+            .filter(|q| inside_map(q))
+            .fold(0f64, |m, q| m.max(q.z)),
+    );
+    check_unit("points", unit)?;
+    let light_size = light_size_in("size", light.size, unit)?;
+    let (ls, inside): (Vec<LightPoint>, Vec<bool>) = ls_points
+        .par_iter()
+        .map(|q| {
+            if !inside_map(q) {
+                // Outside the map, or at or behind the light's plane.
+                let lp = LightPoint {
+                    x: 0.0,
+                    y: 0.0,
+                    z: f32::INFINITY,
+                };
+                return (lp, false);
             }
-            let (x, y) = (q.x / q.z, q.y / q.z);
-            let inside = x.abs() <= grid.tx && y.abs() <= grid.ty;
-            let z = if inside { q.z as f32 } else { f32::INFINITY };
-            (
-                LightPoint {
-                    x: x as f32,
-                    y: y as f32,
-                    z,
-                },
-                inside,
-            )
+            let lp = LightPoint {
+                x: (q.x / q.z) as f32,
+                y: (q.y / q.z) as f32,
+                z: (q.z / unit) as f32,
+            };
+            (lp, true)
         })
         .unzip();
     let (layers, triangles, occluder_grid) = match occluders {
@@ -320,7 +356,23 @@ pub fn sample_points(
                     "traces triangles: pass the occluder mesh",
                 ));
             }
-            (layers, None, og)
+            for (k, l) in layers.iter().enumerate() {
+                let arg = format!("occluder layer {k}");
+                if l.len() != og.len() {
+                    return Err(Error::shape(
+                        arg,
+                        format!(
+                            "has {} texels, expected {}x{}",
+                            l.len(),
+                            og.height,
+                            og.width
+                        ),
+                    ));
+                }
+                check_depth(&arg, l)?;
+            }
+            let scaled: Vec<_> = layers.iter().map(|l| scaled_map(l, unit)).collect();
+            (scaled, None, og)
         }
         OccluderSource::Mesh(mesh) => {
             if !method.traces_triangles() {
@@ -330,7 +382,8 @@ pub fn sample_points(
                 ));
             }
             mesh.validate("occluders")?;
-            let ls = mesh.to_light_space(light);
+            let mut ls = mesh.to_light_space(light);
+            ls.iter_mut().for_each(|q| *q /= unit);
             (vec![], Some(light_space_triangles(&ls, mesh.faces)), *grid)
         }
     };
@@ -338,9 +391,9 @@ pub fn sample_points(
     let inputs = ShadowInputs {
         grid: *grid,
         occluder_grid,
-        light_size: light.size,
+        light_size,
         receiver: &[],
-        occluder_layers: layers,
+        occluder_layers: layers.iter().map(|l| &l[..]).collect(),
         occluder_triangles: triangles.as_deref(),
     };
     Ok((

@@ -5,6 +5,7 @@ See the README for the conventions.
 """
 
 from ._core import __version__
+from ._validate import TooLargeError
 from .light import RectLight
 from .scene import Scene
 from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
@@ -13,6 +14,7 @@ __all__ = [
     "RectLight",
     "Scene",
     "ShadowMap",
+    "TooLargeError",
     "soft_shadow_map",
     "soft_shadow_map_from_depth",
     "__version__",
