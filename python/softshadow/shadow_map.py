@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -98,7 +99,14 @@ class ShadowMap:
         light's plane) get ``outside``; by default that is 1.0 when the extent
         was fitted (no shadow can fall there) and a ValueError otherwise.
         """
-        pts = np.asarray(points, dtype=np.float64)
+        pts = np.asarray(points)
+        if pts.dtype.kind not in "fiu":
+            raise TypeError(f"points: must be real numbers, got dtype {pts.dtype}")
+        pts = pts.astype(np.float64, copy=False)
+        if outside is not None:
+            # Any number, NaN included (a marker for points off the map).
+            if isinstance(outside, bool) or not isinstance(outside, numbers.Real):
+                raise TypeError(f"outside: must be a number or None, got {type(outside).__name__}")
         if pts.ndim != 2 or pts.shape[1] != 3:
             raise ValueError(f"points: must have shape (N, 3), got {pts.shape}")
         if not np.isfinite(pts).all():

@@ -295,6 +295,7 @@ fn receiver_points<'py>(
         let shape = receiver_depth.shape();
         let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
         let rec = slice("receiver_depth", &receiver_depth)?;
+        pipeline::check_depth("receiver_depth", rec)?;
         let (pts, idx) = py.detach(|| pipeline::receiver_points(&grid, &light, rec));
         let n = pts.len();
         let flat: Vec<f64> = pts.into_iter().flatten().collect();
