@@ -42,16 +42,17 @@ pub fn farthest(depth: &[f32]) -> f64 {
 }
 
 /// Refuses a unit whose depths the f32 maps cannot hold (a scene 1e300 away
-/// from the light): its depth maps would overflow.
+/// from the light, or 1e-300 from it): its depth maps would overflow, or
+/// underflow to 0.
 pub fn check_unit(arg: &str, unit: f64) -> Result<()> {
-    if (2f64.powi(-100)..=2f64.powi(100)).contains(&unit) {
+    if (2f64.powi(-149)..=2f64.powi(127)).contains(&unit) {
         Ok(())
     } else {
         Err(Error::invalid(
             arg,
             format!(
-                "lie {unit:e} from the light: beyond the float32 range of the depth maps \
-                 (move the light and the scene nearer the origin, or scale them)"
+                "lie about {unit:e} from the light: beyond the float32 range of the depth maps \
+                 (scale the scene and the light)"
             ),
         ))
     }
@@ -62,10 +63,10 @@ pub fn scaled_map(depth: &[f32], unit: f64) -> std::borrow::Cow<'_, [f32]> {
     if unit == 1.0 {
         std::borrow::Cow::Borrowed(depth)
     } else {
-        let inv = (1.0 / unit) as f32;
-        // A power of two: z * inv is exact unless it leaves the f32 range,
-        // where it becomes 0 (at the light: occludes nothing) or inf (empty).
-        std::borrow::Cow::Owned(depth.iter().map(|&z| z * inv).collect())
+        // A power of two, divided in f64: exact unless the result leaves the
+        // f32 range, where it becomes 0 (at the light: occludes nothing) or
+        // inf (far beyond the receivers: empty).
+        std::borrow::Cow::Owned(depth.iter().map(|&z| (z as f64 / unit) as f32).collect())
     }
 }
 
@@ -111,5 +112,12 @@ mod tests {
         assert!(light_size_in("size", [1.0, 1.0], 2f64.powi(51)).is_ok());
         assert!(light_size_in("size", [1e-40, 1.0], 1.0).is_err());
         assert!(light_size_in("size", [1e-40, 1e-40], 2f64.powi(-100)).is_ok());
+        // The deepest f32 depth and the shallowest normal one keep their unit.
+        assert!(check_unit("points", depth_unit(f32::MAX as f64)).is_ok());
+        assert!(check_unit("points", depth_unit(1e-45f32 as f64)).is_ok());
+        assert!(check_unit("receivers", depth_unit(1e300)).is_err());
+        // A subnormal receiver depth scales to 1 without overflowing.
+        let tiny = [1e-45f32];
+        assert_eq!(scaled_map(&tiny, depth_unit(tiny[0] as f64))[0], 1.0);
     }
 }

@@ -54,3 +54,26 @@ def maps(w: int, h: int, ext, rect, zo, zr):
 
 def bound(method: str) -> float:
     return {"ssm": SSM_BOUND, "bitmask": BITMASK_BOUND}[method]
+
+
+def backprojection(x, y, rect, zo, zr, lx, ly):
+    """The rectangle's back-projection onto the light, clipped to it:
+    (x_lo, x_hi, y_lo, y_hi) in light coordinates, per receiver (x, y)."""
+    x0, x1, y0, y1 = rect
+    k = zr * zo / (zr - zo)
+    x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+    return (
+        np.clip(k * (x0 - x), -lx / 2, lx / 2),
+        np.clip(k * (x1 - x), -lx / 2, lx / 2),
+        np.clip(k * (y0 - y), -ly / 2, ly / 2),
+        np.clip(k * (y1 - y), -ly / 2, ly / 2),
+    )
+
+
+def area(b, lx, ly):
+    """Fraction of the light covered by clipped rectangle b."""
+    return np.maximum(b[1] - b[0], 0) * np.maximum(b[3] - b[2], 0) / (lx * ly)
+
+
+def intersection(a, b):
+    return (np.maximum(a[0], b[0]), np.minimum(a[1], b[1]), np.maximum(a[2], b[2]), np.minimum(a[3], b[3]))
