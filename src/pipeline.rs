@@ -420,3 +420,53 @@ pub fn receiver_points(
         })
         .unzip()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A texel-aligned plate at depth 2 over receivers at depth 4, times `s`.
+    fn plate_maps(n: usize, s: f32) -> (Vec<f32>, Vec<f32>) {
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let front = (0..n * n)
+            .map(|k| {
+                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
+                if x.abs() < 0.25 && y.abs() < 0.2 {
+                    2.0 * s
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        (front, vec![4.0 * s; n * n])
+    }
+
+    #[test]
+    fn depth_maps_at_any_power_of_two_scale_give_the_same_visibility() {
+        // The kernels get depths in a unit near the receivers' (units.rs):
+        // without it the SSM loses these shadows at 2^60 and 2^-70.
+        let n = 24;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        for method in [Method::Ssm, Method::Bitmask { samples: 64 }] {
+            let (f, r) = plate_maps(n, 1.0);
+            let (base, _) = from_depth(&grid, &grid, [1.0, 0.6], &f, None, &r, method).unwrap();
+            assert!(base.iter().any(|&v| v < 1e-6));
+            for k in [-90, -70, 50, 60, 90] {
+                let s = 2f32.powi(k);
+                let (f, r) = plate_maps(n, s);
+                let size = [s as f64, 0.6 * s as f64];
+                let (v, _) = from_depth(&grid, &grid, size, &f, None, &r, method).unwrap();
+                assert_eq!(v, base, "{method:?} at 2^{k}");
+            }
+        }
+    }
+
+    #[test]
+    fn light_sizes_beyond_f32_relative_to_depth_are_refused() {
+        let n = 8;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let (f, r) = plate_maps(n, 1.0);
+        let err = from_depth(&grid, &grid, [1e-35, 1.0], &f, None, &r, Method::Ssm).unwrap_err();
+        assert!(matches!(err, Error::InvalidArgument { ref arg, .. } if arg == "light_size"));
+    }
+}

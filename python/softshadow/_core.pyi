@@ -3,8 +3,13 @@ these functions take already-validated, C-contiguous arrays.
 
 Every function raises ValueError, its message starting with the argument's
 name, when a value is refused (non-finite vertices, out-of-range indices, a
-degenerate light, depths that are not > 0 or +inf, an absurd resolution).
-The work runs with the GIL released.
+degenerate light, depths that are not > 0 or +inf, negative counts, a light
+size the f32 kernels cannot resolve); softshadow.TooLargeError (a ValueError
+and a MemoryError) for an absurd resolution, before allocating. Arrays of the
+wrong dtype or number of dimensions raise TypeError from pyo3, which names
+the argument in a note ("while processing 'occluder_depth'"); non-contiguous
+arrays raise ValueError. A panic in the core (a bug) raises RuntimeError;
+the module stays usable. The work runs with the GIL released.
 """
 
 from typing import Any
@@ -80,3 +85,7 @@ def receiver_points(
     extent: tuple[float, float],
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64]]:
     """World points (M, 3) of the texels with a receiver, and their flat indices."""
+
+def _panic_for_tests(in_worker: bool) -> None:
+    """Panics on purpose (in a rayon worker thread when ``in_worker``) to test
+    that panics become RuntimeError. Not part of the API."""

@@ -20,7 +20,10 @@ class RectLight:
     width along ``u`` and the full height along ``v``.
 
     Raises ValueError for a non-finite center, a zero-length ``normal`` or
-    ``up``, an ``up`` parallel to ``normal``, or a size that is not finite and > 0.
+    ``up``, an ``up`` within 1e-6 rad of parallel to ``normal``, or a size that
+    is not finite and > 0. A point light (size 0) is refused: a light of size
+    1e-6 times the scene's depth gives its hard shadow (the methods converge to
+    it as the size shrinks).
     """
 
     center: tuple[float, float, float]

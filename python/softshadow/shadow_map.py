@@ -187,7 +187,10 @@ def soft_shadow_map(
         light's axis, ``z_far`` being the farthest receiver depth; the extent is
         the largest such bound over occluder vertices (exact for triangles), cut
         to the receivers' own extent. Fitting needs every occluder vertex in
-        front of the light's plane.
+        front of the light's plane. Tangent half-extents are at most 1e6.
+        Geometry at or behind the light's plane casts no shadow (it is
+        clipped), and an occluder at or beyond a receiver's depth does not
+        shadow that receiver.
     passes
         The occluder depth layers: 1, the front; 2, front and back (§3.5 of
         the paper); 3 to 8, front, ``passes - 2`` layers found by depth
@@ -217,6 +220,14 @@ def soft_shadow_map(
         paper notes that large lights need fewer occluder texels).
     backend
         ``"cpu"`` (all cores).
+
+    The light's size must lie within about [1e-30, 1e30] times the receivers'
+    depth (the kernels compute in f32, in a depth unit near the receivers'
+    depth, so any scale of scene works); a tiny light gives the hard shadow.
+    Bad values raise ValueError or TypeError naming the argument; a map too
+    large to allocate raises :class:`softshadow.TooLargeError` (a ValueError
+    and a MemoryError) before allocating; an internal error raises
+    RuntimeError and leaves the module usable.
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
@@ -276,6 +287,12 @@ def soft_shadow_map_from_depth(
     half-extents. The result's ``light`` is the canonical light of that size
     (center at the origin, normal +z, up +y), so ``sample`` takes points in that
     frame.
+
+    Depths may be any float32 value > 0 (subnormal to 3.4e38) or +inf; NaN,
+    zero and negative depths are refused (ValueError naming the map). Any
+    real float array is accepted (converted to C-contiguous float32); integer
+    and complex arrays raise TypeError. ``light_size`` must lie within
+    about [1e-30, 1e30] times the receivers' depth.
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
