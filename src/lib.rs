@@ -10,6 +10,7 @@
 pub mod error;
 pub mod extent;
 pub mod light;
+pub mod memory;
 pub mod mesh;
 pub mod methods;
 pub mod pipeline;

@@ -4,6 +4,7 @@
 use crate::error::{Error, Result};
 use crate::extent::fit_extent;
 use crate::light::{check_light_size, MapGrid, RectLight};
+use crate::memory::{check_fits, map_bytes};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared};
@@ -112,6 +113,21 @@ pub fn from_meshes(
     let (ow, oh) = s.occluder_resolution.unwrap_or((s.width, s.height));
     MapGrid::new(ow, oh, s.extent.unwrap_or([1.0, 1.0]))
         .map_err(|e| Error::invalid("occluder_resolution", e.to_string()))?;
+    // Receiver and visibility maps; each occluder layer and the kernels'
+    // 1/depth copy of it.
+    let layers = if s.method.traces_triangles() {
+        0
+    } else {
+        s.passes as usize
+    };
+    check_fits(
+        "resolution",
+        &format!(
+            "{}x{} with {}x{} occluder maps and {} layers",
+            s.width, s.height, ow, oh, layers
+        ),
+        map_bytes(s.width * s.height, 2) + map_bytes(ow * oh, 2 * layers),
+    )?;
     occluders.validate("occluders")?;
     receivers.validate("receivers")?;
 
@@ -262,6 +278,14 @@ pub fn from_depth(
     let mut sw = Stopwatch::new();
     // The kernels' depth unit (see units.rs): copies only far from 1.
     let unit = depth_unit(farthest(receiver));
+    // Visibility, the kernels' 1/depth layers, and the copies in that unit.
+    let copies = if unit == 1.0 { 0 } else { 1 };
+    let layers = 1 + back.is_some() as usize;
+    check_fits(
+        "receiver_depth",
+        &format!("{}x{} maps", grid.width, grid.height),
+        map_bytes(grid.len(), 1 + copies) + map_bytes(occluder_grid.len(), layers * (1 + copies)),
+    )?;
     let light_size = light_size_in("light_size", light_size, unit)?;
     let front = scaled_map(front, unit);
     let back = back.map(|b| scaled_map(b, unit));

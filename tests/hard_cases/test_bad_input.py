@@ -45,6 +45,22 @@ def test_absurd_resolutions_are_refused_before_allocating_as_memory_errors():
         _core.shadow_map_from_meshes(v, f, v, f, LIGHT, 1 << 20, 1 << 20, None, 1, "ssm")
 
 
+def test_maps_larger_than_the_memory_available_are_refused_before_allocating(monkeypatch):
+    # Rust aborts the process when an allocation fails, so the core adds up
+    # its maps' bytes first and compares them with MemAvailable, or with the
+    # cap SOFTSHADOW_MEMORY_LIMIT (set small here to stand for a small machine).
+    scene, light = scenes.square_plate()
+    monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "100000")
+    assert ss.soft_shadow_map(scene, light, resolution=32).visibility.shape == (32, 32)
+    with pytest.raises(ss.TooLargeError, match=r"resolution: 1024x1024 .* 25165824 bytes .* 100000 bytes"):
+        ss.soft_shadow_map(scene, light, resolution=1024)
+    occ = np.full((1024, 1024), np.inf, np.float32)
+    with pytest.raises(MemoryError, match="receiver_depth: 1024x1024 maps would need"):
+        ss.soft_shadow_map_from_depth(occ, occ, light_size=1.0, extent=0.5)
+    monkeypatch.delenv("SOFTSHADOW_MEMORY_LIMIT")
+    assert ss.soft_shadow_map(scene, light, resolution=1024, method="exact", samples=1).visibility.min() == 0.0
+
+
 @pytest.mark.parametrize(
     "kwargs, exc, words",
     [
