@@ -8,7 +8,7 @@ use crate::memory::{check_fits, map_bytes};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared};
-use crate::units::{check_unit, depth_unit, farthest, light_size_in, scaled_map};
+use crate::units::{check_lateral, check_unit, depth_unit, farthest, light_size_in, scaled_map};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -144,6 +144,8 @@ pub fn from_meshes(
             *q /= unit;
         }
     }
+    check_lateral("occluders", &occ_ls, unit)?;
+    check_lateral("receivers", &rec_ls, unit)?;
     sw.lap("transform");
     let extent = match s.extent {
         Some(e) => e,
@@ -408,6 +410,7 @@ pub fn sample_points(
             mesh.validate("occluders")?;
             let mut ls = mesh.to_light_space(light);
             ls.iter_mut().for_each(|q| *q /= unit);
+            check_lateral("occluders", &ls, unit)?;
             (vec![], Some(light_space_triangles(&ls, mesh.faces)), *grid)
         }
     };

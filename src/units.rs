@@ -58,6 +58,34 @@ pub fn check_unit(arg: &str, unit: f64) -> Result<()> {
     }
 }
 
+/// The farthest a vertex may lie from the light's axis, in the kernels' unit
+/// (about the receivers' depth). Beyond, a triangle's vertices are so large
+/// that clipping it to the map in f64 loses its interior (measured: a
+/// triangle 1e19 wide over the map vanished) and the ray caster's f32
+/// determinants overflow; 1e15 keeps a margin of 1e3.
+pub const MAX_LATERAL: f64 = 1e15;
+
+/// Refuses vertices (light space, in the kernels' unit) beyond MAX_LATERAL
+/// from the light's axis, naming the mesh set and the vertex.
+pub fn check_lateral(arg: &str, verts: &[glam::DVec3], unit: f64) -> Result<()> {
+    match verts
+        .iter()
+        .position(|q| q.x.abs().max(q.y.abs()) > MAX_LATERAL)
+    {
+        None => Ok(()),
+        Some(k) => Err(Error::invalid(
+            arg,
+            format!(
+                "vertex {k} lies {:e} from the light's axis, beyond {MAX_LATERAL:e} times the \
+                 depth unit {unit:e} (a power of two near the receivers' depth): so large a \
+                 triangle loses its shape in the rasterizer and the ray caster; split it or drop \
+                 what lies that far",
+                verts[k].x.abs().max(verts[k].y.abs()) * unit
+            ),
+        )),
+    }
+}
+
 /// A depth map in unit `unit`, borrowed when the unit is 1.
 pub fn scaled_map(depth: &[f32], unit: f64) -> std::borrow::Cow<'_, [f32]> {
     if unit == 1.0 {

@@ -87,3 +87,30 @@ def test_scene_and_light_moved_far_from_the_origin(method, backend, offset):
     # scene would be gone. Sampling at far points works too.
     pts, idx = sm.receiver_points()
     np.testing.assert_allclose(sm.sample(pts), sm.visibility.ravel()[idx], atol=1e-5)
+
+
+def _huge_triangle(size):
+    # A triangle at height 2 whose interior covers the light's axis.
+    v = np.array([[size, 2.0, 0.0], [0.0, 2.0, size], [-size, 2.0, -size]])
+    return ss.Scene(occluders=[(v, [[0, 1, 2]])], receivers=[scenes.floor()])
+
+
+@pytest.mark.parametrize("size", [1e3, 1e9, 1e14])
+def test_huge_triangles_keep_their_shape(method, backend, size):
+    # The triangle covers the whole map: umbra wherever the penumbra reach
+    # (0.125 in tangent) stays inside the map (the map methods see no occluder
+    # beyond the map's edge, so receivers near it see past).
+    sm = ss.soft_shadow_map(
+        _huge_triangle(size), scenes.default_light(), resolution=16, extent=0.5, **options(method, backend)
+    )
+    assert_visibility(sm.visibility)
+    assert sm.visibility[4:12, 4:12].max() <= 1e-6
+
+
+def test_triangles_beyond_what_f64_clipping_resolves_are_refused(method, backend):
+    # 1e19 wide: clipped in f64 to a map 1 wide its interior was lost (the
+    # shadow vanished) and the ray caster's f32 determinants overflowed.
+    with pytest.raises(ValueError, match=r"occluders: vertex 0 lies 1e19 from the light's axis"):
+        ss.soft_shadow_map(
+            _huge_triangle(1e19), scenes.default_light(), resolution=16, extent=0.5, **options(method, backend)
+        )
