@@ -186,9 +186,10 @@ def soft_shadow_map(
         ``z`` shadows at most ``|x| + (Lx/2)(1/z - 1/z_far)`` away from the
         light's axis, ``z_far`` being the farthest receiver depth; the extent is
         the largest such bound over occluder vertices (exact for triangles), cut
-        to the receivers' own extent widened by the largest penumbra reach
-        (occluders just outside the receivers still shadow them; the map
-        methods see only occluders inside the map). Fitting needs every occluder vertex in
+        to the receivers' own extent, or to the occluders' own where that is
+        wider (by no more than the largest penumbra reach): the map methods
+        see only occluders inside the map, and one just outside the
+        receivers can shadow them. Fitting needs every occluder vertex in
         front of the light's plane. Tangent half-extents are at most 1e6.
         Geometry at or behind the light's plane casts no shadow (it is
         clipped), and an occluder at or beyond a receiver's depth does not
