@@ -12,11 +12,20 @@ use crate::error::{Error, Result};
 /// The environment variable that caps the bytes of maps one call may allocate.
 pub const LIMIT_VAR: &str = "SOFTSHADOW_MEMORY_LIMIT";
 
+/// Requests below this many bytes fit on any machine this runs on: they
+/// skip reading /proc/meminfo (tens of microseconds), which small maps
+/// would notice.
+const SURELY_FITS: u64 = 1 << 26;
+
+fn cap() -> Option<u64> {
+    std::env::var(LIMIT_VAR)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+}
+
 /// Bytes available for maps: the smaller of the cap and MemAvailable.
 pub fn available_bytes() -> Option<u64> {
-    let cap = std::env::var(LIMIT_VAR)
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok());
+    let cap = cap();
     let free = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
         s.lines()
             .find(|l| l.starts_with("MemAvailable:"))
@@ -39,7 +48,12 @@ pub fn map_bytes(texels: usize, maps: usize) -> u64 {
 
 /// Refuses (TooLarge, naming `arg`) work needing `bytes` when fewer are available.
 pub fn check_fits(arg: &str, what: &str, bytes: u64) -> Result<()> {
-    match available_bytes() {
+    let avail = if bytes < SURELY_FITS {
+        cap()
+    } else {
+        available_bytes()
+    };
+    match avail {
         Some(avail) if bytes > avail => Err(Error::too_large(
             arg,
             format!(
