@@ -4,12 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-import softshadow as ss
-from softshadow import scenes
-
 
 def box(lo, hi):
-    """An axis-aligned box [lo, hi] (closed, outward-facing triangles)."""
+    """An axis-aligned box [lo, hi]: a closed mesh of 12 triangles."""
     (x0, y0, z0), (x1, y1, z1) = lo, hi
     v = np.array(
         [
@@ -42,13 +39,6 @@ def box(lo, hi):
         dtype=np.uint32,
     )
     return v, f
-
-
-def plate_scene(height=2.0, half=0.5, light_size=1.0, floor_y=0.0):
-    """A horizontal square plate over the floor, the default light (height 4)."""
-    occ = scenes.quad((0.0, height, 0.0), half)
-    rec = scenes.quad((0.0, floor_y, 0.0), 4.0)
-    return ss.Scene(occluders=[occ], receivers=[rec]), scenes.default_light(light_size)
 
 
 def moved(mesh, offset):
