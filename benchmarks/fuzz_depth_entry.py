@@ -5,7 +5,8 @@ extension's `_core.shadow_map_from_depth`, `_core.sample_points` and
 `_core.receiver_points` directly (past the Python checks). Inputs mix valid and
 hostile values: shapes from 1x1 up, every float dtype and some integer ones,
 NaN, +-inf, zeros, negative zeros, subnormals, 1e-30 to 1e30 depths, extreme
-light sizes and extents, odd sample counts, non-contiguous arrays.
+light sizes (point lights included) and extents, odd sample counts,
+non-contiguous arrays.
 
 Each call must either return a visibility map of the receiver map's shape,
 finite, in [0, 1] and 1 wherever there is no receiver or no occluder in front
@@ -123,7 +124,7 @@ def depth_case(draw):
     same = draw(st.booleans())
     occ = draw(depth_map(rec.shape if same else None))
     back = draw(mostly(st.one_of(st.none(), depth_map(occ.shape)), depth_map()))
-    size = (draw(sizes), draw(sizes))
+    size = draw(mostly(st.tuples(sizes, sizes), st.just((0.0, 0.0)), 19))  # (0, 0): a point light
     ext = (draw(extents), draw(extents))
     method = draw(methods)
     n = draw(samples) if method == "bitmask" else draw(mostly(st.none(), samples, 8))
@@ -167,7 +168,7 @@ def points_case(draw):
     occ = draw(depth_map())
     coords = mostly(st.floats(-5, 5), hostile_depths, 8)
     pts = draw(hnp.arrays(np.float64, (draw(st.integers(0, 40)), 3), elements=coords))
-    size = (draw(sizes), draw(sizes))
+    size = draw(mostly(st.tuples(sizes, sizes), st.just((0.0, 0.0)), 19))  # (0, 0): a point light
     ext = (draw(extents), draw(extents))
     w, h = draw(mostly(st.integers(1, 30), st.integers(-1, 0))), draw(st.integers(1, 30))
     method = draw(methods)

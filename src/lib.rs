@@ -14,6 +14,7 @@ pub mod memory;
 pub mod mesh;
 pub mod methods;
 pub mod pipeline;
+pub mod point_light;
 pub mod raster;
 pub mod units;
 

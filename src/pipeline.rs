@@ -3,10 +3,11 @@
 
 use crate::error::{Error, Result};
 use crate::extent::fit_extent;
-use crate::light::{check_light_size, MapGrid, RectLight};
+use crate::light::{check_light_size, is_point, MapGrid, RectLight};
 use crate::memory::{check_fits, map_bytes};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
+use crate::point_light;
 use crate::raster::{rasterize, Prepared};
 use crate::units::{check_lateral, check_unit, depth_unit, farthest, light_size_in, scaled_map};
 use glam::{DVec3, Vec3};
@@ -192,7 +193,7 @@ pub fn from_meshes(
         occluder_layers: layers,
         occluder_triangles: triangles.as_deref(),
     };
-    let visibility = s.method.implementation().visibility_map(&inputs);
+    let visibility = shade_map(s.method, &inputs);
     sw.lap("shadow");
     let (mut occluder_front, mut occluder_back) = match occ {
         Some(o) => (Some(o.nearest), o.farthest),
@@ -219,6 +220,25 @@ pub fn from_meshes(
         occluder_back,
         timings: sw.timings,
     })
+}
+
+/// Visibility of every receiver texel: the method's, or for a point light
+/// (size 0) on the map methods the hard shadow they converge to.
+fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
+    if is_point(inputs.light_size) && !method.traces_triangles() {
+        point_light::visibility_map(inputs)
+    } else {
+        method.implementation().visibility_map(inputs)
+    }
+}
+
+/// Visibility at receiver points, as `shade_map`.
+fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
+    if is_point(inputs.light_size) && !method.traces_triangles() {
+        point_light::visibility_points(inputs, pts)
+    } else {
+        method.implementation().visibility_points(inputs, pts)
+    }
 }
 
 /// Occluder triangles in light space, in f32 (relative to the light's center,
@@ -304,7 +324,7 @@ pub fn from_depth(
         occluder_layers: layers,
         occluder_triangles: None,
     };
-    let v = method.implementation().visibility_map(&inputs);
+    let v = shade_map(method, &inputs);
     sw.lap("shadow");
     Ok((v, sw.timings))
 }
@@ -423,10 +443,7 @@ pub fn sample_points(
         occluder_layers: layers.iter().map(|l| &l[..]).collect(),
         occluder_triangles: triangles.as_deref(),
     };
-    Ok((
-        method.implementation().visibility_points(&inputs, &ls),
-        inside,
-    ))
+    Ok((shade_points(method, &inputs, &ls), inside))
 }
 
 /// World points of the receiver texels (texel centers at their receiver

@@ -101,6 +101,9 @@ pub fn scaled_map(depth: &[f32], unit: f64) -> std::borrow::Cow<'_, [f32]> {
 /// The light's size in unit `unit`, refused when the kernels cannot resolve it.
 pub fn light_size_in(arg: &str, size: [f64; 2], unit: f64) -> Result<[f64; 2]> {
     let s = [size[0] / unit, size[1] / unit];
+    if crate::light::is_point(size) {
+        return Ok([0.0, 0.0]);
+    }
     if s.iter()
         .all(|x| (MIN_RELATIVE_SIZE..=MAX_RELATIVE_SIZE).contains(x))
     {
@@ -111,7 +114,7 @@ pub fn light_size_in(arg: &str, size: [f64; 2], unit: f64) -> Result<[f64; 2]> {
         format!(
             "{size:?} is {:?} times the receivers' depth ({unit:e}); the kernels compute in f32 \
              and resolve ratios in [{MIN_RELATIVE_SIZE:e}, {MAX_RELATIVE_SIZE:e}] (a smaller \
-             light casts the hard shadow: pass a size like 1e-6 times the depth for it)",
+             light casts the hard shadow: pass (0, 0) for a point light)",
             s
         ),
     ))

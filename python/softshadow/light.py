@@ -21,9 +21,9 @@ class RectLight:
 
     Raises ValueError for a non-finite center, a zero-length ``normal`` or
     ``up``, an ``up`` within 1e-6 rad of parallel to ``normal``, or a size that
-    is not finite and > 0. A point light (size 0) is refused: a light of size
-    1e-6 times the scene's depth gives its hard shadow (the methods converge to
-    it as the size shrinks).
+    is neither finite and > 0 nor (0, 0). Size (0, 0) is a point light: every
+    method then gives the hard shadow map, the limit they converge to as the
+    size shrinks.
     """
 
     center: tuple[float, float, float]

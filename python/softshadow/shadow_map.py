@@ -226,7 +226,8 @@ def soft_shadow_map(
 
     The light's size must lie within about [1e-30, 1e30] times the receivers'
     depth (the kernels compute in f32, in a depth unit near the receivers'
-    depth, so any scale of scene works); a tiny light gives the hard shadow.
+    depth, so any scale of scene works), or (0, 0): a point light, whose
+    shadow is the hard shadow map the methods converge to.
     Bad values raise ValueError or TypeError naming the argument; a map too
     large to allocate raises :class:`softshadow.TooLargeError` (a ValueError
     and a MemoryError) before allocating; an internal error raises
@@ -295,7 +296,8 @@ def soft_shadow_map_from_depth(
     zero and negative depths are refused (ValueError naming the map). Any
     real float array is accepted (converted to C-contiguous float32); integer
     and complex arrays raise TypeError. ``light_size`` must lie within
-    about [1e-30, 1e30] times the receivers' depth.
+    about [1e-30, 1e30] times the receivers' depth, or be (0, 0) for a
+    point light (hard shadows).
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
@@ -305,8 +307,8 @@ def soft_shadow_map_from_depth(
     if np.isscalar(light_size):
         light_size = (light_size, light_size)
     size = check.vector("light_size", light_size, 2)
-    if not all(s > 0 for s in size):
-        raise ValueError(f"light_size: must be > 0, got {list(size)}")
+    if not (all(s > 0 for s in size) or size == (0.0, 0.0)):
+        raise ValueError(f"light_size: must be > 0, or (0, 0) for a point light, got {list(size)}")
     ext = check.extent(extent)
     method = check.choice("method", method, METHODS)
     samples = _check_samples(samples, method)

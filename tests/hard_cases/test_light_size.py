@@ -1,10 +1,11 @@
-"""Point-light limit (size -> 0) and lights far larger than the scene.
+"""Point-light limit (size -> 0, and exactly 0) and lights far larger than the scene.
 
 As the light shrinks the penumbra's tangent half-width (L/2)(1/z_O - 1/z_R)
 falls below half a texel and every method returns the hard shadow map: 0
 where the occluder covers the receiver's direction, 1 elsewhere. A size of
-exactly 0 is refused (ValueError naming the size): pass a small one, as
-below. Sizes are resolved down to 1e-30 of the receivers' depth (units.rs).
+exactly (0, 0) is a point light and gives that map; sizes between 0 and
+1e-30 of the receivers' depth, which f32 cannot resolve, are refused
+(units.rs).
 """
 
 import numpy as np
@@ -41,12 +42,37 @@ def test_small_lights_converge_to_the_hard_shadow_from_meshes(method, backend, s
     np.testing.assert_allclose(sm.visibility, np.where(hard, 0.0, 1.0), atol=1e-6)
 
 
-def test_point_light_of_size_zero_is_refused():
-    with pytest.raises(ValueError, match="size"):
-        ss.RectLight(center=(0, 4, 0), normal=(0, -1, 0), up=(0, 0, 1), size=0.0)
+def test_point_light_of_size_zero_gives_the_hard_shadow(method, backend):
+    # Size (0, 0) is a point light: the map methods take the hard shadow they
+    # converge to (point_light.rs; their kernels divide by the size), exact
+    # sends every ray to the light's center. Same maps as a 1e-9 light.
+    scene, _ = scenes.square_plate()
+    point = ss.RectLight(center=(0, 4, 0), normal=(0, -1, 0), up=(0, 0, 1), size=0.0)
+    tiny = ss.RectLight(center=(0, 4, 0), normal=(0, -1, 0), up=(0, 0, 1), size=1e-9)
+    kw = dict(resolution=64, extent=EXT, **options(method, backend))
+    sm = ss.soft_shadow_map(scene, point, **kw)
+    x = plate.centers(64, 0.5)
+    hard = (np.abs(x) < 0.25)[None, :] & (np.abs(x) < 0.25)[:, None]
+    np.testing.assert_array_equal(sm.visibility, np.where(hard, 0.0, 1.0))
+    np.testing.assert_allclose(sm.visibility, ss.soft_shadow_map(scene, tiny, **kw).visibility, atol=1e-6)
+    pts, idx = sm.receiver_points()
+    np.testing.assert_array_equal(sm.sample(pts), sm.visibility.ravel()[idx])
+
+
+def test_point_light_from_depth_maps(map_method, backend):
+    occ, rec, _, _ = plate.maps(64, 64, EXT, RECT, 2.0, 4.0)
+    occ[0, 0] = 5.0  # behind the receiver: no shadow
+    v = ss.soft_shadow_map_from_depth(occ, rec, light_size=0.0, extent=EXT, **options(map_method, backend))
+    np.testing.assert_array_equal(v.visibility, np.where(occ < rec, 0.0, 1.0))
+
+
+@pytest.mark.parametrize("size", [(0.0, 1.0), (-0.0, -1.0)])
+def test_half_point_lights_are_refused(size):
+    with pytest.raises(ValueError, match="size.*point light"):
+        ss.RectLight(center=(0, 4, 0), normal=(0, -1, 0), up=(0, 0, 1), size=size)
     occ, rec, _, _ = plate.maps(8, 8, EXT, RECT, 2.0, 4.0)
     with pytest.raises(ValueError, match="light_size"):
-        ss.soft_shadow_map_from_depth(occ, rec, light_size=(0.0, 0.0), extent=EXT)
+        ss.soft_shadow_map_from_depth(occ, rec, light_size=size, extent=EXT)
 
 
 def test_size_below_what_f32_resolves_is_refused_by_name():
