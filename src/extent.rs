@@ -7,8 +7,13 @@
 //! z_far is the farthest receiver depth. Over a triangle |x| is convex and 1/Z
 //! is linear in the map's plane, so the bound's maximum is at a vertex: the
 //! extent is the largest bound over occluder vertices (and likewise in y). It
-//! is then cut to the receivers' own tangent extent when every receiver vertex
-//! lies in front of the light (shadows land on receivers only).
+//! is then cut, when every receiver vertex lies in front of the light, to the
+//! receivers' own tangent extent -- shadows land on receivers only -- or to
+//! the occluders' own (their vertices' largest |x|) where that is wider: the
+//! map methods see only occluders inside the map, and one just outside the
+//! receivers can shadow them. Never wider than the receivers' extent plus
+//! the largest penumbra reach Lx/2 (1/Z_O - 1/z_far): occluder points farther
+//! out cannot shadow a receiver.
 
 use crate::error::{Error, Result};
 use glam::DVec3;
@@ -43,16 +48,25 @@ pub fn fit_extent(
     }
     let inv_far = 1.0 / z_far;
     let mut ext = [0f64; 2];
+    // The occluders' own tangent extent, and their largest penumbra reach.
+    let mut own = [0f64; 2];
+    let mut reach = [0f64; 2];
     for q in occluders {
         let pen = (1.0 / q.z - inv_far).max(0.0);
-        ext[0] = ext[0].max((q.x / q.z).abs() + 0.5 * light_size[0] * pen);
-        ext[1] = ext[1].max((q.y / q.z).abs() + 0.5 * light_size[1] * pen);
+        let r = [0.5 * light_size[0] * pen, 0.5 * light_size[1] * pen];
+        let t = [(q.x / q.z).abs(), (q.y / q.z).abs()];
+        for a in 0..2 {
+            ext[a] = ext[a].max(t[a] + r[a]);
+            own[a] = own[a].max(t[a]);
+            reach[a] = reach[a].max(r[a]);
+        }
     }
     if receivers.iter().all(|q| q.z > 0.0) {
         let rx = in_front.clone().fold(0f64, |m, q| m.max((q.x / q.z).abs()));
         let ry = in_front.fold(0f64, |m, q| m.max((q.y / q.z).abs()));
-        ext[0] = ext[0].min(rx);
-        ext[1] = ext[1].min(ry);
+        for (a, r) in [rx, ry].into_iter().enumerate() {
+            ext[a] = ext[a].min(r.max(own[a]).min(r + reach[a]));
+        }
     }
     Ok([ext[0].max(MIN_EXTENT), ext[1].max(MIN_EXTENT)])
 }
@@ -69,10 +83,17 @@ mod tests {
         let e = fit_extent(&occ, &rec, [1.0, 0.5]).unwrap();
         // |x| = 0.125; penumbra 0.5 * (1/2 - 1/4) = 0.125 -> 0.25; y: 0.125 + 0.0625.
         assert!((e[0] - 0.25).abs() < 1e-15 && (e[1] - 0.1875).abs() < 1e-15);
-        // Small receivers cut it.
+        // Small receivers cut it, but not below the occluders' own extent
+        // (0.125: the map methods see only occluders inside the map, and
+        // this one's penumbra reaches the receivers).
         let rec = [DVec3::new(-0.4, -0.4, 4.0), DVec3::new(0.4, 0.4, 4.0)];
         let e = fit_extent(&occ, &rec, [1.0, 0.5]).unwrap();
-        assert!((e[0] - 0.1).abs() < 1e-15);
+        assert!((e[0] - 0.125).abs() < 1e-15, "{e:?}");
+        // Smaller receivers still: no wider than them plus the reach (an
+        // occluder point farther out cannot shadow them).
+        let rec = [DVec3::new(-0.1, -0.1, 4.0), DVec3::new(0.1, 0.1, 4.0)];
+        let e = fit_extent(&occ, &rec, [0.2, 0.2]).unwrap();
+        assert!((e[0] - (0.025 + 0.025)).abs() < 1e-15, "{e:?}");
     }
 
     #[test]

@@ -13,10 +13,13 @@ pub mod extent;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod light;
+pub mod memory;
 pub mod mesh;
 pub mod methods;
 pub mod pipeline;
+pub mod point_light;
 pub mod raster;
+pub mod units;
 
 #[cfg(feature = "python")]
 mod python;

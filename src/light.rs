@@ -36,16 +36,25 @@ fn finite3(arg: &str, a: [f64; 3]) -> Result<DVec3> {
     }
 }
 
-/// Checks a light size: both components finite and > 0.
+/// Checks a light size: both components finite and > 0, or both 0 (a point
+/// light: hard shadows, see point_light.rs).
 pub fn check_light_size(arg: &str, size: [f64; 2]) -> Result<[f64; 2]> {
-    if size.iter().all(|s| s.is_finite() && *s > 0.0) {
+    if size.iter().all(|s| s.is_finite() && *s > 0.0) || size == [0.0, 0.0] {
         Ok(size)
     } else {
         Err(Error::invalid(
             arg,
-            format!("must be two finite sizes > 0 (full width, full height), got {size:?}"),
+            format!(
+                "must be two finite sizes > 0 (full width, full height), or (0, 0) for a point \
+                 light, got {size:?}"
+            ),
         ))
     }
+}
+
+/// Whether a (checked) light size is a point light's.
+pub fn is_point(size: [f64; 2]) -> bool {
+    size == [0.0, 0.0]
 }
 
 impl RectLight {
@@ -122,6 +131,11 @@ pub struct MapGrid {
 /// size take 4 GiB; beyond it we refuse before allocating.
 pub const MAX_TEXELS: usize = 1 << 28;
 
+/// The widest tangent half-extent we accept (89.99994 degrees off the axis).
+/// The kernels hold tangents in f32 and multiply them by depths: far beyond
+/// this, texel positions overflow and shadows silently vanish.
+pub const MAX_EXTENT: f64 = 1e6;
+
 impl MapGrid {
     pub fn new(width: usize, height: usize, extent: [f64; 2]) -> Result<Self> {
         if width == 0 || height == 0 {
@@ -145,6 +159,12 @@ impl MapGrid {
             return Err(Error::invalid(
                 "extent",
                 format!("must be two finite tangent half-extents > 0, got {extent:?}"),
+            ));
+        }
+        if extent.iter().any(|t| *t > MAX_EXTENT) {
+            return Err(Error::invalid(
+                "extent",
+                format!("tangent half-extents must be <= {MAX_EXTENT:e}, got {extent:?}"),
             ));
         }
         Ok(MapGrid {
@@ -228,6 +248,7 @@ mod tests {
         assert!(RectLight::new(ok.0, [0.0; 3], ok.2, ok.3).is_err());
         assert!(RectLight::new(ok.0, ok.1, [0.0, 0.0, 5.0], ok.3).is_err());
         assert!(RectLight::new(ok.0, ok.1, ok.2, [0.0, 1.0]).is_err());
+        assert!(RectLight::new(ok.0, ok.1, ok.2, [-0.0, 0.0]).is_ok()); // a point light
         assert!(RectLight::new(ok.0, ok.1, ok.2, [1.0, f64::NAN]).is_err());
         assert!(RectLight::new([f64::INFINITY, 0.0, 0.0], ok.1, ok.2, ok.3).is_err());
     }
@@ -251,5 +272,7 @@ mod tests {
             Err(Error::TooLarge { .. })
         ));
         assert!(MapGrid::new(8, 8, [0.0, 1.0]).is_err());
+        assert!(MapGrid::new(8, 8, [1.0, 2e6]).is_err());
+        assert!(MapGrid::new(8, 8, [50.0, 1e6]).is_ok());
     }
 }

@@ -3,10 +3,13 @@
 
 use crate::error::{Error, Result};
 use crate::extent::fit_extent;
-use crate::light::{check_light_size, MapGrid, RectLight};
+use crate::light::{check_light_size, is_point, MapGrid, RectLight};
+use crate::memory::{check_fits, map_bytes};
 use crate::mesh::MeshRef;
 use crate::methods::{LightPoint, Method, ShadowInputs};
+use crate::point_light;
 use crate::raster::{rasterize, Prepared};
+use crate::units::{check_lateral, check_unit, depth_unit, farthest, light_size_in, scaled_map};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -90,11 +93,26 @@ fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
 /// A scene moved to light space with its map grids fitted: what both
 /// backends start from.
 pub(crate) struct FramedScene {
+    /// Light-space vertices in the kernels' depth unit (see units.rs).
     pub occ_ls: Vec<DVec3>,
     pub rec_ls: Vec<DVec3>,
     pub grid: MapGrid,
     pub occluder_grid: MapGrid,
     pub near: f64,
+    /// The depth unit (a power of two): maps go back to the user's units
+    /// by multiplying with it.
+    pub unit: f64,
+    /// The light's size in that unit.
+    pub light_size: [f64; 2],
+}
+
+/// Depth maps back in the user's units: powers of two, so exact.
+pub(crate) fn to_user_units<'a>(unit: f64, maps: impl Iterator<Item = &'a mut Vec<f32>>) {
+    if unit != 1.0 {
+        for m in maps {
+            m.par_iter_mut().for_each(|z| *z *= unit as f32);
+        }
+    }
 }
 
 /// Checks the input, moves the meshes to light space and fits the grids
@@ -124,15 +142,42 @@ pub(crate) fn frame_scene(
     let (ow, oh) = s.occluder_resolution.unwrap_or((s.width, s.height));
     MapGrid::new(ow, oh, s.extent.unwrap_or([1.0, 1.0]))
         .map_err(|e| Error::invalid("occluder_resolution", e.to_string()))?;
+    // Receiver and visibility maps; each occluder layer and the kernels'
+    // 1/depth copy of it.
+    let layers = if s.method.traces_triangles() {
+        0
+    } else {
+        s.passes as usize
+    };
+    check_fits(
+        "resolution",
+        &format!(
+            "{}x{} with {}x{} occluder maps and {} layers",
+            s.width, s.height, ow, oh, layers
+        ),
+        map_bytes(s.width * s.height, 2) + map_bytes(ow * oh, 2 * layers),
+    )?;
     occluders.validate("occluders")?;
     receivers.validate("receivers")?;
 
-    let occ_ls = occluders.to_light_space(light);
-    let rec_ls = receivers.to_light_space(light);
+    let mut occ_ls = occluders.to_light_space(light);
+    let mut rec_ls = receivers.to_light_space(light);
+    // Light space in the kernels' depth unit (see units.rs); maps go back to
+    // the user's units at the end.
+    let unit = depth_unit(rec_ls.iter().fold(0f64, |m, q| m.max(q.z)));
+    check_unit("receivers", unit)?;
+    let light_size = light_size_in("size", light.size, unit)?;
+    if unit != 1.0 {
+        for q in occ_ls.iter_mut().chain(rec_ls.iter_mut()) {
+            *q /= unit;
+        }
+    }
+    check_lateral("occluders", &occ_ls, unit)?;
+    check_lateral("receivers", &rec_ls, unit)?;
     sw.lap("transform");
     let extent = match s.extent {
         Some(e) => e,
-        None => fit_extent(&occ_ls, &rec_ls, light.size)?,
+        None => fit_extent(&occ_ls, &rec_ls, light_size)?,
     };
     let grid = MapGrid::new(s.width, s.height, extent)?;
     let occluder_grid = MapGrid::new(ow, oh, extent)?;
@@ -144,6 +189,8 @@ pub(crate) fn frame_scene(
         grid,
         occluder_grid,
         near,
+        unit,
+        light_size,
     })
 }
 
@@ -161,6 +208,8 @@ pub fn from_meshes(
         grid,
         occluder_grid,
         near,
+        unit,
+        light_size,
     } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
     let receiver = rasterize(&grid, &rec_ls, receivers.faces, near, false).nearest;
     sw.lap("raster_receivers");
@@ -194,17 +243,25 @@ pub fn from_meshes(
     let inputs = ShadowInputs {
         grid,
         occluder_grid,
-        light_size: light.size,
+        light_size,
         receiver: &receiver,
         occluder_layers: layers,
         occluder_triangles: triangles.as_deref(),
     };
-    let visibility = s.method.implementation().visibility_map(&inputs);
+    let visibility = shade_map(s.method, &inputs);
     sw.lap("shadow");
-    let (occluder_front, occluder_back) = match occ {
+    let (mut occluder_front, mut occluder_back) = match occ {
         Some(o) => (Some(o.nearest), o.farthest),
         None => (None, None),
     };
+    let mut receiver = receiver;
+    to_user_units(
+        unit,
+        std::iter::once(&mut receiver)
+            .chain(occluder_front.as_mut())
+            .chain(middle.iter_mut())
+            .chain(occluder_back.as_mut()),
+    );
     Ok(ShadowResult {
         grid,
         occluder_grid,
@@ -215,6 +272,25 @@ pub fn from_meshes(
         occluder_back,
         timings: sw.timings,
     })
+}
+
+/// Visibility of every receiver texel: the method's, or for a point light
+/// (size 0) on the map methods the hard shadow they converge to.
+fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
+    if is_point(inputs.light_size) && !method.traces_triangles() {
+        point_light::visibility_map(inputs)
+    } else {
+        method.implementation().visibility_map(inputs)
+    }
+}
+
+/// Visibility at receiver points, as `shade_map`.
+fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
+    if is_point(inputs.light_size) && !method.traces_triangles() {
+        point_light::visibility_points(inputs, pts)
+    } else {
+        method.implementation().visibility_points(inputs, pts)
+    }
 }
 
 /// Occluder triangles in light space, in f32 (relative to the light's center,
@@ -297,19 +373,33 @@ pub fn from_depth(
         method,
     )?;
     let mut sw = Stopwatch::new();
-    let mut layers = vec![front];
-    if let Some(b) = back {
+    // The kernels' depth unit (see units.rs): copies only far from 1.
+    let unit = depth_unit(farthest(receiver));
+    // Visibility, the kernels' 1/depth layers, and the copies in that unit.
+    let copies = if unit == 1.0 { 0 } else { 1 };
+    let layers = 1 + back.is_some() as usize;
+    check_fits(
+        "receiver_depth",
+        &format!("{}x{} maps", grid.width, grid.height),
+        map_bytes(grid.len(), 1 + copies) + map_bytes(occluder_grid.len(), layers * (1 + copies)),
+    )?;
+    let light_size = light_size_in("light_size", light_size, unit)?;
+    let front = scaled_map(front, unit);
+    let back = back.map(|b| scaled_map(b, unit));
+    let receiver = scaled_map(receiver, unit);
+    let mut layers: Vec<&[f32]> = vec![&front];
+    if let Some(b) = &back {
         layers.push(b);
     }
     let inputs = ShadowInputs {
         grid: *grid,
         occluder_grid: *occluder_grid,
         light_size,
-        receiver,
+        receiver: &receiver,
         occluder_layers: layers,
         occluder_triangles: None,
     };
-    let v = method.implementation().visibility_map(&inputs);
+    let v = shade_map(method, &inputs);
     sw.lap("shadow");
     Ok((v, sw.timings))
 }
@@ -344,31 +434,39 @@ pub fn sample_points(
             format!("point {k} is not finite: {:?}", points[k]),
         ));
     }
-    let (ls, inside): (Vec<LightPoint>, Vec<bool>) = points
+    let ls_points: Vec<DVec3> = points
         .par_iter()
-        .map(|p| {
-            let q = light.to_light(DVec3::from_array(*p));
-            if !(q.z > 0.0) {
-                return (
-                    LightPoint {
-                        x: 0.0,
-                        y: 0.0,
-                        z: f32::INFINITY,
-                    },
-                    false,
-                );
+        .map(|p| light.to_light(DVec3::from_array(*p)))
+        .collect();
+    let inside_map =
+        |q: &DVec3| q.z > 0.0 && (q.x / q.z).abs() <= grid.tx && (q.y / q.z).abs() <= grid.ty;
+    // The kernels' depth unit (see units.rs), from the points inside the map.
+    let unit = depth_unit(
+        ls_points
+            .iter()
+            .filter(|q| inside_map(q))
+            .fold(0f64, |m, q| m.max(q.z)),
+    );
+    check_unit("points", unit)?;
+    let light_size = light_size_in("size", light.size, unit)?;
+    let (ls, inside): (Vec<LightPoint>, Vec<bool>) = ls_points
+        .par_iter()
+        .map(|q| {
+            if !inside_map(q) {
+                // Outside the map, or at or behind the light's plane.
+                let lp = LightPoint {
+                    x: 0.0,
+                    y: 0.0,
+                    z: f32::INFINITY,
+                };
+                return (lp, false);
             }
-            let (x, y) = (q.x / q.z, q.y / q.z);
-            let inside = x.abs() <= grid.tx && y.abs() <= grid.ty;
-            let z = if inside { q.z as f32 } else { f32::INFINITY };
-            (
-                LightPoint {
-                    x: x as f32,
-                    y: y as f32,
-                    z,
-                },
-                inside,
-            )
+            let lp = LightPoint {
+                x: (q.x / q.z) as f32,
+                y: (q.y / q.z) as f32,
+                z: (q.z / unit) as f32,
+            };
+            (lp, true)
         })
         .unzip();
     let (layers, triangles, occluder_grid) = match occluders {
@@ -379,7 +477,23 @@ pub fn sample_points(
                     "traces triangles: pass the occluder mesh",
                 ));
             }
-            (layers, None, og)
+            for (k, l) in layers.iter().enumerate() {
+                let arg = format!("occluder layer {k}");
+                if l.len() != og.len() {
+                    return Err(Error::shape(
+                        arg,
+                        format!(
+                            "has {} texels, expected {}x{}",
+                            l.len(),
+                            og.height,
+                            og.width
+                        ),
+                    ));
+                }
+                check_depth(&arg, l)?;
+            }
+            let scaled: Vec<_> = layers.iter().map(|l| scaled_map(l, unit)).collect();
+            (scaled, None, og)
         }
         OccluderSource::Mesh(mesh) => {
             if !method.traces_triangles() {
@@ -389,7 +503,9 @@ pub fn sample_points(
                 ));
             }
             mesh.validate("occluders")?;
-            let ls = mesh.to_light_space(light);
+            let mut ls = mesh.to_light_space(light);
+            ls.iter_mut().for_each(|q| *q /= unit);
+            check_lateral("occluders", &ls, unit)?;
             (vec![], Some(light_space_triangles(&ls, mesh.faces)), *grid)
         }
     };
@@ -397,15 +513,12 @@ pub fn sample_points(
     let inputs = ShadowInputs {
         grid: *grid,
         occluder_grid,
-        light_size: light.size,
+        light_size,
         receiver: &[],
-        occluder_layers: layers,
+        occluder_layers: layers.iter().map(|l| &l[..]).collect(),
         occluder_triangles: triangles.as_deref(),
     };
-    Ok((
-        method.implementation().visibility_points(&inputs, &ls),
-        inside,
-    ))
+    Ok((shade_points(method, &inputs, &ls), inside))
 }
 
 /// World points of the receiver texels (texel centers at their receiver
@@ -425,4 +538,65 @@ pub fn receiver_points(
             (p.to_array(), k as u64)
         })
         .unzip()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A texel-aligned plate at depth 2 over receivers at depth 4, times `s`.
+    fn plate_maps(n: usize, s: f32) -> (Vec<f32>, Vec<f32>) {
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let front = (0..n * n)
+            .map(|k| {
+                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
+                if x.abs() < 0.25 && y.abs() < 0.2 {
+                    2.0 * s
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        (front, vec![4.0 * s; n * n])
+    }
+
+    #[test]
+    fn depth_maps_at_any_power_of_two_scale_give_the_same_visibility() {
+        // The kernels get depths in a unit near the receivers' (units.rs):
+        // without it the SSM loses these shadows at 2^60 and 2^-70.
+        let n = 24;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let ssm = Method::parse("ssm", None, None, None).unwrap();
+        let bitmask = Method::parse("bitmask", Some(64), None, None).unwrap();
+        for method in [ssm, bitmask] {
+            let (f, r) = plate_maps(n, 1.0);
+            let (base, _) = from_depth(&grid, &grid, [1.0, 0.6], &f, None, &r, method).unwrap();
+            assert!(base.iter().any(|&v| v < 1e-6));
+            for k in [-90, -70, 50, 60, 90] {
+                let s = 2f32.powi(k);
+                let (f, r) = plate_maps(n, s);
+                let size = [s as f64, 0.6 * s as f64];
+                let (v, _) = from_depth(&grid, &grid, size, &f, None, &r, method).unwrap();
+                assert_eq!(v, base, "{method:?} at 2^{k}");
+            }
+        }
+    }
+
+    #[test]
+    fn light_sizes_beyond_f32_relative_to_depth_are_refused() {
+        let n = 8;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let (f, r) = plate_maps(n, 1.0);
+        let err = from_depth(
+            &grid,
+            &grid,
+            [1e-35, 1.0],
+            &f,
+            None,
+            &r,
+            Method::parse("ssm", None, None, None).unwrap(),
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::InvalidArgument { ref arg, .. } if arg == "light_size"));
+    }
 }

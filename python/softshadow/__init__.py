@@ -6,6 +6,7 @@ See the README for the conventions.
 """
 
 from ._core import __version__
+from ._validate import TooLargeError
 from .backend import GpuUnavailableError, gpu_available, gpu_info
 from .light import RectLight
 from .scene import Scene
@@ -16,6 +17,7 @@ __all__ = [
     "RectLight",
     "Scene",
     "ShadowMap",
+    "TooLargeError",
     "soft_shadow_map",
     "soft_shadow_map_from_depth",
     "gpu_available",

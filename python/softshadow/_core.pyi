@@ -3,8 +3,13 @@ these functions take already-validated, C-contiguous arrays.
 
 Every function raises ValueError, its message starting with the argument's
 name, when a value is refused (non-finite vertices, out-of-range indices, a
-degenerate light, depths that are not > 0 or +inf, an absurd resolution).
-The work runs with the GIL released.
+degenerate light, depths that are not > 0 or +inf, negative counts, a light
+size the f32 kernels cannot resolve); softshadow.TooLargeError (a ValueError
+and a MemoryError) for an absurd resolution, before allocating. Arrays of the
+wrong dtype or number of dimensions raise TypeError from pyo3, which names
+the argument in a note ("while processing 'occluder_depth'"); non-contiguous
+arrays raise ValueError. A panic in the core (a bug) raises RuntimeError;
+the module stays usable. The work runs with the GIL released.
 """
 
 from typing import Any
@@ -106,3 +111,7 @@ def gpu_info() -> dict[str, Any]:
     ``device_type`` ("discrete_gpu", "integrated_gpu", "virtual_gpu", "cpu"
     or "other"), ``driver`` and ``software`` (bool: a CPU renderer). Raises
     GpuUnavailableError when there is none."""
+
+def _panic_for_tests(in_worker: bool) -> None:
+    """Panics on purpose (in a rayon worker thread when ``in_worker``) to test
+    that panics become RuntimeError. Not part of the API."""

@@ -11,8 +11,15 @@ from typing import Any
 
 import numpy as np
 
-# Keep in sync with MAX_TEXELS in src/light.rs: the core refuses larger maps too.
+# Keep in sync with MAX_TEXELS and MAX_EXTENT in src/light.rs: the core
+# refuses larger maps and wider extents too.
 MAX_TEXELS = 1 << 28
+MAX_EXTENT = 1e6
+
+
+class TooLargeError(ValueError, MemoryError):
+    """A request refused before allocating because it would need too much
+    memory. Both a ValueError (a bad argument) and a MemoryError."""
 
 
 def vector(name: str, value: Any, n: int) -> tuple[float, ...]:
@@ -45,7 +52,7 @@ def resolution(value: Any, name: str = "resolution") -> tuple[int, int]:
     if w < 1 or h < 1:
         raise ValueError(f"{name}: must be at least 1x1, got {w}x{h}")
     if w * h > MAX_TEXELS:
-        raise ValueError(f"{name}: {w}x{h} would need {w * h * 4} bytes per map (limit {MAX_TEXELS} texels)")
+        raise TooLargeError(f"{name}: {w}x{h} would need {w * h * 4} bytes per map (limit {MAX_TEXELS} texels)")
     return w, h
 
 
@@ -61,6 +68,8 @@ def extent(value: Any) -> tuple[float, float]:
         raise ValueError(f"extent: must be (tx, ty), got shape {a.shape}")
     if not (np.all(np.isfinite(a)) and np.all(a > 0)):
         raise ValueError(f"extent: must be finite and > 0, got {a.tolist()}")
+    if np.any(a > MAX_EXTENT):
+        raise ValueError(f"extent: tangent half-extents must be <= {MAX_EXTENT:g}, got {a.tolist()}")
     return float(a[0]), float(a[1])
 
 

@@ -34,15 +34,25 @@ def write_exr(path: str | os.PathLike[str], channels: dict[str, Any] | Any) -> N
     if len(shapes) != 1:
         raise ValueError(f"channels: all maps must share one shape, got {sorted(shapes)}")
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    folder = os.path.dirname(os.path.abspath(os.fspath(path)))
+    if not os.path.isdir(folder):
+        raise FileNotFoundError(f"path: folder {folder!r} does not exist")
     OpenEXR.File(header, data).write(os.fspath(path))
 
 
 def read_exr(path: str | os.PathLike[str]) -> dict[str, np.ndarray]:
-    """Reads every channel of an EXR file as arrays."""
+    """Reads every channel of an EXR file as arrays. A missing file raises
+    FileNotFoundError, one OpenEXR cannot read ValueError (both name it)."""
     import OpenEXR
 
-    with OpenEXR.File(os.fspath(path)) as f:
-        return {k: np.array(c.pixels) for k, c in f.channels().items()}
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        raise FileNotFoundError(f"path: no such file {p!r}")
+    try:
+        with OpenEXR.File(p) as f:
+            return {k: np.array(c.pixels) for k, c in f.channels().items()}
+    except RuntimeError as e:  # OpenEXR's only error type
+        raise ValueError(f"path: {p!r} is not an EXR file OpenEXR can read ({e})") from e
 
 
 def to_uint8(a: Any, *, lo: float = 0.0, hi: float = 1.0) -> np.ndarray:

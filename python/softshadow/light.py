@@ -20,7 +20,10 @@ class RectLight:
     width along ``u`` and the full height along ``v``.
 
     Raises ValueError for a non-finite center, a zero-length ``normal`` or
-    ``up``, an ``up`` parallel to ``normal``, or a size that is not finite and > 0.
+    ``up``, an ``up`` within 1e-6 rad of parallel to ``normal``, or a size that
+    is neither finite and > 0 nor (0, 0). Size (0, 0) is a point light: every
+    method then gives the hard shadow map, the limit they converge to as the
+    size shrinks.
     """
 
     center: tuple[float, float, float]

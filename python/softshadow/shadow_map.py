@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,6 +30,8 @@ DEFAULT_HIERARCHY = {"ssm": False, "bitmask": True}
 PRECISIONS = ("f32", "f64", "f16", "f16-batched")
 DEFAULT_SAMPLES = 256  # keep in sync with DEFAULT_SAMPLES in src/methods/mod.rs
 MAX_PASSES = 8  # keep in sync with MAX_PASSES in src/pipeline.rs
+# The backends a result can come from ("auto" picks one of them).
+BACKENDS = tuple(b for b in backends.BACKENDS if b != "auto")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -109,7 +112,14 @@ class ShadowMap:
         light's plane) get ``outside``; by default that is 1.0 when the extent
         was fitted (no shadow can fall there) and a ValueError otherwise.
         """
-        pts = np.asarray(points, dtype=np.float64)
+        pts = np.asarray(points)
+        if pts.dtype.kind not in "fiu":
+            raise TypeError(f"points: must be real numbers, got dtype {pts.dtype}")
+        pts = pts.astype(np.float64, copy=False)
+        if outside is not None:
+            # Any number, NaN included (a marker for points off the map).
+            if isinstance(outside, bool) or not isinstance(outside, numbers.Real):
+                raise TypeError(f"outside: must be a number or None, got {type(outside).__name__}")
         if pts.ndim != 2 or pts.shape[1] != 3:
             raise ValueError(f"points: must have shape (N, 3), got {pts.shape}")
         if not np.isfinite(pts).all():
@@ -237,8 +247,14 @@ def soft_shadow_map(
         ``z`` shadows at most ``|x| + (Lx/2)(1/z - 1/z_far)`` away from the
         light's axis, ``z_far`` being the farthest receiver depth; the extent is
         the largest such bound over occluder vertices (exact for triangles), cut
-        to the receivers' own extent. Fitting needs every occluder vertex in
-        front of the light's plane.
+        to the receivers' own extent, or to the occluders' own where that is
+        wider (by no more than the largest penumbra reach): the map methods
+        see only occluders inside the map, and one just outside the
+        receivers can shadow them. Fitting needs every occluder vertex in
+        front of the light's plane. Tangent half-extents are at most 1e6.
+        Geometry at or behind the light's plane casts no shadow (it is
+        clipped), and an occluder at or beyond a receiver's depth does not
+        shadow that receiver.
     passes
         The occluder depth layers: 1, the front; 2, front and back (§3.5 of
         the paper); 3 to 8, front, ``passes - 2`` layers found by depth
@@ -302,6 +318,15 @@ def soft_shadow_map(
         raises ``GpuUnavailableError``. ``"auto"``: the GPU when a real
         (non-software) one is present, else the CPU. ``timings`` then hold the device's stages
         (``gpu_*``, from timestamp queries where the adapter has them).
+
+    The light's size must lie within about [1e-30, 1e30] times the receivers'
+    depth (the kernels compute in f32, in a depth unit near the receivers'
+    depth, so any scale of scene works), or (0, 0): a point light, whose
+    shadow is the hard shadow map the methods converge to.
+    Bad values raise ValueError or TypeError naming the argument; a map too
+    large to allocate raises :class:`softshadow.TooLargeError` (a ValueError
+    and a MemoryError) before allocating; an internal error raises
+    RuntimeError and leaves the module usable.
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
@@ -374,6 +399,13 @@ def soft_shadow_map_from_depth(
     frame. ``method``, ``samples``, ``hierarchy``, ``precision`` and
     ``backend`` are as for :func:`soft_shadow_map` (``"gpu"``: the maps go up
     once, the shading runs on the device, the visibility comes back).
+
+    Depths may be any float32 value > 0 (subnormal to 3.4e38) or +inf; NaN,
+    zero and negative depths are refused (ValueError naming the map). Any
+    real float array is accepted (converted to C-contiguous float32); integer
+    and complex arrays raise TypeError. ``light_size`` must lie within
+    about [1e-30, 1e30] times the receivers' depth, or be (0, 0) for a
+    point light (hard shadows).
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
@@ -383,8 +415,8 @@ def soft_shadow_map_from_depth(
     if np.isscalar(light_size):
         light_size = (light_size, light_size)
     size = check.vector("light_size", light_size, 2)
-    if not all(s > 0 for s in size):
-        raise ValueError(f"light_size: must be > 0, got {list(size)}")
+    if not (all(s > 0 for s in size) or size == (0.0, 0.0)):
+        raise ValueError(f"light_size: must be > 0, or (0, 0) for a point light, got {list(size)}")
     ext = check.extent(extent)
     method = check.choice("method", method, (*METHODS, AUTO))
     if method == AUTO:

@@ -9,10 +9,20 @@ use super::gather;
 use super::readback::{submit_and_read, visibility, with_error_scopes};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
-use crate::error::Result;
-use crate::light::MapGrid;
+use crate::error::{Error, Result};
+use crate::light::{is_point, MapGrid};
 use crate::methods::Method;
 use crate::pipeline::{check_depth_inputs, Stopwatch, Timings};
+use crate::units::{depth_unit, farthest, light_size_in, scaled_map};
+
+/// A point light (size 0) has no GPU kernel: its hard shadow map is the
+/// CPU's (`point_light.rs`).
+pub(super) fn point_light_on_gpu(arg: &str) -> Error {
+    Error::invalid(
+        arg,
+        "a point light (size 0) runs on the CPU backend only; use backend=\"cpu\"",
+    )
+}
 
 /// `pipeline::from_depth` on the GPU: the same checks, result and stage
 /// names (plus the device's).
@@ -35,6 +45,18 @@ pub fn from_depth(
         method,
     )?;
     gather::check_method(method)?;
+    // The kernels' depth unit, as on the CPU (see units.rs).
+    let unit = depth_unit(farthest(receiver));
+    let light_size = light_size_in("light_size", light_size, unit)?;
+    if is_point(light_size) {
+        return Err(point_light_on_gpu("light_size"));
+    }
+    let (front, back, receiver) = (
+        scaled_map(front, unit),
+        back.map(|b| scaled_map(b, unit)),
+        scaled_map(receiver, unit),
+    );
+    let (front, back, receiver) = (&front[..], back.as_deref(), &receiver[..]);
     check_side("receiver_depth", (grid.width, grid.height))?;
     check_side(
         "occluder_depth",

@@ -10,17 +10,19 @@
 use super::context::gpu;
 use super::dispatch::storage;
 use super::exact::ExactShading;
+use super::from_depth::point_light_on_gpu;
 use super::gather;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::light::RectLight;
+use crate::light::{is_point, RectLight};
 use crate::mesh::MeshRef;
 use crate::methods::Method;
 use crate::pipeline::{
-    frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
+    frame_scene, light_space_triangles, to_user_units, FramedScene, MapSettings, ShadowResult,
+    Stopwatch,
 };
 use crate::raster::setup_triangles;
 
@@ -75,7 +77,12 @@ pub fn from_meshes(
         grid,
         occluder_grid,
         near,
+        unit,
+        light_size,
     } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
+    if is_point(light_size) {
+        return Err(point_light_on_gpu("size"));
+    }
     // Occluder depth layers in `maps` after the receiver's (none when traced).
     let layers = if traced { 0 } else { s.passes };
     let passes = layers as usize;
@@ -100,14 +107,14 @@ pub fn from_meshes(
         let shading = match s.method {
             Method::Exact { samples } => {
                 let t = light_space_triangles(&occ_ls, occluders.faces);
-                Stage::Rays(ExactShading::new(g, &grid, t, samples, light.size))
+                Stage::Rays(ExactShading::new(g, &grid, t, samples, light_size))
             }
             _ => Stage::Maps(Shading::new(
                 g,
                 s.method,
                 &grid,
                 &occluder_grid,
-                light.size,
+                light_size,
                 layers,
                 w_max,
             )),
@@ -166,13 +173,20 @@ pub fn from_meshes(
             })
             .collect()
     };
-    let receiver: Vec<f32> = maps[..rec_len].iter().map(|&b| f32::from_bits(b)).collect();
-    let front = (!traced).then(|| map_of(0, false));
-    let middle: Vec<Vec<f32>> = (1..passes.saturating_sub(1))
+    let mut receiver: Vec<f32> = maps[..rec_len].iter().map(|&b| f32::from_bits(b)).collect();
+    let mut front = (!traced).then(|| map_of(0, false));
+    let mut middle: Vec<Vec<f32>> = (1..passes.saturating_sub(1))
         .map(|k| map_of(k, false))
         .collect();
     // The farthest layer starts at 0 (before the atomicMax): 0 means empty.
-    let back = (passes >= 2).then(|| map_of(passes - 1, true));
+    let mut back = (passes >= 2).then(|| map_of(passes - 1, true));
+    to_user_units(
+        unit,
+        std::iter::once(&mut receiver)
+            .chain(front.as_mut())
+            .chain(middle.iter_mut())
+            .chain(back.as_mut()),
+    );
     Ok(ShadowResult {
         grid,
         occluder_grid,

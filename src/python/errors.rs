@@ -1,8 +1,10 @@
-//! The one place where core errors become Python exceptions.
+//! The one place where core errors (and panics) become Python exceptions.
 
 use crate::error::Error;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
-use pyo3::PyErr;
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyType;
+use std::panic::{catch_unwind, AssertUnwindSafe};
 
 pyo3::create_exception!(
     _core,
@@ -13,14 +15,47 @@ pyo3::create_exception!(
 
 impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
+        let msg = e.to_string();
         match e {
-            // All three are about an argument's value (or the size it asks for),
-            // and the message starts with the argument's name.
-            Error::InvalidArgument { .. }
-            | Error::ShapeMismatch { .. }
-            | Error::TooLarge { .. } => PyValueError::new_err(e.to_string()),
-            Error::GpuUnavailable { .. } => GpuUnavailableError::new_err(e.to_string()),
-            Error::Gpu { .. } => PyRuntimeError::new_err(e.to_string()),
+            Error::GpuUnavailable { .. } => GpuUnavailableError::new_err(msg),
+            Error::Gpu { .. } => PyRuntimeError::new_err(msg),
+            // About an argument's value; the message starts with its name.
+            Error::InvalidArgument { .. } | Error::ShapeMismatch { .. } => {
+                PyValueError::new_err(msg)
+            }
+            // Refused before allocating: softshadow.TooLargeError, both a
+            // ValueError (a bad argument) and a MemoryError.
+            Error::TooLarge { .. } => Python::attach(|py| {
+                match py
+                    .import("softshadow._validate")
+                    .and_then(|m| m.getattr("TooLargeError"))
+                    .and_then(|c| Ok(c.cast_into::<PyType>()?))
+                {
+                    Ok(cls) => PyErr::from_type(cls, msg),
+                    Err(_) => PyMemoryError::new_err(msg),
+                }
+            }),
+        }
+    }
+}
+
+/// Runs `f`, turning a panic (a bug in the core: every refusal of input is an
+/// `Error`) into a RuntimeError instead of pyo3's PanicException, which is a
+/// BaseException that `except Exception` does not catch. Panics in rayon's
+/// worker threads reach here too: rayon resumes them on the calling thread.
+/// Nothing the core shares outlives a call, so the next call starts clean.
+pub fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(PyRuntimeError::new_err(format!(
+                "softshadow internal error (a bug; please report it with the input): {what}"
+            )))
         }
     }
 }

@@ -1,0 +1,32 @@
+"""Shared parameters of the hard cases: every method and backend the package
+offers joins every test through these lists (a new backend or method is
+tested by adding it to softshadow.shadow_map, nothing here)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from softshadow.shadow_map import BACKENDS, METHODS, TRACING_METHODS
+
+__all__ = ["BACKENDS", "MAP_METHODS", "METHODS", "SAMPLES", "assert_visibility", "options"]
+
+# Methods that read depth maps (so work from soft_shadow_map_from_depth).
+MAP_METHODS = tuple(m for m in METHODS if m not in TRACING_METHODS)
+# Samples for the sampling methods in these tests: enough to resolve the
+# numbers asserted, few enough to keep the suite fast.
+SAMPLES = {"bitmask": 256, "exact": 256}
+
+
+def options(method: str, backend: str) -> dict:
+    """Keyword arguments for method and backend."""
+    kw = {"method": method, "backend": backend}
+    if method in SAMPLES:
+        kw["samples"] = SAMPLES[method]
+    return kw
+
+
+def assert_visibility(v: np.ndarray) -> None:
+    """Every visibility map: float32, finite, in [0, 1]."""
+    assert v.dtype == np.float32
+    assert np.isfinite(v).all(), "non-finite visibility"
+    assert v.min() >= 0.0 and v.max() <= 1.0, (float(v.min()), float(v.max()))

@@ -1,0 +1,296 @@
+"""Bad input at every public entry point, beyond tests/test_inputs.py.
+
+Each case raises ValueError, TypeError or MemoryError (TooLargeError is both
+a ValueError and a MemoryError) whose message starts with the argument's
+name -- for the extension's own functions, pyo3's conversion errors name it
+in a note ("while processing 'occluder_depth'"). After every case a good call
+still works (the autouse fixture).
+"""
+
+import numpy as np
+import pytest
+
+import softshadow as ss
+from softshadow import _core, io, scenes
+
+
+def _good_depth(n=8):
+    occ = np.full((n, n), np.inf, np.float32)
+    occ[2:5, 2:5] = 2.0
+    return occ, np.full((n, n), 4.0, np.float32)
+
+
+@pytest.fixture(autouse=True)
+def still_works_afterwards():
+    yield
+    occ, rec = _good_depth()
+    v = ss.soft_shadow_map_from_depth(occ, rec, light_size=1.0, extent=0.5).visibility
+    assert v.min() < 0.5 and v.max() == 1.0
+    scene, light = scenes.square_plate()
+    assert ss.soft_shadow_map(scene, light, resolution=8, method="exact", samples=4).visibility.min() == 0.0
+
+
+LIGHT = ((0.0, 4.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0))
+
+
+def test_absurd_resolutions_are_refused_before_allocating_as_memory_errors():
+    scene, light = scenes.square_plate()
+    for kw in (dict(resolution=(1 << 15, 1 << 14)), dict(occluder_resolution=1 << 20)):
+        with pytest.raises(MemoryError, match=r"resolution: .* would need \d+ bytes") as e:
+            ss.soft_shadow_map(scene, light, **kw)
+        assert isinstance(e.value, ValueError) and isinstance(e.value, ss.TooLargeError)
+    # The core refuses it too, by the same type, before touching the meshes.
+    v, f = scene.occluder_mesh
+    with pytest.raises(ss.TooLargeError, match="resolution.*bytes"):
+        _core.shadow_map_from_meshes(v, f, v, f, LIGHT, 1 << 20, 1 << 20, None, 1, "ssm")
+
+
+def test_maps_larger_than_the_memory_available_are_refused_before_allocating(monkeypatch):
+    # Rust aborts the process when an allocation fails, so the core adds up
+    # its maps' bytes first and compares them with MemAvailable, or with the
+    # cap SOFTSHADOW_MEMORY_LIMIT (set small here to stand for a small machine).
+    scene, light = scenes.square_plate()
+    monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "100000")
+    assert ss.soft_shadow_map(scene, light, resolution=32).visibility.shape == (32, 32)
+    with pytest.raises(ss.TooLargeError, match=r"resolution: 1024x1024 .* 25165824 bytes .* 100000 bytes"):
+        ss.soft_shadow_map(scene, light, resolution=1024)
+    occ = np.full((1024, 1024), np.inf, np.float32)
+    with pytest.raises(MemoryError, match="receiver_depth: 1024x1024 maps would need"):
+        ss.soft_shadow_map_from_depth(occ, occ, light_size=1.0, extent=0.5)
+    monkeypatch.delenv("SOFTSHADOW_MEMORY_LIMIT")
+    assert ss.soft_shadow_map(scene, light, resolution=1024, method="exact", samples=1).visibility.min() == 0.0
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, words",
+    [
+        (dict(samples=0), ValueError, "samples"),
+        (dict(samples=-16), ValueError, "samples"),
+        (dict(samples=24), ValueError, "samples.*16, 64, 256"),  # bitmask's counts
+        (dict(samples=16.0), TypeError, "samples"),
+        (dict(samples=True), TypeError, "samples"),
+        (dict(method=None), TypeError, "method"),
+        (dict(passes=True), TypeError, "passes"),
+        (dict(extent=(2e6, 1.0)), ValueError, "extent"),
+        (dict(occluder_resolution=(8, -1)), ValueError, "occluder_resolution"),
+    ],
+)
+def test_bad_options_for_the_sampling_methods(kwargs, exc, words):
+    scene, light = scenes.square_plate()
+    kw = dict(method="bitmask", resolution=8)
+    kw.update(kwargs)
+    with pytest.raises(exc, match=words):
+        ss.soft_shadow_map(scene, light, **kw)
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, words",
+    [
+        (dict(center=(0, 0)), ValueError, "center"),
+        (dict(center="origin"), TypeError, "center"),
+        (dict(center=(0, np.inf, 0)), ValueError, "center"),
+        (dict(normal=(0, 0, 0)), ValueError, "normal.*zero"),
+        (dict(up=(0, 0, 0)), ValueError, "up.*zero"),
+        (dict(up=(0, 1, 0)), ValueError, "up.*parallel"),  # anti-parallel to normal
+        (dict(up=(1e-9, 1, 0)), ValueError, "up.*parallel"),  # within 1e-6 rad
+        (dict(size=-1.0), ValueError, "size"),
+        (dict(size=(1.0, np.inf)), ValueError, "size"),
+        (dict(size=(1.0, np.nan)), ValueError, "size"),
+        (dict(size=(1.0, 2.0, 3.0)), ValueError, "size"),
+    ],
+)
+def test_bad_lights(kwargs, exc, words):
+    args = dict(center=(0, 4, 0), normal=(0, -1, 0), up=(0, 0, 1), size=1.0)
+    args.update(kwargs)
+    with pytest.raises(exc, match=words):
+        ss.RectLight(**args)
+
+
+def test_up_nearly_but_not_parallel_is_accepted():
+    light = ss.RectLight(center=(0, 4, 0), normal=(0, -1, 0), up=(1e-3, 1, 0), size=1.0)
+    np.testing.assert_allclose(light.v, (1, 0, 0), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "mesh, exc, words",
+    [
+        ((np.array([[0, 0, np.inf], [1, 0, 0], [0, 1, 0]]), [[0, 1, 2]]), ValueError, r"occluders\[0\].*vertex 0"),
+        ((np.zeros((3, 3), bool), [[0, 1, 2]]), TypeError, r"occluders\[0\].*vertices"),
+        ((np.zeros((3, 3)).astype(object), [[0, 1, 2]]), TypeError, r"occluders\[0\].*vertices"),
+        ((np.zeros((3, 3)), np.array([[0, 1, 2**32]], np.int64)), ValueError, r"occluders\[0\].*indices"),
+        ((np.zeros((3, 3)), np.zeros((1, 3, 1), np.int32)), ValueError, r"occluders\[0\].*faces"),
+    ],
+)
+def test_bad_meshes(mesh, exc, words):
+    with pytest.raises(exc, match=words):
+        ss.Scene(occluders=[mesh], receivers=[scenes.floor()])
+
+
+def test_degenerate_open_and_non_manifold_meshes_are_accepted():
+    # Degenerate triangles (repeated or collinear vertices) cover no texel and
+    # hit no ray; open meshes (a plate) and non-manifold ones (three
+    # triangles on one edge, duplicated faces) are surfaces like any other:
+    # the occluder maps and the ray caster need no volume.
+    plate_v, plate_f = scenes.quad((0.0, 2.0, 0.0), 0.5)
+    degenerate = np.array([[0, 0, 1], [1, 1, 1], [2, 3, 2]], np.uint32)
+    collinear_v = np.array([[-0.5, 2.0, 0.0], [0.0, 2.0, 0.0], [0.5, 2.0, 0.0]])
+    # A vertical fin on the plate's middle line: three faces share an edge.
+    fin_v = np.array([[-0.5, 2.0, 0.0], [0.5, 2.0, 0.0], [0.0, 2.5, 0.0]])
+    light = scenes.default_light()
+    for method in ss.shadow_map.METHODS:
+        kw = dict(resolution=32, extent=0.5, method=method)
+        if method != "ssm":
+            kw["samples"] = 64
+        base = ss.soft_shadow_map(ss.Scene(occluders=[(plate_v, plate_f)], receivers=[scenes.floor()]), light, **kw)
+        only_degenerate = ss.Scene(
+            occluders=[(collinear_v, [[0, 1, 2]]), (plate_v, degenerate)], receivers=[scenes.floor()]
+        )
+        np.testing.assert_array_equal(ss.soft_shadow_map(only_degenerate, light, **kw).visibility, 1.0)
+        messy = ss.Scene(
+            occluders=[
+                (plate_v, np.vstack([plate_f, plate_f, degenerate, plate_f[:, ::-1]])),
+                (collinear_v, [[0, 1, 2]]),
+            ],
+            receivers=[scenes.floor()],
+        )
+        np.testing.assert_array_equal(ss.soft_shadow_map(messy, light, **kw).visibility, base.visibility)
+        fin = ss.Scene(occluders=[(plate_v, plate_f), (fin_v, [[0, 1, 2]])], receivers=[scenes.floor()])
+        v = ss.soft_shadow_map(fin, light, **kw).visibility
+        assert np.isfinite(v).all() and np.all(v <= base.visibility + 1e-6)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda a: np.asfortranarray(a),
+        lambda a: a[::-1, ::-1].copy()[::-1, ::-1],  # negative strides
+        lambda a: a.astype(">f4"),  # big-endian
+        lambda a: a.astype(np.float16),
+        lambda a: np.lib.stride_tricks.as_strided(a, a.shape, a.strides, writeable=False),
+    ],
+)
+def test_depth_maps_in_any_float_layout_are_accepted(make):
+    occ, rec = _good_depth()
+    want = ss.soft_shadow_map_from_depth(occ, rec, light_size=1.0, extent=0.5).visibility
+    got = ss.soft_shadow_map_from_depth(make(occ), make(rec), light_size=1.0, extent=0.5).visibility
+    np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, words",
+    [
+        (dict(light_size=(1.0, 1.0, 1.0)), ValueError, "light_size"),
+        (dict(light_size="big"), TypeError, "light_size"),
+        (dict(light_size=(1.0, np.inf)), ValueError, "light_size"),
+        (dict(method="exact"), ValueError, "method.*triangles"),
+        (dict(samples=64), ValueError, "samples.*ssm"),
+    ],
+)
+def test_bad_depth_entry_options(kwargs, exc, words):
+    occ, rec = _good_depth()
+    args = dict(light_size=1.0, extent=0.5)
+    args.update(kwargs)
+    with pytest.raises(exc, match=words):
+        ss.soft_shadow_map_from_depth(occ, rec, **args)
+
+
+def test_complex_depth_maps_are_refused():
+    occ, rec = _good_depth()
+    with pytest.raises(TypeError, match="occluder_depth.*float"):
+        ss.soft_shadow_map_from_depth(occ.astype(np.complex64), rec, light_size=1.0, extent=0.5)
+
+
+def test_bad_points_and_outside_values():
+    scene, light = scenes.square_plate()
+    sm = ss.soft_shadow_map(scene, light, resolution=16)
+    with pytest.raises(TypeError, match="points"):
+        sm.sample([["a", "b", "c"]])
+    with pytest.raises(TypeError, match="points"):
+        sm.sample(np.zeros((2, 3), complex))
+    with pytest.raises(TypeError, match="outside"):
+        sm.sample(np.zeros((2, 3)), outside="lit")
+    # Empty, integer and behind-the-light points are fine.
+    assert sm.sample(np.zeros((0, 3))).shape == (0,)
+    np.testing.assert_array_equal(sm.sample(np.array([[0, 9, 0], [0, 4, 0]])), 1.0)
+    assert np.isnan(sm.sample([[0.0, 9.0, 0.0]], outside=np.nan)).all()
+
+
+@pytest.mark.parametrize(
+    "call, exc, words",
+    [
+        # Wrong dtypes and shapes: pyo3 names the argument in a note.
+        (
+            lambda o, r: _core.shadow_map_from_depth(o.astype(np.float64), None, r, (1, 1), (0.5, 0.5), "ssm"),
+            TypeError,
+            "while processing 'occluder_depth'",
+        ),
+        (
+            lambda o, r: _core.shadow_map_from_depth(o, None, r[None], (1, 1), (0.5, 0.5), "ssm"),
+            TypeError,
+            "while processing 'receiver_depth'",
+        ),
+        (
+            lambda o, r: _core.shadow_map_from_depth(o, None, r, (1, 1, 1), (0.5, 0.5), "ssm"),
+            ValueError,
+            "while processing 'light_size'",
+        ),
+        (lambda o, r: _core.light_frame((1, 2)), ValueError, "while processing 'light'"),
+        # Values: the core's messages start with the name.
+        (lambda o, r: _core.shadow_map_from_depth(o, None, r, (1, 1), (0.5, 0.5), "ssm", -1), ValueError, "samples"),
+        (
+            lambda o, r: _core.shadow_map_from_depth(o, None, r, (1e-40, 1), (0.5, 0.5), "bitmask"),
+            ValueError,
+            "light_size",
+        ),
+        (
+            lambda o, r: _core.sample_points(LIGHT, (0.5, 0.5), -8, 8, np.zeros((1, 3)), "ssm", occluder_depth=o),
+            ValueError,
+            "resolution",
+        ),
+        (
+            lambda o, r: _core.sample_points(
+                LIGHT, (0.5, 0.5), 8, 8, np.zeros((1, 3)), "ssm", occluder_depth=np.full((8, 8), np.nan, np.float32)
+            ),
+            ValueError,
+            "occluder layer 0.*> 0",
+        ),
+        (lambda o, r: _core.receiver_points(-r, LIGHT, (0.5, 0.5)), ValueError, "receiver_depth.*> 0"),
+        (
+            lambda o, r: _core.shadow_map_from_meshes(
+                np.zeros((3, 3)),
+                np.array([[0, 1, 2]], np.uint32),
+                np.zeros((3, 3)),
+                np.array([[0, 1, 2]], np.uint32),
+                LIGHT,
+                8,
+                8,
+                None,
+                -2,
+                "ssm",
+            ),
+            ValueError,
+            "passes",
+        ),
+    ],
+)
+def test_core_functions_name_the_argument(call, exc, words):
+    occ, rec = _good_depth()
+    with pytest.raises(exc) as e:
+        call(occ, rec)
+    text = str(e.value) + " ".join(getattr(e.value, "__notes__", []))
+    assert pytest.importorskip("re").search(words, text), text
+
+
+def test_io_errors_name_the_path_or_channel(tmp_path):
+    pytest.importorskip("OpenEXR")
+    with pytest.raises(ValueError, match="channels\\['V'\\].*2-D"):
+        io.write_exr(tmp_path / "a.exr", {"V": np.zeros((2, 2, 2))})
+    with pytest.raises(ValueError, match="channels.*one shape"):
+        io.write_exr(tmp_path / "a.exr", {"V": np.zeros((2, 2)), "W": np.zeros((3, 2))})
+    with pytest.raises(FileNotFoundError, match="path: .*missing.exr"):
+        io.read_exr(tmp_path / "missing.exr")
+    (tmp_path / "text.exr").write_text("not an image")
+    with pytest.raises(ValueError, match="path: .*text.exr"):
+        io.read_exr(tmp_path / "text.exr")
+    with pytest.raises(FileNotFoundError, match="path: .*no_dir"):
+        io.write_exr(tmp_path / "no_dir" / "a.exr", np.zeros((2, 2)))
