@@ -11,7 +11,7 @@ from softshadow.shadow_map import auto_settings
 @pytest.mark.parametrize("name", ["bunny_floating", "two_spheres"])
 def test_the_hierarchy_changes_less_than_the_error_it_saves_time_for(reference_for, name):
     # At 256² with 256² occluder maps the wide penumbrae read coarser levels
-    # (2-4x faster at 512², see benchmarks/bench_hierarchy.py); the change
+    # (1.2-4.4x faster at 512², see benchmarks/bench_hierarchy.py); the change
     # must stay well inside the method's own error against Mitsuba.
     scene, light = scenes.SCENES[name]()
     kw = dict(resolution=256, method="bitmask", samples=256)

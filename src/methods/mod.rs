@@ -69,9 +69,9 @@ pub enum Method {
 /// at most this fraction of the light's width, seen from the receiver it is
 /// nearest to. Measured with bitmask (256 samples, two passes) against
 /// Mitsuba on the study's scenes (`benchmarks/bench_hierarchy.py`): at 3% the
-/// error moves by at most 0.001 while 512² maps get 2.7-4x faster; at 6% the
-/// error grows by up to 0.003 (a coarse texel misplaces an edge by half its
-/// back-projection), at 12.5% by up to 0.02.
+/// error moves by at most 0.001 while 512² maps take 1.2-4.4x less time; at
+/// 6% the error grew by up to 0.003 (a coarse texel misplaces an edge by half
+/// its back-projection), at 12.5% by up to 0.02.
 pub const HIERARCHY: Hierarchy = Hierarchy {
     max_texel_on_light: 0.03,
 };
