@@ -78,6 +78,11 @@ dtypes = mostly(
 )
 samples = mostly(st.sampled_from([16, 64, 256]), st.sampled_from([0, 1, 3, -1, 1 << 20, 2**40]), 8)
 methods = mostly(st.sampled_from(["ssm", "bitmask"]), st.sampled_from(["exact", "bogus"]), 12)
+# The kernels' options: the hierarchy (map methods) and the summation
+# precision (ssm); a wrong one for the method is refused by name.
+hierarchies = st.sampled_from([None, False, True])
+precisions = mostly(st.sampled_from([None, "f32", "f64", "f16", "f16-batched"]), st.sampled_from(["f8", ""]), 12)
+backends = st.sampled_from(["cpu"] * 7 + ["gpu"])
 
 
 @st.composite
@@ -128,14 +133,24 @@ def depth_case(draw):
     ext = (draw(extents), draw(extents))
     method = draw(methods)
     n = draw(samples) if method == "bitmask" else draw(mostly(st.none(), samples, 8))
-    return rec, occ, back, size, ext, method, n
+    opts = (draw(hierarchies), draw(precisions), draw(backends))
+    return rec, occ, back, size, ext, method, n, opts
 
 
 def run_public(case) -> None:
-    rec, occ, back, size, ext, method, n = case
+    rec, occ, back, size, ext, method, n, (hierarchy, precision, backend) = case
     try:
         sm = ss.soft_shadow_map_from_depth(
-            occ, rec, light_size=size, extent=ext, occluder_depth_back=back, method=method, samples=n
+            occ,
+            rec,
+            light_size=size,
+            extent=ext,
+            occluder_depth_back=back,
+            method=method,
+            samples=n,
+            hierarchy=hierarchy,
+            precision=precision,
+            backend=backend,
         )
     except BaseException as e:  # noqa: BLE001 - the point is to see everything
         allowed(e)
@@ -152,9 +167,9 @@ def run_public(case) -> None:
 
 
 def run_core(case) -> None:
-    rec, occ, back, size, ext, method, n = case
+    rec, occ, back, size, ext, method, n, (hierarchy, precision, backend) = case
     try:
-        r = _core.shadow_map_from_depth(occ, back, rec, size, ext, method, n)
+        r = _core.shadow_map_from_depth(occ, back, rec, size, ext, method, n, hierarchy, precision, backend)
     except BaseException as e:  # noqa: BLE001
         allowed(e)
         return
@@ -173,14 +188,14 @@ def points_case(draw):
     w, h = draw(mostly(st.integers(1, 30), st.integers(-1, 0))), draw(st.integers(1, 30))
     method = draw(methods)
     n = draw(samples) if method == "bitmask" else draw(mostly(st.none(), samples, 8))
-    return occ, pts, size, ext, w, h, method, n
+    return occ, pts, size, ext, w, h, method, n, draw(hierarchies), draw(precisions)
 
 
 def run_points(case) -> None:
-    occ, pts, size, ext, w, h, method, n = case
+    occ, pts, size, ext, w, h, method, n, hierarchy, precision = case
     light = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0), size)
     try:
-        v, inside = _core.sample_points(light, ext, w, h, pts, method, n, occluder_depth=occ)
+        v, inside = _core.sample_points(light, ext, w, h, pts, method, n, hierarchy, precision, occluder_depth=occ)
     except BaseException as e:  # noqa: BLE001
         allowed(e)
         return
