@@ -12,6 +12,7 @@ use crate::raster::{rasterize, Prepared};
 use crate::units::{check_lateral, check_unit, depth_unit, farthest, light_size_in, scaled_map};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// The most occluder depth layers we peel.
@@ -106,12 +107,20 @@ pub(crate) struct FramedScene {
     pub light_size: [f64; 2],
 }
 
-/// Depth maps back in the user's units: powers of two, so exact.
-pub(crate) fn to_user_units<'a>(unit: f64, maps: impl Iterator<Item = &'a mut Vec<f32>>) {
-    if unit != 1.0 {
-        for m in maps {
-            m.par_iter_mut().for_each(|z| *z *= unit as f32);
+impl ShadowResult {
+    /// The depth maps, computed in the kernels' depth unit `unit` (see
+    /// units.rs), back in the user's units: a power of two, so exact.
+    pub(crate) fn in_user_units(mut self, unit: f64) -> ShadowResult {
+        if unit != 1.0 {
+            let maps = std::iter::once(&mut self.receiver)
+                .chain(self.occluder_front.as_mut())
+                .chain(self.occluder_middle.iter_mut())
+                .chain(self.occluder_back.as_mut());
+            for m in maps {
+                m.par_iter_mut().for_each(|z| *z *= unit as f32);
+            }
         }
+        self
     }
 }
 
@@ -250,18 +259,10 @@ pub fn from_meshes(
     };
     let visibility = shade_map(s.method, &inputs);
     sw.lap("shadow");
-    let (mut occluder_front, mut occluder_back) = match occ {
+    let (occluder_front, occluder_back) = match occ {
         Some(o) => (Some(o.nearest), o.farthest),
         None => (None, None),
     };
-    let mut receiver = receiver;
-    to_user_units(
-        unit,
-        std::iter::once(&mut receiver)
-            .chain(occluder_front.as_mut())
-            .chain(middle.iter_mut())
-            .chain(occluder_back.as_mut()),
-    );
     Ok(ShadowResult {
         grid,
         occluder_grid,
@@ -271,7 +272,8 @@ pub fn from_meshes(
         occluder_middle: middle,
         occluder_back,
         timings: sw.timings,
-    })
+    }
+    .in_user_units(unit))
 }
 
 /// Visibility of every receiver texel: the method's, or for a point light
@@ -353,6 +355,33 @@ pub(crate) fn check_depth_inputs(
     Ok(light_size)
 }
 
+/// The user's depth maps and light size in the kernels' depth unit (see
+/// units.rs), shared by both backends; the maps are copied only when the unit
+/// is not 1.
+pub(crate) struct DepthInUnit<'a> {
+    pub light_size: [f64; 2],
+    pub front: Cow<'a, [f32]>,
+    pub back: Option<Cow<'a, [f32]>>,
+    pub receiver: Cow<'a, [f32]>,
+}
+
+impl<'a> DepthInUnit<'a> {
+    pub(crate) fn new(
+        unit: f64,
+        light_size: [f64; 2],
+        front: &'a [f32],
+        back: Option<&'a [f32]>,
+        receiver: &'a [f32],
+    ) -> Result<DepthInUnit<'a>> {
+        Ok(DepthInUnit {
+            light_size: light_size_in("light_size", light_size, unit)?,
+            front: scaled_map(front, unit),
+            back: back.map(|b| scaled_map(b, unit)),
+            receiver: scaled_map(receiver, unit),
+        })
+    }
+}
+
 /// Soft shadow map from depth maps the user rendered.
 pub fn from_depth(
     grid: &MapGrid,
@@ -383,19 +412,16 @@ pub fn from_depth(
         &format!("{}x{} maps", grid.width, grid.height),
         map_bytes(grid.len(), 1 + copies) + map_bytes(occluder_grid.len(), layers * (1 + copies)),
     )?;
-    let light_size = light_size_in("light_size", light_size, unit)?;
-    let front = scaled_map(front, unit);
-    let back = back.map(|b| scaled_map(b, unit));
-    let receiver = scaled_map(receiver, unit);
-    let mut layers: Vec<&[f32]> = vec![&front];
-    if let Some(b) = &back {
+    let d = DepthInUnit::new(unit, light_size, front, back, receiver)?;
+    let mut layers: Vec<&[f32]> = vec![&d.front];
+    if let Some(b) = &d.back {
         layers.push(b);
     }
     let inputs = ShadowInputs {
         grid: *grid,
         occluder_grid: *occluder_grid,
-        light_size,
-        receiver: &receiver,
+        light_size: d.light_size,
+        receiver: &d.receiver,
         occluder_layers: layers,
         occluder_triangles: None,
     };

@@ -17,6 +17,28 @@ fn y_ge(k: u32, q: u32) -> u32 {
     return tables[(gp.samples + 1u + k) * WORDS + q];
 }
 
+// The receiver's mask while gather_chunk runs.
+var<private> mask: array<u32, 8>;
+
+// Bitmask::add_texel's arithmetic for micro-patch [x0, x1] x (row r) at
+// 1/depth w: the samples whose ranks its back-projection covers.
+fn add_texel(w: f32, x0: f32, x1: f32, xr_s: f32, r: RowReach, rc: Receiver) {
+    let s = f32(gp.samples);
+    let half = 0.5 * s;
+    let d = w - rc.wr;
+    let inv = select(0.0, 1.0 / d, d > 0.0);
+    // Light coordinate t in [-1, 1] -> sample units; first rank at or above a
+    // lower bound, one past the last at or below an upper bound, clamped to
+    // [0, S].
+    let ka = u32(clamp(ceil(((x0 - xr_s) * inv + 1.0) * half - 0.5), 0.0, s));
+    let kb = u32(clamp(floor(((x1 - xr_s) * inv + 1.0) * half - 0.5) + 1.0, 0.0, s));
+    let kc = u32(clamp(ceil(((-r.nay0) * inv + 1.0) * half - 0.5), 0.0, s));
+    let kd = u32(clamp(floor((r.ay1 * inv + 1.0) * half - 0.5) + 1.0, 0.0, s));
+    for (var q = 0u; q < WORDS; q++) {
+        mask[q] |= x_ge(ka, q) & ~x_ge(kb, q) & y_ge(kc, q) & ~y_ge(kd, q);
+    }
+}
+
 // Ors this dispatch's chunk of rows of its layer into every receiver's mask.
 @compute @workgroup_size(8, 8)
 fn bitmask(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -24,7 +46,6 @@ fn bitmask(@builtin(global_invocation_id) gid: vec3<u32>) {
     if !rc.ok {
         return;
     }
-    var mask: array<u32, 8>;
     var full = true;
     for (var q = 0u; q < WORDS; q++) {
         mask[q] = acc[rc.idx * WORDS + q];
@@ -34,38 +55,7 @@ fn bitmask(@builtin(global_invocation_id) gid: vec3<u32>) {
     if full {
         return;
     }
-    let xr_s = rc.xr * gp.inv_half_lx;
-    let s = f32(gp.samples);
-    let half = 0.5 * s;
-    let js = chunk_rows(rc.yr, rc.wr);
-    let base = layer_offset(chunk.layer);
-    for (var j = js.x; j <= js.y; j++) {
-        let r = row_reach(chunk.layer, u32(j), rc.xr, rc.yr, rc.wr);
-        if !r.ok {
-            continue;
-        }
-        let row = base + u32(j) * gp.occ_w;
-        for (var i = r.i_lo; i < r.i_hi; i++) {
-            let w = inv_depth(maps[row + i]);
-            if w <= rc.wr {
-                continue;
-            }
-            let x0 = axes[gp.ax_col_x0s + i];
-            let x1 = x0 + gp.wx;
-            let d = w - rc.wr;
-            let inv = select(0.0, 1.0 / d, d > 0.0);
-            // Light coordinate t in [-1, 1] -> sample units; first rank at
-            // or above a lower bound, one past the last at or below an
-            // upper bound, clamped to [0, S].
-            let ka = u32(clamp(ceil(((x0 - xr_s) * inv + 1.0) * half - 0.5), 0.0, s));
-            let kb = u32(clamp(floor(((x1 - xr_s) * inv + 1.0) * half - 0.5) + 1.0, 0.0, s));
-            let kc = u32(clamp(ceil(((-r.nay0) * inv + 1.0) * half - 0.5), 0.0, s));
-            let kd = u32(clamp(floor((r.ay1 * inv + 1.0) * half - 0.5) + 1.0, 0.0, s));
-            for (var q = 0u; q < WORDS; q++) {
-                mask[q] |= x_ge(ka, q) & ~x_ge(kb, q) & y_ge(kc, q) & ~y_ge(kd, q);
-            }
-        }
-    }
+    gather_chunk(rc);
     for (var q = 0u; q < WORDS; q++) {
         acc[rc.idx * WORDS + q] = mask[q];
     }

@@ -12,7 +12,8 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use std::sync::OnceLock;
 
-pub const SOURCE: &str = include_str!("exact.wgsl");
+/// The module: the 64-bit helpers it calls (u64.wgsl), then exact.wgsl.
+pub const SOURCE: &str = concat!(include_str!("u64.wgsl"), "\n", include_str!("exact.wgsl"));
 
 /// Loop iterations (BVH nodes visited and triangles tested) one invocation
 /// may run per dispatch; lavapipe stops an invocation after 65535.

@@ -47,29 +47,7 @@ struct Node {
 @group(0) @binding(6) var<storage, read_write> seen: array<u32>;
 @group(0) @binding(7) var<storage, read_write> status: array<atomic<u32>>;
 
-// u64 as vec2(lo, hi).
-fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
-    let lo = a.x + b.x;
-    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
-}
-
-// The full 64-bit product of two u32 (16-bit halves).
-fn mul32(a: u32, b: u32) -> vec2<u32> {
-    let a0 = a & 0xffffu;
-    let a1 = a >> 16u;
-    let b0 = b & 0xffffu;
-    let b1 = b >> 16u;
-    let p00 = a0 * b0;
-    let p01 = a0 * b1;
-    let p10 = a1 * b0;
-    let p11 = a1 * b1;
-    let mid = p01 + p10;
-    let mid_carry = select(0u, 0x10000u, mid < p01);
-    let lo = p00 + (mid << 16u);
-    let hi = p11 + (mid >> 16u) + mid_carry + select(0u, 1u, lo < p00);
-    return vec2<u32>(lo, hi);
-}
-
+// u64 as vec2(lo, hi); add64 and mul32 come from u64.wgsl.
 // Wrapping u64 product.
 fn mul64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
     let p = mul32(a.x, b.x);

@@ -12,8 +12,8 @@ use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::light::{is_point, MapGrid};
 use crate::methods::Method;
-use crate::pipeline::{check_depth_inputs, Stopwatch, Timings};
-use crate::units::{depth_unit, farthest, light_size_in, scaled_map};
+use crate::pipeline::{check_depth_inputs, DepthInUnit, Stopwatch, Timings};
+use crate::units::{depth_unit, farthest};
 
 /// A point light (size 0) has no GPU kernel: its hard shadow map is the
 /// CPU's (`point_light.rs`).
@@ -46,17 +46,22 @@ pub fn from_depth(
     )?;
     gather::check_method(method)?;
     // The kernels' depth unit, as on the CPU (see units.rs).
-    let unit = depth_unit(farthest(receiver));
-    let light_size = light_size_in("light_size", light_size, unit)?;
-    if is_point(light_size) {
+    let d = DepthInUnit::new(
+        depth_unit(farthest(receiver)),
+        light_size,
+        front,
+        back,
+        receiver,
+    )?;
+    if is_point(d.light_size) {
         return Err(point_light_on_gpu("light_size"));
     }
-    let (front, back, receiver) = (
-        scaled_map(front, unit),
-        back.map(|b| scaled_map(b, unit)),
-        scaled_map(receiver, unit),
+    let (light_size, front, back, receiver) = (
+        d.light_size,
+        &d.front[..],
+        d.back.as_deref(),
+        &d.receiver[..],
     );
-    let (front, back, receiver) = (&front[..], back.as_deref(), &receiver[..]);
     check_side("receiver_depth", (grid.width, grid.height))?;
     check_side(
         "occluder_depth",

@@ -21,8 +21,7 @@ use crate::light::{is_point, RectLight};
 use crate::mesh::MeshRef;
 use crate::methods::Method;
 use crate::pipeline::{
-    frame_scene, light_space_triangles, to_user_units, FramedScene, MapSettings, ShadowResult,
-    Stopwatch,
+    frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
 };
 use crate::raster::setup_triangles;
 
@@ -173,20 +172,13 @@ pub fn from_meshes(
             })
             .collect()
     };
-    let mut receiver: Vec<f32> = maps[..rec_len].iter().map(|&b| f32::from_bits(b)).collect();
-    let mut front = (!traced).then(|| map_of(0, false));
-    let mut middle: Vec<Vec<f32>> = (1..passes.saturating_sub(1))
+    let receiver: Vec<f32> = maps[..rec_len].iter().map(|&b| f32::from_bits(b)).collect();
+    let front = (!traced).then(|| map_of(0, false));
+    let middle: Vec<Vec<f32>> = (1..passes.saturating_sub(1))
         .map(|k| map_of(k, false))
         .collect();
     // The farthest layer starts at 0 (before the atomicMax): 0 means empty.
-    let mut back = (passes >= 2).then(|| map_of(passes - 1, true));
-    to_user_units(
-        unit,
-        std::iter::once(&mut receiver)
-            .chain(front.as_mut())
-            .chain(middle.iter_mut())
-            .chain(back.as_mut()),
-    );
+    let back = (passes >= 2).then(|| map_of(passes - 1, true));
     Ok(ShadowResult {
         grid,
         occluder_grid,
@@ -196,5 +188,6 @@ pub fn from_meshes(
         occluder_middle: middle,
         occluder_back: back,
         timings,
-    })
+    }
+    .in_user_units(unit))
 }

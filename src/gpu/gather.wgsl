@@ -13,6 +13,10 @@
 // bounds the loop iterations of an invocation (lavapipe stops an invocation
 // after 65535 in all; real GPUs reset long-running dispatches) whatever the
 // penumbra's size in texels.
+//
+// A method's file defines `add_texel(w, x0, x1, xr_s, r, rc)`, which adds one
+// micro-patch to its per-invocation state (a `var<private>`), and its entry
+// points, which load that state from `acc`, call `gather_chunk` and store it.
 
 // Shared with Rust (`GatherParams` in gather.rs; a test compares layouts).
 struct GatherParams {
@@ -211,4 +215,30 @@ fn chunk_rows(yr: f32, wr: f32) -> vec2<i32> {
 
 fn layer_offset(layer: u32) -> u32 {
     return gp.layer0_offset + layer * gp.layer_stride;
+}
+
+// Visits, in row order, every texel of this dispatch's chunk of its layer
+// that can reach receiver `rc`, and hands each to the method's add_texel
+// (defined in the method's file, which adds to its own per-invocation
+// state): the twin of gather.rs's add_row loop, whose methods are its
+// Accumulators.
+fn gather_chunk(rc: Receiver) {
+    let xr_s = rc.xr * gp.inv_half_lx;
+    let js = chunk_rows(rc.yr, rc.wr);
+    let base = layer_offset(chunk.layer);
+    for (var j = js.x; j <= js.y; j++) {
+        let r = row_reach(chunk.layer, u32(j), rc.xr, rc.yr, rc.wr);
+        if !r.ok {
+            continue;
+        }
+        let row = base + u32(j) * gp.occ_w;
+        for (var i = r.i_lo; i < r.i_hi; i++) {
+            let w = inv_depth(maps[row + i]);
+            if w <= rc.wr {
+                continue;
+            }
+            let x0 = axes[gp.ax_col_x0s + i];
+            add_texel(w, x0, x0 + gp.wx, xr_s, r, rc);
+        }
+    }
 }

@@ -10,6 +10,8 @@
 //!   `crate::methods::bitmask`.
 //! * `exact.wgsl` (`exact.rs`): ray casting through the CPU-built BVH; twin
 //!   `crate::methods::exact`.
+//! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl` and
+//!   `exact.wgsl`.
 //!
 //! Entry points: `from_meshes` (the whole mesh pipeline) and `from_depth`
 //! (the user's depth maps, shaded). Device, queue and pipelines are made once

@@ -11,7 +11,8 @@ use crate::raster::{SetupTri, PEEL_GAP};
 use bytemuck::{Pod, Zeroable};
 use std::sync::OnceLock;
 
-pub const SOURCE: &str = include_str!("raster.wgsl");
+/// The module: the 64-bit helpers it calls (u64.wgsl), then raster.wgsl.
+pub const SOURCE: &str = concat!(include_str!("u64.wgsl"), "\n", include_str!("raster.wgsl"));
 /// No layer (WGSL `NONE`).
 pub const NONE: u32 = u32::MAX;
 const GROUP: u32 = 64;

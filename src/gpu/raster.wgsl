@@ -67,33 +67,10 @@ const GROUP: u32 = 64u;
 @group(0) @binding(3) var<uniform> fill_params: FillParams;
 @group(0) @binding(4) var<storage, read> tiles: array<Tile>;
 
-// Signed 64-bit integers as vec2(lo, hi) in two's complement.
-fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
-    let lo = a.x + b.x;
-    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
-}
-
-fn neg64(a: vec2<u32>) -> vec2<u32> {
-    return add64(~a, vec2<u32>(1u, 0u));
-}
-
-// The exact product of two i32 (schoolbook on 16-bit halves).
+// The exact product of two i32 as a signed 64-bit integer (vec2(lo, hi),
+// two's complement; add64, neg64 and mul32 come from u64.wgsl).
 fn mul64(a: i32, b: i32) -> vec2<u32> {
-    let ua = u32(abs(a));
-    let ub = u32(abs(b));
-    let a0 = ua & 0xffffu;
-    let a1 = ua >> 16u;
-    let b0 = ub & 0xffffu;
-    let b1 = ub >> 16u;
-    let p00 = a0 * b0;
-    let p01 = a0 * b1;
-    let p10 = a1 * b0;
-    let p11 = a1 * b1;
-    let mid = p01 + p10;
-    let mid_carry = select(0u, 0x10000u, mid < p01);
-    let lo = p00 + (mid << 16u);
-    let hi = p11 + (mid >> 16u) + mid_carry + select(0u, 1u, lo < p00);
-    let r = vec2<u32>(lo, hi);
+    let r = mul32(u32(abs(a)), u32(abs(b)));
     if (a < 0) != (b < 0) {
         return neg64(r);
     }

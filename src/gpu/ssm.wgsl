@@ -5,6 +5,17 @@
 // ssm.rs's D2_MIN: keeps 0/0 away where occluder and receiver share a depth.
 const D2_MIN: f32 = 1e-36;
 
+// The receiver's sum of this layer while gather_chunk runs.
+var<private> sum: f32;
+
+// Sum::add_texel's arithmetic for micro-patch [x0, x1] x (row r) at 1/depth w.
+fn add_texel(w: f32, x0: f32, x1: f32, xr_s: f32, r: RowReach, rc: Receiver) {
+    let d = w - rc.wr;
+    let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
+    let cy = min(r.ay1, d) + min(r.nay0, d);
+    sum += max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
+}
+
 // Adds this dispatch's chunk of rows of its layer to every receiver's sum.
 @compute @workgroup_size(8, 8)
 fn ssm(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -13,33 +24,12 @@ fn ssm(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let slot = chunk.layer * gp.rec_w * gp.rec_h + rc.idx;
-    var sum = bitcast<f32>(acc[slot]);
+    sum = bitcast<f32>(acc[slot]);
     // Contributions are >= 0 and the occlusion is clamped: 4 is final.
     if sum >= 4.0 {
         return;
     }
-    let xr_s = rc.xr * gp.inv_half_lx;
-    let js = chunk_rows(rc.yr, rc.wr);
-    let base = layer_offset(chunk.layer);
-    for (var j = js.x; j <= js.y; j++) {
-        let r = row_reach(chunk.layer, u32(j), rc.xr, rc.yr, rc.wr);
-        if !r.ok {
-            continue;
-        }
-        let row = base + u32(j) * gp.occ_w;
-        for (var i = r.i_lo; i < r.i_hi; i++) {
-            let w = inv_depth(maps[row + i]);
-            if w <= rc.wr {
-                continue;
-            }
-            let x0 = axes[gp.ax_col_x0s + i];
-            let x1 = x0 + gp.wx;
-            let d = w - rc.wr;
-            let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
-            let cy = min(r.ay1, d) + min(r.nay0, d);
-            sum += max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
-        }
-    }
+    gather_chunk(rc);
     acc[slot] = bitcast<u32>(sum);
 }
 

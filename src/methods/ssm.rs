@@ -84,32 +84,62 @@ fn contribution(l: usize, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) -> 
     max(cx, 0.0) * max(cy, 0.0) / d.mul_add(d, D2_MIN)
 }
 
-/// f32 sums of 4x the occluded fraction (the 1/4 is applied in `occlusion`),
-/// two-level: `row` collects one occluder row, `total` the rows.
-struct Sum;
-
+/// A sum per lane in two levels: `open` collects the current group of
+/// contributions (an occluder row, or an FP16 batch), `done` the groups closed
+/// so far. Adding small terms to a small open sum keeps the rounding error
+/// near sqrt(M) eps for M terms, where one running sum reaches M eps.
 #[derive(Clone, Copy)]
 struct TwoLevel {
-    total: Lanes,
-    row: Lanes,
+    done: Lanes,
+    open: Lanes,
 }
+
+impl TwoLevel {
+    fn new() -> TwoLevel {
+        TwoLevel {
+            done: [0.0; LANES],
+            open: [0.0; LANES],
+        }
+    }
+
+    #[inline(always)]
+    fn total(&self, l: usize) -> f32 {
+        self.done[l] + self.open[l]
+    }
+
+    /// Moves the open sums into the closed ones.
+    #[inline(always)]
+    fn close(&mut self) {
+        for l in 0..LANES {
+            self.done[l] += self.open[l];
+            self.open[l] = 0.0;
+        }
+    }
+
+    /// Whether every lane's total reached `limit`.
+    #[inline(always)]
+    fn all_reach(&self, limit: f32) -> bool {
+        (0..LANES).all(|l| self.total(l) >= limit)
+    }
+}
+
+/// f32 sums of 4x the occluded fraction (the 1/4 is applied in `occlusion`),
+/// closed after every occluder row.
+struct Sum;
 
 impl Accumulator for Sum {
     type State = TwoLevel;
     const LAYERS_SHARE_STATE: bool = false;
 
     fn empty(&self) -> TwoLevel {
-        TwoLevel {
-            total: [0.0; LANES],
-            row: [0.0; LANES],
-        }
+        TwoLevel::new()
     }
 
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // one index over several lane arrays: what vectorizes
     fn add_texel(&self, acc: &mut TwoLevel, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
         for l in 0..LANES {
-            acc.row[l] += contribution(l, w, x0, x1, r, g);
+            acc.open[l] += contribution(l, w, x0, x1, r, g);
         }
     }
 
@@ -137,7 +167,7 @@ impl Accumulator for Sum {
         });
         for (row, y) in cy.iter().enumerate() {
             for (c, x) in cx.iter().enumerate() {
-                acc.row[row * TILE_W + c] += x * y;
+                acc.open[row * TILE_W + c] += x * y;
             }
         }
     }
@@ -147,20 +177,17 @@ impl Accumulator for Sum {
     /// is clamped, so a total that reached 1 is final.
     #[inline(always)]
     fn full(&self, acc: &TwoLevel, _g: &Group) -> bool {
-        acc.total.iter().zip(&acc.row).all(|(&t, &r)| t + r >= 4.0)
+        acc.all_reach(4.0)
     }
 
     #[inline(always)]
     fn occlusion(&self, acc: &TwoLevel) -> Lanes {
-        std::array::from_fn(|l| (0.25 * (acc.total[l] + acc.row[l])).min(1.0))
+        std::array::from_fn(|l| (0.25 * acc.total(l)).min(1.0))
     }
 
     #[inline(always)]
     fn end_row(&self, acc: &mut TwoLevel) {
-        for l in 0..LANES {
-            acc.total[l] += acc.row[l];
-            acc.row[l] = 0.0;
-        }
+        acc.close();
     }
 }
 
@@ -221,49 +248,37 @@ struct SumF16 {
     batched: bool,
 }
 
-#[derive(Clone, Copy)]
-struct F16State {
-    /// The finished batches, in f32.
-    done: Lanes,
-    /// The current binary16 sum (every value representable in binary16).
-    sum: Lanes,
-}
-
+/// The state is a `TwoLevel` whose `open` sums are binary16 values (the
+/// current batch) and whose `done` sums are the closed batches, in f32.
 impl Accumulator for SumF16 {
-    type State = F16State;
+    type State = TwoLevel;
     const LAYERS_SHARE_STATE: bool = false;
     const ROW_MAJOR: bool = true;
 
-    fn empty(&self) -> F16State {
-        F16State {
-            done: [0.0; LANES],
-            sum: [0.0; LANES],
-        }
+    fn empty(&self) -> TwoLevel {
+        TwoLevel::new()
     }
 
     #[inline(always)]
-    fn add_texel(&self, acc: &mut F16State, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
+    fn add_texel(&self, acc: &mut TwoLevel, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
         for l in 0..LANES {
             // Exact in binary: the 1/4 only moves the exponent.
             let c = round_to_f16(0.25 * contribution(l, w, x0, x1, r, g));
-            acc.sum[l] = round_to_f16(acc.sum[l] + c);
+            acc.open[l] = round_to_f16(acc.open[l] + c);
         }
     }
 
-    fn full(&self, acc: &F16State, _g: &Group) -> bool {
-        acc.done.iter().zip(&acc.sum).all(|(&d, &s)| d + s >= 1.0)
+    fn full(&self, acc: &TwoLevel, _g: &Group) -> bool {
+        acc.all_reach(1.0)
     }
 
-    fn occlusion(&self, acc: &F16State) -> Lanes {
-        std::array::from_fn(|l| (acc.done[l] + acc.sum[l]).min(1.0))
+    fn occlusion(&self, acc: &TwoLevel) -> Lanes {
+        std::array::from_fn(|l| acc.total(l).min(1.0))
     }
 
-    fn end_batch(&self, acc: &mut F16State) {
+    fn end_batch(&self, acc: &mut TwoLevel) {
         if self.batched {
-            for l in 0..LANES {
-                acc.done[l] += acc.sum[l];
-                acc.sum[l] = 0.0;
-            }
+            acc.close();
         }
     }
 }
