@@ -24,11 +24,9 @@ import platform
 
 import numpy as np
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
-
-import softshadow as ss  # noqa: E402
-from softshadow import metrics, reference, scenes  # noqa: E402
-from softshadow.study import median_seconds as median_time  # noqa: E402
+import softshadow as ss
+from softshadow import metrics, reference, scenes
+from softshadow.experiments.study import median_seconds as median_time
 
 MITSUBA_SAMPLES = (4, 16, 64, 256)
 EXACT_SAMPLES = (16, 64, 256)

@@ -20,10 +20,8 @@ import time
 
 import numpy as np
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
-
-import softshadow as ss  # noqa: E402
-from softshadow import metrics, reference, scenes  # noqa: E402
+import softshadow as ss
+from softshadow import metrics, reference, scenes
 
 
 def main() -> None:

@@ -5,5 +5,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh reference,io
-export DRJIT_LIBLLVM_PATH="${DRJIT_LIBLLVM_PATH:-/usr/lib/x86_64-linux-gnu/libLLVM-19.so}"
-.venv/bin/python -m softshadow.demo --out out "$@"
+.venv/bin/python -m softshadow.experiments.demo --out out "$@"

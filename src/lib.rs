@@ -7,22 +7,24 @@
 // comparison is the point, not an accident.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod depth_plane;
+// The stages, in the order the data flows: geometry in light space,
+// rasterized light-view maps, the shadow methods that read them, and the
+// pipelines that chain them; `gpu` mirrors raster and methods on the device.
+pub mod backend;
 pub mod error;
-pub mod extent;
+pub mod geom;
 #[cfg(feature = "gpu")]
 pub mod gpu;
-pub mod light;
 pub mod memory;
-pub mod mesh;
 pub mod methods;
 pub mod pipeline;
-pub mod point_light;
 pub mod raster;
-pub mod units;
+pub mod threads;
 
 #[cfg(feature = "python")]
 mod python;
 
+pub use backend::{Backend, BackendChoice};
 pub use error::{Error, Result};
-pub use light::{MapGrid, RectLight};
+pub use geom::light::{MapGrid, RectLight};
+pub use methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};

@@ -14,6 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+# Imported first so that the reference package points DRJIT_LIBLLVM_PATH at a
+# usable libLLVM before any test module imports mitsuba or drjit (the only
+# place the library is looked for); it never imports Mitsuba itself.
+import softshadow.reference  # noqa: F401
+
 CACHE = Path(__file__).resolve().parent.parent / ".cache" / "references"
 REFERENCE_SAMPLES = 1024
 

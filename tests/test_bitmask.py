@@ -51,7 +51,7 @@ def test_adding_an_occluder_never_brightens():
 def test_bitmask_from_depth_and_points():
     scene, light = scenes.torus_floating()
     sm = ss.soft_shadow_map(scene, light, resolution=64, method="bitmask", samples=64)
-    assert sm.occluder_depth is not None and sm.samples == 64
+    assert sm.occluder_depth is not None and sm.method.samples == 64
     again = ss.soft_shadow_map_from_depth(
         sm.occluder_depth,
         sm.receiver_depth,

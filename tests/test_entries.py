@@ -77,7 +77,7 @@ def test_shadow_map_contents(bunny):
     assert front[hit].min() >= 2.0 - 1e-5 and back[hit].max() <= 3.0 + 1e-5
     assert np.all(back[hit] >= front[hit])
     assert set(sm.timings) == {"transform", "extent", "raster_receivers", "raster_occluders", "shadow"}
-    assert sm.method == "ssm" and sm.passes == 2 and sm.extent_fitted
+    assert sm.method.name == "ssm" and sm.passes == 2 and sm.extent_fitted
 
 
 def test_two_passes_never_lighter_than_one(bunny):

@@ -21,7 +21,7 @@ def test_plate_matches_the_closed_form():
     # 4 x 32 strata, each off by at most 1/1024.
     assert np.abs(sm.visibility - exact).max() <= 4 * 32 / 1024
     assert np.abs(sm.visibility - exact).mean() < 0.01
-    assert sm.occluder_depth is None and sm.occluder_depth_back is None and sm.samples == 1024
+    assert sm.occluder_depth is None and sm.occluder_depth_back is None and sm.method.samples == 1024
     assert "raster_occluders" not in sm.timings  # no occluder map is made
 
 

@@ -5,7 +5,6 @@ import pytest
 
 import softshadow as ss
 from softshadow import metrics, scenes
-from softshadow.shadow_map import auto_settings
 
 
 @pytest.mark.parametrize("name", ["bunny_floating", "two_spheres"])
@@ -17,7 +16,7 @@ def test_the_hierarchy_changes_less_than_the_error_it_saves_time_for(reference_f
     kw = dict(resolution=256, method="bitmask", samples=256)
     full = ss.soft_shadow_map(scene, light, hierarchy=False, **kw)
     fast = ss.soft_shadow_map(scene, light, **kw)
-    assert fast.hierarchy is True and full.hierarchy is False
+    assert fast.method.hierarchy is True and full.method.hierarchy is False
     ref = reference_for(name, ss.soft_shadow_map(scene, light, resolution=256), scene.occluders)
     err_full = metrics.shadow_error(full.visibility, ref)
     err_fast = metrics.shadow_error(fast.visibility, ref)
@@ -43,12 +42,12 @@ def test_the_hierarchy_keeps_contact_shadows_sharp(reference_for):
 def test_ssm_is_published_without_a_hierarchy_unless_asked():
     scene, light = scenes.torus_floating()
     paper = ss.soft_shadow_map(scene, light, resolution=128)
-    assert paper.hierarchy is False
+    assert paper.method.hierarchy is False
     asked = ss.soft_shadow_map(scene, light, resolution=128, hierarchy=True)
-    assert asked.hierarchy is True
+    assert asked.method.hierarchy is True
     assert np.all((asked.visibility >= 0) & (asked.visibility <= 1))
     exact = ss.soft_shadow_map(scene, light, resolution=64, method="exact", samples=16)
-    assert exact.hierarchy is None
+    assert not hasattr(exact.method, "hierarchy")
 
 
 def test_hierarchy_is_refused_where_it_does_not_apply():
@@ -70,14 +69,19 @@ def test_hierarchy_is_refused_where_it_does_not_apply():
     ],
 )
 def test_auto_rule(resolution, occluders):
-    assert auto_settings(resolution) == ("ssm", occluders)
+    scene, light = scenes.square_plate()
+    sm = ss.soft_shadow_map(scene, light, resolution=resolution, method="auto")
+    assert sm.method == ss.Ssm(passes=2, occluder_resolution=occluders, hierarchy=False, precision="f32")
+    assert ss.Auto().rule(resolution) == ss.Ssm(passes=2, occluder_resolution=occluders)
+    assert sm.occluder_depth.shape == occluders[::-1]
 
 
 def test_auto_runs_the_rule_and_names_what_ran():
     scene, light = scenes.bunny_floating()
     auto = ss.soft_shadow_map(scene, light, resolution=256, method="auto")
     same = ss.soft_shadow_map(scene, light, resolution=256, method="ssm", occluder_resolution=64)
-    assert auto.method == "ssm"
+    assert auto.method == same.method == ss.Ssm(passes=2, occluder_resolution=64, hierarchy=False)
+    assert ss.soft_shadow_map(scene, light, resolution=256, method=ss.Auto()).method == auto.method
     assert auto.occluder_depth.shape == (64, 64)
     np.testing.assert_array_equal(auto.visibility, same.visibility)
     # An explicit occluder resolution wins over the rule.
@@ -87,4 +91,4 @@ def test_auto_runs_the_rule_and_names_what_ran():
     fd = ss.soft_shadow_map_from_depth(
         same.occluder_depth, same.receiver_depth, light_size=1.0, extent=same.extent, method="auto"
     )
-    assert fd.method == "ssm"
+    assert fd.method == ss.Ssm(passes=1, occluder_resolution=64, hierarchy=False)

@@ -155,11 +155,10 @@ def test_the_core_refuses_bad_values_even_past_the_python_checks():
             v,
             np.array([[0, 1, 2]], np.uint32),
             ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)),
-            8,
-            8,
+            (8, 8),
             (0.5, 0.5),
-            1,
             "ssm",
+            passes=1,
         )
     with pytest.raises(ValueError, match="resolution"):
         _core.shadow_map_from_meshes(
@@ -168,11 +167,10 @@ def test_the_core_refuses_bad_values_even_past_the_python_checks():
             v,
             np.array([[0, 1, 2]], np.uint32),
             ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1)),
-            1 << 20,
-            1 << 20,
+            (1 << 20, 1 << 20),
             None,
-            1,
             "ssm",
+            passes=1,
         )
     with pytest.raises(ValueError, match="up"):
         _core.light_frame(((0, 0, 0), (0, 0, 1), (0, 0, 2), (1, 1)))
@@ -192,7 +190,7 @@ def test_the_core_checks_shapes_not_just_sizes():
     light = ((0, 4, 0), (0, -1, 0), (0, 0, 1), (1, 1))
     with pytest.raises(ValueError, match="occluder_depth_back.*shape"):
         _core.sample_points(
-            light, (0.5, 0.5), 8, 16, np.zeros((1, 3)), "ssm", occluder_depth=rec, occluder_depth_back=occ
+            light, (0.5, 0.5), (8, 16), np.zeros((1, 3)), ss.Ssm(), occluder_depth=rec, occluder_depth_back=occ
         )
     with pytest.raises(ValueError, match="occluders: pass either"):
-        _core.sample_points(light, (0.5, 0.5), 8, 16, np.zeros((1, 3)), "ssm")
+        _core.sample_points(light, (0.5, 0.5), (8, 16), np.zeros((1, 3)), ss.Ssm())

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from softshadow import io
-from softshadow.demo import main
+from softshadow.experiments.demo import main
 
 
 def read_png_grey(path):

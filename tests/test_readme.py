@@ -21,7 +21,18 @@ def test_usage_example_runs():
     v = sm.sample(env["points"])
     assert v[0] < 0.2 and v[1] == 1.0  # under the bunny; far outside its shadow
     assert np.abs(fast.visibility - sm.visibility).mean() < 0.01
-    assert accurate.method == "bitmask" and env["reference"].occluder_depth is None
+    ss = env["ss"]
+    assert sm.method == ss.Ssm(passes=2, occluder_resolution=256, hierarchy=False, precision="f32")
+    assert fast.method == env["auto"].method == ss.Ssm(passes=2, occluder_resolution=64, hierarchy=False)
+    assert (
+        accurate.method
+        == env["same"].method
+        == ss.Bitmask(samples=256, passes=2, occluder_resolution=256, hierarchy=True)
+    )
+    np.testing.assert_array_equal(accurate.visibility, env["same"].visibility)
+    assert env["reference"].occluder_depth is None and env["reference"].method == ss.Exact(samples=1024)
+    assert env["one_core"].threads == 1
+    np.testing.assert_array_equal(env["one_core"].visibility, sm.visibility)
     np.testing.assert_array_equal(env["sm2"].visibility, ss_one_pass(env))
 
 

@@ -20,6 +20,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+import softshadow
 from softshadow import metrics, reference
 
 # --------------------------------------------------------------------------
@@ -176,7 +177,7 @@ def test_seed_determinism_and_batching(mitsuba_reference, monkeypatch):
     np.testing.assert_array_equal(first, run(7))
     assert np.any(first != run(8))  # penumbra points see different jitter
     # Splitting the rays into many batches must not change the result.
-    monkeypatch.setattr(mitsuba_reference, "MAX_RAYS_PER_BATCH", 100)
+    monkeypatch.setattr(mitsuba_reference._rays, "MAX_RAYS_PER_BATCH", 100)
     np.testing.assert_array_equal(first, run(7))
 
 
@@ -246,7 +247,7 @@ def test_scalar_variant_agrees(mitsuba_reference):
         """
     )
     env = dict(os.environ, SOFTSHADOW_MITSUBA_VARIANT="scalar_rgb")
-    env["PYTHONPATH"] = os.pathsep.join([str(Path(reference.__file__).parent.parent)] + sys.path)
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(softshadow.__file__).parent.parent)] + sys.path)
     result = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     name, *values = result.stdout.split()
@@ -372,7 +373,7 @@ def test_missing_mitsuba_message(monkeypatch):
 
 
 def test_importing_softshadow_does_not_import_mitsuba():
-    package_root = Path(reference.__file__).parent.parent
+    package_root = Path(softshadow.__file__).parent.parent
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(package_root)] + sys.path))
     script = (
         "import sys, softshadow, softshadow.metrics, softshadow.reference; "

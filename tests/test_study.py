@@ -7,7 +7,7 @@ pytest.importorskip("mitsuba")
 
 
 def test_study_plane_on_a_small_map(tmp_path):
-    from softshadow.study import main
+    from softshadow.experiments.study import main
 
     out = tmp_path / "study"
     assert (
@@ -46,7 +46,7 @@ def test_study_plane_on_a_small_map(tmp_path):
 
 
 def test_mitsuba_time_at_equal_error_follows_the_sample_law():
-    from softshadow.study import Point, mitsuba_seconds_at
+    from softshadow.experiments.study import Point, mitsuba_seconds_at
 
     # error = 0.4 / sqrt(k), time = k ms: the interpolation is exact inside
     # and the extrapolation keeps the law outside.

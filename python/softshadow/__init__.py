@@ -1,26 +1,39 @@
 """softshadow: soft shadows cast by rectangular area lights.
 
-Soft shadow maps (Atty et al. 2005) computed by a Rust core on all CPU cores,
-or on a GPU through wgpu (``backend="gpu"``).
-See the README for the conventions.
+Soft shadow maps (Atty et al. 2005), their bitmask variant and exact ray
+casting, computed by a Rust core on all CPU cores or on a GPU through wgpu
+(``backend="gpu"``). Pick a method with a typed config (``Ssm``,
+``Bitmask``, ``Exact``, ``Auto``) or its name; :func:`capabilities` lists
+every method's options, defaults, limits and backends. See the README and
+docs/ for the conventions.
 """
 
 from ._core import __version__
-from ._validate import TooLargeError
-from .backend import GpuUnavailableError, gpu_available, gpu_info
+from .backend import gpu_available, gpu_info
+from .errors import GpuUnavailableError, TooLargeError
 from .light import RectLight
+from .methods import Auto, Bitmask, Exact, MethodConfig, MethodInfo, OptionInfo, Ssm, capabilities, limits
 from .scene import Scene
 from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
 __all__ = [
+    "Auto",
+    "Bitmask",
+    "Exact",
     "GpuUnavailableError",
+    "MethodConfig",
+    "MethodInfo",
+    "OptionInfo",
     "RectLight",
     "Scene",
     "ShadowMap",
+    "Ssm",
     "TooLargeError",
-    "soft_shadow_map",
-    "soft_shadow_map_from_depth",
+    "capabilities",
     "gpu_available",
     "gpu_info",
+    "limits",
+    "soft_shadow_map",
+    "soft_shadow_map_from_depth",
     "__version__",
 ]

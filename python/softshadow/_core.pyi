@@ -1,28 +1,216 @@
-"""The Rust core (pyo3 bindings). Use the package's public API instead:
-these functions take already-validated, C-contiguous arrays.
+"""The Rust core (pyo3 bindings). Use the package's public API instead.
 
-Every function raises ValueError, its message starting with the argument's
-name, when a value is refused (non-finite vertices, out-of-range indices, a
-degenerate light, depths that are not > 0 or +inf, negative counts, a light
-size the f32 kernels cannot resolve); softshadow.TooLargeError (a ValueError
-and a MemoryError) for an absurd resolution, before allocating. Arrays of the
-wrong dtype or number of dimensions raise TypeError from pyo3, which names
-the argument in a note ("while processing 'occluder_depth'"); non-contiguous
-arrays raise ValueError. A panic in the core (a bug) raises RuntimeError;
-the module stays usable. The work runs with the GIL released.
+The bindings only convert: they check types (TypeError naming the argument),
+borrow C-contiguous arrays and release the GIL; every value is checked by
+the core (ValueError, its message starting with the argument's name;
+softshadow.TooLargeError, a ValueError and a MemoryError, before
+allocating). A panic in the core (a bug) raises RuntimeError and leaves the
+module usable.
 """
 
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
 
+__all__ = [
+    "Ssm",
+    "Bitmask",
+    "Exact",
+    "Auto",
+    "MeshShadowResult",
+    "DepthShadowResult",
+    "MethodInfo",
+    "OptionInfo",
+    "capabilities",
+    "limits",
+    "light_frame",
+    "shadow_map_from_meshes",
+    "shadow_map_from_depth",
+    "sample_points",
+    "receiver_points",
+    "worker_threads",
+    "gpu_available",
+    "gpu_info",
+    "GpuUnavailableError",
+    "_panic_for_tests",
+    "__version__",
+    "ENV_THREADS",
+]
+
 __version__: str
+ENV_THREADS: str
 
 #: (center, normal, up, size)
-Light = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float], tuple[float, float]]
+_Light = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float], tuple[float, float]]
+_Resolution = int | tuple[int, int]
 
-def light_frame(light: Light) -> tuple[list[float], list[float], list[float]]:
+@final
+class Ssm:
+    """Soft shadow maps as published (Atty et al. 2005)."""
+
+    def __new__(
+        cls,
+        *,
+        passes: int | None = None,
+        occluder_resolution: _Resolution | None = None,
+        hierarchy: bool | None = None,
+        precision: str | None = None,
+    ) -> Ssm: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def passes(self) -> int | None: ...
+    @property
+    def occluder_resolution(self) -> tuple[int, int] | None: ...
+    @property
+    def hierarchy(self) -> bool | None: ...
+    @property
+    def precision(self) -> str: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+@final
+class Bitmask:
+    """Micro-patches marking light samples in a bit mask per receiver."""
+
+    def __new__(
+        cls,
+        *,
+        samples: int | None = None,
+        passes: int | None = None,
+        occluder_resolution: _Resolution | None = None,
+        hierarchy: bool | None = None,
+    ) -> Bitmask: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def samples(self) -> int: ...
+    @property
+    def passes(self) -> int | None: ...
+    @property
+    def occluder_resolution(self) -> tuple[int, int] | None: ...
+    @property
+    def hierarchy(self) -> bool | None: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+@final
+class Exact:
+    """Ray casting against the occluder triangles."""
+
+    def __new__(cls, *, samples: int | None = None) -> Exact: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def samples(self) -> int: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+@final
+class Auto:
+    """The rule ``method="auto"`` names; resolves to an ``Ssm`` when run."""
+
+    def __new__(cls) -> Auto: ...
+    @property
+    def name(self) -> str: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def rule(self, resolution: _Resolution) -> Ssm:
+        """The ``Ssm`` the rule picks for an output resolution, from meshes."""
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+
+_MethodArg = str | Ssm | Bitmask | Exact | Auto
+
+@final
+class OptionInfo:
+    """One option of a method's config."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def kind(self) -> str:
+        """ "int", "one_of", "bool", "choice" or "resolution"."""
+    @property
+    def default(self) -> Any:
+        """The default; None where it is resolved when the config runs."""
+    @property
+    def default_doc(self) -> str: ...
+    @property
+    def doc(self) -> str: ...
+    @property
+    def min(self) -> int | None: ...
+    @property
+    def max(self) -> int | None: ...
+    @property
+    def choices(self) -> list[Any] | None: ...
+    @property
+    def restricted_on(self) -> dict[str, list[Any]]:
+        """Backends that accept only some values: {backend: [values]}."""
+
+@final
+class MethodInfo:
+    """One method: its config class, options, backends and what it reads."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def config(self) -> type[Ssm] | type[Bitmask] | type[Exact] | type[Auto]: ...
+    @property
+    def summary(self) -> str: ...
+    @property
+    def reads(self) -> list[str]: ...
+    @property
+    def backends(self) -> list[str]: ...
+    @property
+    def options(self) -> dict[str, OptionInfo]: ...
+
+@final
+class MeshShadowResult:
+    """A shadow map of meshes and the light-view maps it came from."""
+
+    @property
+    def visibility(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def receiver_depth(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def occluder_depth(self) -> npt.NDArray[np.float32] | None: ...
+    @property
+    def occluder_depth_back(self) -> npt.NDArray[np.float32] | None: ...
+    @property
+    def occluder_depth_middle(self) -> list[npt.NDArray[np.float32]]: ...
+    @property
+    def extent(self) -> tuple[float, float]: ...
+    @property
+    def timings(self) -> dict[str, float]: ...
+    @property
+    def method(self) -> Ssm | Bitmask | Exact: ...
+    @property
+    def backend(self) -> str: ...
+    @property
+    def threads(self) -> int: ...
+
+@final
+class DepthShadowResult:
+    """Depth maps shaded."""
+
+    @property
+    def visibility(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def timings(self) -> dict[str, float]: ...
+    @property
+    def method(self) -> Ssm | Bitmask | Exact: ...
+    @property
+    def backend(self) -> str: ...
+    @property
+    def threads(self) -> int: ...
+
+def capabilities() -> dict[str, MethodInfo]:
+    """{method name: MethodInfo} for every method."""
+
+def limits() -> dict[str, Any]:
+    """The limits that are not one method's."""
+
+def light_frame(light: _Light) -> tuple[list[float], list[float], list[float]]:
     """Validates a light and returns its frame (u, v, n) as unit vectors."""
 
 def shadow_map_from_meshes(
@@ -30,30 +218,21 @@ def shadow_map_from_meshes(
     occ_faces: npt.NDArray[np.uint32],
     rec_vertices: npt.NDArray[np.float64],
     rec_faces: npt.NDArray[np.uint32],
-    light: Light,
-    width: int,
-    height: int,
+    light: _Light,
+    resolution: _Resolution,
     extent: tuple[float, float] | None,
-    passes: int,
-    method: str,
+    method: _MethodArg,
+    *,
+    passes: int | None = None,
     samples: int | None = None,
+    occluder_resolution: _Resolution | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
-    occluder_resolution: tuple[int, int] | None = None,
     backend: str = "cpu",
-) -> dict[str, Any]:
-    """Rasterizes the receivers (and, for the map methods, the occluders) into
-    light-view maps and computes the visibility. Returns a dict with
-    ``visibility`` and ``receiver_depth`` ((H, W) float32), ``occluder_depth``
-    and ``occluder_depth_back`` (on the occluder grid; None with one pass, or
-    for methods that trace triangles), ``occluder_depth_middle`` (the peeled
-    layers, a list; empty below 3 passes), ``extent``: (tx, ty) and
-    ``timings``: {stage: seconds}. ``samples`` is for the sampling methods
-    only, ``hierarchy`` (None: the method's default) for the occluder-map
-    methods, ``precision`` ("f32", "f64", "f16", "f16-batched"; None: "f32")
-    for "ssm". ``backend``: "cpu" or "gpu" (every method; no adapter raises
-    GpuUnavailableError; the GPU has no hierarchy and sums in f32, and
-    refuses ``hierarchy=True`` and other precisions)."""
+    threads: int | None = None,
+) -> MeshShadowResult:
+    """Meshes -> light-view maps -> visibility, on ``backend`` ("cpu", "gpu"
+    or "auto"). ``method`` is a config, or a name with the loose options."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
@@ -61,57 +240,53 @@ def shadow_map_from_depth(
     receiver_depth: npt.NDArray[np.float32],
     light_size: tuple[float, float],
     extent: tuple[float, float],
-    method: str,
+    method: _MethodArg,
+    *,
+    passes: int | None = None,
     samples: int | None = None,
+    occluder_resolution: _Resolution | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
     backend: str = "cpu",
-) -> dict[str, Any]:
+    threads: int | None = None,
+) -> DepthShadowResult:
     """Visibility from depth maps (the occluder maps may have their own
-    resolution; the output has the receiver map's). Returns ``visibility`` and
-    ``timings``. ``backend``: "cpu" or "gpu" (as for shadow_map_from_meshes)."""
+    resolution; the output has the receiver map's)."""
 
 def sample_points(
-    light: Light,
+    light: _Light,
     extent: tuple[float, float],
-    width: int,
-    height: int,
+    resolution: tuple[int, int],
     points: npt.NDArray[np.float64],
-    method: str,
-    samples: int | None = None,
-    hierarchy: bool | None = None,
-    precision: str | None = None,
+    method: _MethodArg,
+    *,
     occluder_depth: npt.NDArray[np.float32] | None = None,
     occluder_depth_back: npt.NDArray[np.float32] | None = None,
     occ_vertices: npt.NDArray[np.float64] | None = None,
     occ_faces: npt.NDArray[np.uint32] | None = None,
     occluder_depth_middle: list[npt.NDArray[np.float32]] | None = None,
+    threads: int | None = None,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.bool_]]:
-    """Visibility at world points (N, 3), and whether each lies inside the map
-    (points outside, or at or behind the light's plane, get 1 and False). The
-    occluders are the occluder maps (map methods) or the mesh (``"exact"``)."""
+    """Visibility at world points (N, 3), and whether each lies inside the map."""
 
 def receiver_points(
     receiver_depth: npt.NDArray[np.float32],
-    light: Light,
+    light: _Light,
     extent: tuple[float, float],
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64]]:
     """World points (M, 3) of the texels with a receiver, and their flat indices."""
 
+def worker_threads(threads: int | None = None) -> int:
+    """The worker threads a call would run on with ``threads``."""
+
 class GpuUnavailableError(RuntimeError):
-    """backend="gpu" was asked for and no GPU adapter can be opened (none
-    present, no Vulkan driver, or SOFTSHADOW_GPU=off)."""
+    """backend="gpu" was asked for and no GPU adapter can be opened."""
 
 def gpu_available() -> bool:
-    """Whether a GPU adapter opens (software ones such as lavapipe count).
-    The device is opened once per process and kept."""
+    """Whether a GPU adapter opens (software ones such as lavapipe count)."""
 
 def gpu_info() -> dict[str, Any]:
-    """The adapter backend="gpu" uses: ``name``, ``backend`` ("vulkan"),
-    ``device_type`` ("discrete_gpu", "integrated_gpu", "virtual_gpu", "cpu"
-    or "other"), ``driver`` and ``software`` (bool: a CPU renderer). Raises
-    GpuUnavailableError when there is none."""
+    """The adapter backend="gpu" uses."""
 
 def _panic_for_tests(in_worker: bool) -> None:
-    """Panics on purpose (in a rayon worker thread when ``in_worker``) to test
-    that panics become RuntimeError. Not part of the API."""
+    """Panics on purpose to test that panics become RuntimeError."""

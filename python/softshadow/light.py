@@ -39,12 +39,10 @@ class RectLight:
         up: Any,
         size: Any = (1.0, 1.0),
     ) -> None:
-        c = check.vector("center", center, 3)
-        n = check.vector("normal", normal, 3)
-        u = check.vector("up", up, 3)
-        if np.isscalar(size):
-            size = (size, size)
-        s = check.vector("size", size, 2)
+        c = check.vector3("center", center)
+        n = check.vector3("normal", normal)
+        u = check.vector3("up", up)
+        s = check.pair("size", size)
         frame = _core.light_frame((c, n, u, s))
         object.__setattr__(self, "center", c)
         object.__setattr__(self, "normal", n)

@@ -9,6 +9,7 @@ floor y = 0 (a square 8 units wide), light 1 x 1 at height 4 facing down,
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from importlib import resources
 
 import numpy as np
@@ -116,7 +117,8 @@ def two_spheres(light_size: float = 1.0) -> tuple[Scene, RectLight]:
     return Scene(occluders=occ, receivers=[floor()]), default_light(light_size)
 
 
-SCENES = {
+#: The built-in scenes by name; each call builds ``(scene, light)`` afresh.
+SCENES: dict[str, Callable[[], tuple[Scene, RectLight]]] = {
     "bunny_floating": bunny_floating,
     "bunny_on_floor": bunny_on_floor,
     "square_plate": square_plate,

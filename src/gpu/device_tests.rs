@@ -2,8 +2,8 @@
 //! an adapter these tests say so and pass, unless SOFTSHADOW_REQUIRE_GPU=1
 //! (set by scripts/test.sh, which installs lavapipe) makes that a failure.
 
-use crate::light::RectLight;
-use crate::mesh::MeshRef;
+use crate::geom::light::RectLight;
+use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
 use crate::pipeline::{self, MapSettings, ShadowResult};
 
@@ -142,7 +142,7 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
         assert_eq!(same_bits(&c.receiver, &g.receiver), 0, "receiver");
         match (c.occluder_front, g.occluder_front) {
             (Some(a), Some(b)) => assert_eq!(same_bits(&a, &b), 0, "front, passes {passes}"),
-            (None, None) => assert!(method.traces_triangles()),
+            (None, None) => assert!(method.reads_input(crate::methods::Input::OccluderTriangles)),
             _ => panic!("front layers differ in presence"),
         }
         assert_eq!(c.occluder_middle.len(), g.occluder_middle.len());
@@ -187,7 +187,7 @@ fn depth_maps_cannot_be_traced() {
     // `exact` traces triangles, which depth maps do not have: refused as on
     // the CPU, before any GPU work.
     let z = vec![2f32; 64];
-    let g = crate::light::MapGrid::new(8, 8, [0.5, 0.5]).unwrap();
+    let g = crate::geom::light::MapGrid::new(8, 8, [0.5, 0.5]).unwrap();
     let e = super::from_depth(
         &g,
         &g,

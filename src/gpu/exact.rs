@@ -6,7 +6,7 @@
 use super::context::Gpu;
 use super::dispatch::{bind, module, pipeline, storage, uniform, upload};
 use super::timing::StageTimer;
-use crate::light::MapGrid;
+use crate::geom::light::MapGrid;
 use crate::methods::exact::{sample_grid, Bvh, RAY_EPS};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;

@@ -10,10 +10,10 @@ use super::readback::{submit_and_read, visibility, with_error_scopes};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::light::{is_point, MapGrid};
+use crate::geom::light::{is_point, MapGrid};
+use crate::geom::units::{depth_unit, farthest};
 use crate::methods::Method;
 use crate::pipeline::{check_depth_inputs, DepthInUnit, Stopwatch, Timings};
-use crate::units::{depth_unit, farthest};
 
 /// A point light (size 0) has no GPU kernel: its hard shadow map is the
 /// CPU's (`point_light.rs`).

@@ -17,9 +17,9 @@ use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::light::{is_point, RectLight};
-use crate::mesh::MeshRef;
-use crate::methods::Method;
+use crate::geom::light::{is_point, RectLight};
+use crate::geom::mesh::MeshRef;
+use crate::methods::{Input, Method};
 use crate::pipeline::{
     frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
 };
@@ -60,7 +60,7 @@ pub fn from_meshes(
     s: &MapSettings,
 ) -> Result<ShadowResult> {
     // Map methods shade occluder maps; `exact` traces the triangles.
-    let traced = s.method.traces_triangles();
+    let traced = s.method.reads_input(Input::OccluderTriangles);
     if !traced {
         gather::check_method(s.method)?;
     }

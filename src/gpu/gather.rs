@@ -5,7 +5,7 @@
 
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
 use crate::error::{Error, Result};
-use crate::light::MapGrid;
+use crate::geom::light::MapGrid;
 use crate::methods::ssm::Precision;
 use crate::methods::Method;
 use bytemuck::{Pod, Zeroable};

@@ -6,7 +6,7 @@
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform, upload};
 use super::timing::StageTimer;
-use crate::light::MapGrid;
+use crate::geom::light::MapGrid;
 use crate::raster::{SetupTri, PEEL_GAP};
 use bytemuck::{Pod, Zeroable};
 use std::sync::OnceLock;

@@ -8,7 +8,7 @@ use super::dispatch::{storage, upload};
 use super::gather::{self, GatherBuffers, GatherParams};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::light::MapGrid;
+use crate::geom::light::MapGrid;
 use crate::methods::Method;
 
 /// Refuses maps (and accumulators) that do not fit one buffer binding, or

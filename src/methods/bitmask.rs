@@ -277,7 +277,7 @@ impl ShadowMethod for Bitmask {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::MapGrid;
+    use crate::geom::light::MapGrid;
 
     #[test]
     fn pattern_is_multi_jittered() {
@@ -378,19 +378,5 @@ mod tests {
         };
         let v = Bitmask::new(64, None).visibility_map(&inputs);
         assert!(v.iter().all(|&x| x == 0.0), "{v:?}");
-    }
-}
-
-#[cfg(test)]
-mod bench {
-    use super::*;
-
-    /// Times the kernel on the maps `benchmarks/dump_maps.py` writes (a
-    /// development aid): cargo test --release --lib bench_bitmask -- --ignored --nocapture
-    #[test]
-    #[ignore]
-    fn bench_bitmask() {
-        let (t, sum) = crate::methods::bench_data::time(&Bitmask::new(256, None), 5);
-        println!("median {:.2} ms (checksum {sum:.3})", t * 1e3);
     }
 }

@@ -309,7 +309,7 @@ impl ShadowMethod for Exact {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::MapGrid;
+    use crate::geom::light::MapGrid;
 
     fn plate(z: f32, lo: [f32; 2], hi: [f32; 2]) -> Vec<[Vec3; 3]> {
         let v = [

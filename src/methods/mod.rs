@@ -1,16 +1,21 @@
-//! Shadow methods. Each method is one module behind [`ShadowMethod`]; every
-//! method reads the same inputs (the light-view maps) and writes the same
-//! outputs (visibility per receiver texel, or per receiver point).
+//! Shadow methods. Each method is one module behind [`ShadowMethod`],
+//! configured by one typed config (`config.rs`) and declaring what it reads
+//! ([`Method::reads`]); every method writes the same outputs (visibility per
+//! receiver texel, or per receiver point). `capabilities.rs` publishes the
+//! table of methods, options, defaults and limits.
 
 pub mod bitmask;
+pub mod capabilities;
+pub mod config;
 pub mod exact;
 mod gather;
-
-pub use gather::Hierarchy;
+pub mod point_light;
 pub mod ssm;
 
-use crate::error::{Error, Result};
-use crate::light::MapGrid;
+pub use config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
+pub use gather::Hierarchy;
+
+use crate::geom::light::MapGrid;
 use glam::Vec3;
 
 /// What every method reads: the light-view maps and the light's size.
@@ -48,8 +53,29 @@ pub trait ShadowMethod: Sync {
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32>;
 }
 
-/// The methods a user can pick.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What a method reads besides the receivers: the pipeline builds only that.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Input {
+    /// Light-view depth layers of the occluders (front, peeled, back).
+    OccluderLayers,
+    /// The occluder triangles in light space.
+    OccluderTriangles,
+}
+
+impl Input {
+    /// The name the capabilities table gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::OccluderLayers => "occluder_layers",
+            Input::OccluderTriangles => "occluder_triangles",
+        }
+    }
+}
+
+/// A method's kernel, with the options that change what it computes (the
+/// options that change what it reads, layers and their resolution, are the
+/// pipeline's: see `config.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Method {
     /// Soft shadow maps, Atty et al. 2005, as published (additive
     /// micro-patches); `hierarchy` reads coarser occluder texels where the
@@ -76,85 +102,12 @@ pub const HIERARCHY: Hierarchy = Hierarchy {
     max_texel_on_light: 0.03,
 };
 
-/// Default light samples per receiver for the sampling methods.
-pub const DEFAULT_SAMPLES: u32 = 256;
-/// The most light samples per receiver we accept.
-pub const MAX_SAMPLES: u32 = 1 << 16;
+/// Whether the hierarchy is on by default on the CPU: off for the paper's
+/// method (reproduced as published), on for bitmask.
+pub const HIERARCHY_DEFAULT_SSM: bool = false;
+pub const HIERARCHY_DEFAULT_BITMASK: bool = true;
 
 impl Method {
-    /// The method named `name`; `samples` is for the sampling methods only,
-    /// `hierarchy` for the occluder-map methods only, `precision` for "ssm"
-    /// only (the others count samples in integers).
-    pub fn parse(
-        name: &str,
-        samples: Option<u32>,
-        hierarchy: Option<bool>,
-        precision: Option<&str>,
-    ) -> Result<Self> {
-        let precision = match precision {
-            None => None,
-            Some(p) => Some(ssm::Precision::parse(p).ok_or_else(|| {
-                Error::invalid(
-                    "precision",
-                    format!("must be one of \"f32\", \"f64\", \"f16\", \"f16-batched\", got {p:?}"),
-                )
-            })?),
-        };
-        if name != "ssm" && precision.is_some() {
-            return Err(Error::invalid(
-                "precision",
-                "applies to \"ssm\" (sums of occlusions); the other methods count samples exactly",
-            ));
-        }
-        let method = match name {
-            "ssm" => Method::Ssm {
-                hierarchy: hierarchy.unwrap_or(false),
-                precision: precision.unwrap_or_default(),
-            },
-            "exact" => Method::Exact {
-                samples: samples.unwrap_or(DEFAULT_SAMPLES),
-            },
-            "bitmask" => Method::Bitmask {
-                samples: samples.unwrap_or(DEFAULT_SAMPLES),
-                hierarchy: hierarchy.unwrap_or(true),
-            },
-            other => {
-                return Err(Error::invalid(
-                    "method",
-                    format!("unknown method {other:?}; available: \"ssm\", \"bitmask\", \"exact\""),
-                ))
-            }
-        };
-        if method.traces_triangles() && hierarchy.is_some() {
-            return Err(Error::invalid(
-                "hierarchy",
-                "applies to the occluder-map methods (\"ssm\", \"bitmask\"), not to \"exact\"",
-            ));
-        }
-        match (method, samples) {
-            (Method::Ssm { .. }, Some(_)) => Err(Error::invalid(
-                "samples",
-                "applies to the sampling methods (\"bitmask\", \"exact\"), not to \"ssm\"",
-            )),
-            (Method::Exact { samples }, _) if samples == 0 || samples > MAX_SAMPLES => {
-                Err(Error::invalid(
-                    "samples",
-                    format!("must be in [1, {MAX_SAMPLES}], got {samples}"),
-                ))
-            }
-            (Method::Bitmask { samples, .. }, _) if !bitmask::SAMPLE_COUNTS.contains(&samples) => {
-                Err(Error::invalid(
-                    "samples",
-                    format!(
-                        "bitmask takes one of {:?} samples, got {samples}",
-                        bitmask::SAMPLE_COUNTS
-                    ),
-                ))
-            }
-            _ => Ok(method),
-        }
-    }
-
     /// The name a user passes as `method=`.
     pub fn name(&self) -> &'static str {
         match self {
@@ -164,9 +117,17 @@ impl Method {
         }
     }
 
-    /// Whether the method reads the occluder triangles (not the occluder maps).
-    pub fn traces_triangles(&self) -> bool {
-        matches!(self, Method::Exact { .. })
+    /// What the method reads of the occluders.
+    pub fn reads(&self) -> &'static [Input] {
+        match self {
+            Method::Ssm { .. } | Method::Bitmask { .. } => &[Input::OccluderLayers],
+            Method::Exact { .. } => &[Input::OccluderTriangles],
+        }
+    }
+
+    /// Whether the method reads `input`.
+    pub fn reads_input(&self, input: Input) -> bool {
+        self.reads().contains(&input)
     }
 
     pub fn implementation(&self) -> Box<dyn ShadowMethod> {
@@ -235,49 +196,5 @@ pub(crate) mod plate_case {
             }
         }
         max
-    }
-}
-
-/// The bunny's maps that `benchmarks/dump_maps.py` writes to /tmp, timed by
-/// the kernels' ignored bench tests.
-#[cfg(test)]
-pub(crate) mod bench_data {
-    use super::{MapGrid, ShadowInputs, ShadowMethod};
-
-    fn read(p: &str) -> Vec<f32> {
-        std::fs::read(p)
-            .unwrap_or_else(|e| panic!("{p}: {e}; run python benchmarks/dump_maps.py first"))
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect()
-    }
-
-    /// Median seconds of `runs` runs of `method` on the dumped maps, and a
-    /// checksum of the result.
-    pub fn time(method: &dyn ShadowMethod, runs: usize) -> (f64, f64) {
-        let (front, back, rec) = (
-            read("/tmp/front.f32"),
-            read("/tmp/back.f32"),
-            read("/tmp/rec.f32"),
-        );
-        let grid = MapGrid::new(256, 256, [0.3137646436112252, 0.3050549377029778]).unwrap();
-        let inputs = ShadowInputs {
-            grid,
-            occluder_grid: grid,
-            light_size: [1.0, 1.0],
-            receiver: &rec,
-            occluder_layers: vec![&front, &back],
-            occluder_triangles: None,
-        };
-        let mut ts = vec![];
-        let mut sum = 0.0;
-        for _ in 0..runs {
-            let t = std::time::Instant::now();
-            let v = method.visibility_map(&inputs);
-            ts.push(t.elapsed().as_secs_f64());
-            sum = v.iter().map(|&x| x as f64).sum::<f64>();
-        }
-        ts.sort_by(|a, b| a.total_cmp(b));
-        (ts[runs / 2], sum)
     }
 }

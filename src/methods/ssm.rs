@@ -10,7 +10,7 @@
 //! plane at X = k (xq - xr) with k = zR zO / (zR - zO) = 1 / (1/zO - 1/zR).
 //! In units of the light's width, shifted so the light is [0, 1]:
 //!     [a, b] = [(x0 - xr) r / Lx + 1/2, (x1 - xr) r / Lx + 1/2],  r = 1/(wO - wR)
-//! with w = 1/z; the same along y; the occlusion is |[a,b] ∩ [0,1]| |[c,d] ∩ [0,1]|
+//! with w = 1/z; the same along y; the occlusion is `|[a,b] ∩ [0,1]| |[c,d] ∩ [0,1]|`
 //! (the paper's SAT trick). The patch reaches receivers within
 //!     |xq - xr| < L/2 (wO - wR)
 //! which is its penumbra extent (§3.3) in tangent units.
@@ -32,7 +32,7 @@ pub struct Ssm {
 }
 
 /// How the micro-patch occlusions are summed (Appendix A of the paper).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Precision {
     /// f32 sums, each occluder row summed on its own before joining the
     /// total: a two-level sum whose rounding error grows as sqrt(M) eps, not
@@ -52,6 +52,24 @@ pub enum Precision {
 }
 
 impl Precision {
+    /// Every precision, in the order the capabilities list them.
+    pub const ALL: [Precision; 4] = [
+        Precision::F32,
+        Precision::F64,
+        Precision::F16,
+        Precision::F16Batched,
+    ];
+
+    /// The name a user passes as `precision=`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+            Precision::F16 => "f16",
+            Precision::F16Batched => "f16-batched",
+        }
+    }
+
     pub fn parse(name: &str) -> Option<Precision> {
         Some(match name {
             "f32" => Precision::F32,
@@ -312,7 +330,7 @@ impl ShadowMethod for Ssm {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::MapGrid;
+    use crate::geom::light::MapGrid;
 
     /// The published method written as plainly as possible, in f64: every
     /// occluder texel against every receiver texel, no bounds, no early exit.
@@ -643,19 +661,5 @@ mod tests {
         // exactly, so only f32 rounding remains.
         let max = crate::methods::plate_case::max_error(&Ssm::default(), 64);
         assert!(max < 1e-5, "max error {max}");
-    }
-}
-
-#[cfg(test)]
-mod bench {
-    use super::*;
-
-    /// Times the kernel on the maps `benchmarks/dump_maps.py` writes (a
-    /// development aid): cargo test --release --lib bench_dumped -- --ignored --nocapture
-    #[test]
-    #[ignore]
-    fn bench_dumped() {
-        let (t, sum) = crate::methods::bench_data::time(&Ssm::default(), 30);
-        println!("median {:.2} ms (checksum {sum:.3})", t * 1e3);
     }
 }

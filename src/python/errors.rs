@@ -27,7 +27,7 @@ impl From<Error> for PyErr {
             // ValueError (a bad argument) and a MemoryError.
             Error::TooLarge { .. } => Python::attach(|py| {
                 match py
-                    .import("softshadow._validate")
+                    .import("softshadow.errors")
                     .and_then(|m| m.getattr("TooLargeError"))
                     .and_then(|c| Ok(c.cast_into::<PyType>()?))
                 {

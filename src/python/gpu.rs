@@ -1,80 +1,15 @@
-//! The GPU side of the bindings: which backend runs the mesh pipeline, and
-//! what the adapter is. Without the `gpu` feature every GPU request raises
-//! GpuUnavailableError.
+//! What the GPU adapter is. Without the `gpu` feature there is none, and
+//! every GPU request raises GpuUnavailableError (the dispatch is the core's:
+//! `crate::backend`).
 
-use crate::error::{Error, Result};
-use crate::light::{MapGrid, RectLight};
-use crate::mesh::MeshRef;
-use crate::methods::Method;
-use crate::pipeline::{self, MapSettings, ShadowResult, Timings};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// Runs the mesh pipeline on `backend` ("cpu" or "gpu"; Python resolves "auto").
-pub fn from_meshes(
-    backend: &str,
-    occ: MeshRef,
-    rec: MeshRef,
-    light: &RectLight,
-    s: &MapSettings,
-) -> Result<ShadowResult> {
-    match backend {
-        "cpu" => pipeline::from_meshes(occ, rec, light, s),
-        #[cfg(feature = "gpu")]
-        "gpu" => crate::gpu::from_meshes(occ, rec, light, s),
-        #[cfg(not(feature = "gpu"))]
-        "gpu" => Err(not_built()),
-        other => Err(Error::invalid(
-            "backend",
-            format!("must be \"cpu\" or \"gpu\", got {other:?}"),
-        )),
-    }
-}
-
-/// Shades depth maps on `backend` ("cpu" or "gpu").
-#[allow(clippy::too_many_arguments)]
-pub fn from_depth(
-    backend: &str,
-    grid: &MapGrid,
-    occluder_grid: &MapGrid,
-    light_size: [f64; 2],
-    front: &[f32],
-    back: Option<&[f32]>,
-    receiver: &[f32],
-    method: Method,
-) -> Result<(Vec<f32>, Timings)> {
-    match backend {
-        "cpu" => pipeline::from_depth(
-            grid,
-            occluder_grid,
-            light_size,
-            front,
-            back,
-            receiver,
-            method,
-        ),
-        #[cfg(feature = "gpu")]
-        "gpu" => crate::gpu::from_depth(
-            grid,
-            occluder_grid,
-            light_size,
-            front,
-            back,
-            receiver,
-            method,
-        ),
-        #[cfg(not(feature = "gpu"))]
-        "gpu" => Err(not_built()),
-        other => Err(Error::invalid(
-            "backend",
-            format!("must be \"cpu\" or \"gpu\", got {other:?}"),
-        )),
-    }
-}
-
 #[cfg(not(feature = "gpu"))]
-fn not_built() -> Error {
-    Error::gpu_unavailable("this build of softshadow has no GPU backend (cargo feature `gpu`)")
+fn not_built() -> crate::error::Error {
+    crate::error::Error::gpu_unavailable(
+        "this build of softshadow has no GPU backend (cargo feature `gpu`)",
+    )
 }
 
 /// Whether backend="gpu" can run: an adapter opens (software or not).

@@ -1,15 +1,21 @@
 """Shared parameters of the hard cases: every method and backend the package
 offers joins every test through these lists (a new backend or method is
-tested by adding it to softshadow.shadow_map, nothing here)."""
+tested by adding it to the core's capabilities table, nothing here)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from softshadow.shadow_map import BACKENDS, METHODS, TRACING_METHODS
+import softshadow as ss
 
 __all__ = ["BACKENDS", "MAP_METHODS", "METHODS", "SAMPLES", "assert_visibility", "options"]
 
+_CAPS = ss.capabilities()
+# Every method ("auto" is a rule that resolves to one of them).
+METHODS = tuple(name for name in _CAPS if name != "auto")
+# Every backend of this build that runs some method.
+BACKENDS = tuple(dict.fromkeys(b for name in METHODS for b in _CAPS[name].backends))
+TRACING_METHODS = tuple(name for name in METHODS if "occluder_triangles" in _CAPS[name].reads)
 # Methods that read depth maps (so work from soft_shadow_map_from_depth).
 MAP_METHODS = tuple(m for m in METHODS if m not in TRACING_METHODS)
 # Samples for the sampling methods in these tests: enough to resolve the

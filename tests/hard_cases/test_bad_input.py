@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import softshadow as ss
+from hard_cases.common import METHODS
 from softshadow import _core, io, scenes
 
 
@@ -42,7 +43,7 @@ def test_absurd_resolutions_are_refused_before_allocating_as_memory_errors():
     # The core refuses it too, by the same type, before touching the meshes.
     v, f = scene.occluder_mesh
     with pytest.raises(ss.TooLargeError, match="resolution.*bytes"):
-        _core.shadow_map_from_meshes(v, f, v, f, LIGHT, 1 << 20, 1 << 20, None, 1, "ssm")
+        _core.shadow_map_from_meshes(v, f, v, f, LIGHT, (1 << 20, 1 << 20), None, "ssm", passes=1)
 
 
 def test_maps_larger_than_the_memory_available_are_refused_before_allocating(monkeypatch):
@@ -137,7 +138,7 @@ def test_degenerate_open_and_non_manifold_meshes_are_accepted():
     # A vertical fin on the plate's middle line: three faces share an edge.
     fin_v = np.array([[-0.5, 2.0, 0.0], [0.5, 2.0, 0.0], [0.0, 2.5, 0.0]])
     light = scenes.default_light()
-    for method in ss.shadow_map.METHODS:
+    for method in METHODS:
         kw = dict(resolution=32, extent=0.5, method=method)
         if method != "ssm":
             kw["samples"] = 64
@@ -236,20 +237,29 @@ def test_bad_points_and_outside_values():
         ),
         (lambda o, r: _core.light_frame((1, 2)), ValueError, "while processing 'light'"),
         # Values: the core's messages start with the name.
-        (lambda o, r: _core.shadow_map_from_depth(o, None, r, (1, 1), (0.5, 0.5), "ssm", -1), ValueError, "samples"),
+        (
+            lambda o, r: _core.shadow_map_from_depth(o, None, r, (1, 1), (0.5, 0.5), "bitmask", samples=-1),
+            ValueError,
+            "samples",
+        ),
         (
             lambda o, r: _core.shadow_map_from_depth(o, None, r, (1e-40, 1), (0.5, 0.5), "bitmask"),
             ValueError,
             "light_size",
         ),
         (
-            lambda o, r: _core.sample_points(LIGHT, (0.5, 0.5), -8, 8, np.zeros((1, 3)), "ssm", occluder_depth=o),
+            lambda o, r: _core.sample_points(LIGHT, (0.5, 0.5), (-8, 8), np.zeros((1, 3)), ss.Ssm(), occluder_depth=o),
             ValueError,
             "resolution",
         ),
         (
             lambda o, r: _core.sample_points(
-                LIGHT, (0.5, 0.5), 8, 8, np.zeros((1, 3)), "ssm", occluder_depth=np.full((8, 8), np.nan, np.float32)
+                LIGHT,
+                (0.5, 0.5),
+                (8, 8),
+                np.zeros((1, 3)),
+                ss.Ssm(),
+                occluder_depth=np.full((8, 8), np.nan, np.float32),
             ),
             ValueError,
             "occluder layer 0.*> 0",
@@ -262,11 +272,10 @@ def test_bad_points_and_outside_values():
                 np.zeros((3, 3)),
                 np.array([[0, 1, 2]], np.uint32),
                 LIGHT,
-                8,
-                8,
+                (8, 8),
                 None,
-                -2,
                 "ssm",
+                passes=-2,
             ),
             ValueError,
             "passes",

@@ -5,7 +5,7 @@ import pytest
 
 import softshadow as ss
 from softshadow import scenes
-from softshadow.fp16 import condition_4
+from softshadow.experiments.fp16 import condition_4
 
 # A square plate at depth 2 over a parallel floor at depth 4, light 1x1,
 # tangent extent 0.5: at N² each micro-patch hides (4 / N)² = (128 / N)² 2^-10 of the

@@ -28,9 +28,8 @@ from hypothesis import strategies as st
 
 import softshadow as ss
 from hard_cases import plate as closed
-from hard_cases.common import MAP_METHODS, METHODS, assert_visibility
+from hard_cases.common import BACKENDS, MAP_METHODS, METHODS, assert_visibility
 from softshadow import scenes
-from softshadow.shadow_map import BACKENDS
 
 SETTINGS = settings(
     max_examples=50, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow], database=None

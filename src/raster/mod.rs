@@ -13,8 +13,10 @@
 //! * Parallel without locks: the map is cut into bands of rows; triangles are
 //!   binned by band, and each band is rasterized by one task.
 
-use crate::depth_plane::DepthPlane;
-use crate::light::MapGrid;
+pub(crate) mod depth_plane;
+
+use crate::geom::light::MapGrid;
+use crate::raster::depth_plane::DepthPlane;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -667,43 +669,5 @@ mod tests {
             .iter()
             .all(|z| z.is_infinite() || (*z > 0.0 && z.is_finite())));
         assert!(d.nearest.iter().any(|z| z.is_finite()));
-    }
-}
-
-#[cfg(test)]
-mod bench {
-    use super::*;
-
-    /// Times the rasterizer on the mesh `benchmarks/dump_maps.py` writes to /tmp (a development aid):
-    /// cargo test --release --lib bench_raster -- --ignored --nocapture
-    #[test]
-    #[ignore]
-    fn bench_raster() {
-        let v: Vec<DVec3> = std::fs::read("/tmp/bv.f64")
-            .unwrap()
-            .chunks_exact(24)
-            .map(|b| {
-                let f = |k: usize| f64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap());
-                DVec3::new(f(0), f(1), f(2))
-            })
-            .collect();
-        let f: Vec<[u32; 3]> = std::fs::read("/tmp/bf.u32")
-            .unwrap()
-            .chunks_exact(12)
-            .map(|b| {
-                let u = |k: usize| u32::from_le_bytes(b[4 * k..4 * k + 4].try_into().unwrap());
-                [u(0), u(1), u(2)]
-            })
-            .collect();
-        let g = MapGrid::new(256, 256, [0.31, 0.31]).unwrap();
-        let mut ts = vec![];
-        for _ in 0..50 {
-            let t = std::time::Instant::now();
-            let d = rasterize(&g, &v, &f, 1e-9, true);
-            ts.push(t.elapsed().as_secs_f64());
-            assert!(d.nearest.iter().any(|z| z.is_finite()));
-        }
-        ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
-        println!("raster median {:.3} ms", ts[25] * 1e3);
     }
 }

@@ -1,7 +1,7 @@
 //! Triangle meshes handed to the core: validation and the move to light space.
 
 use crate::error::{Error, Result};
-use crate::light::RectLight;
+use crate::geom::light::RectLight;
 use glam::DVec3;
 use rayon::prelude::*;
 

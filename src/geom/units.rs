@@ -101,7 +101,7 @@ pub fn scaled_map(depth: &[f32], unit: f64) -> std::borrow::Cow<'_, [f32]> {
 /// The light's size in unit `unit`, refused when the kernels cannot resolve it.
 pub fn light_size_in(arg: &str, size: [f64; 2], unit: f64) -> Result<[f64; 2]> {
     let s = [size[0] / unit, size[1] / unit];
-    if crate::light::is_point(size) {
+    if crate::geom::light::is_point(size) {
         return Ok([0.0, 0.0]);
     }
     if s.iter()

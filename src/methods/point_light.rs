@@ -9,7 +9,7 @@
 //! light of size exactly (0, 0) takes this path instead. (`exact` needs no
 //! special case: all its rays go to the light's center.)
 
-use crate::light::MapGrid;
+use crate::geom::light::MapGrid;
 use crate::methods::{LightPoint, ShadowInputs};
 use rayon::prelude::*;
 

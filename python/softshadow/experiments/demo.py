@@ -1,6 +1,6 @@
 """The main job: a soft shadow map of the bunny floating over a floor.
 
-    python -m softshadow.demo [--out DIR] [--resolution N] [--passes P] [--samples K]
+    python -m softshadow.experiments.demo [--out DIR] [--resolution N] [--passes P] [--samples K]
 
 Writes the visibility map as EXR and PNG, prints the stage timings, and the
 error against a Mitsuba reference (K stratified light samples per texel).
@@ -15,13 +15,13 @@ import time
 
 import numpy as np
 
-from . import scenes
-from .io import to_uint8, write_exr, write_png
-from .shadow_map import soft_shadow_map
+from .. import scenes
+from ..io import to_uint8, write_exr, write_png
+from ..shadow_map import soft_shadow_map
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m softshadow.demo", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="python -m softshadow.experiments.demo", description=__doc__.split("\n")[0])
     p.add_argument("--out", default="out", help="output folder (default: out)")
     p.add_argument("--resolution", type=int, default=256)
     p.add_argument("--passes", type=int, default=2, choices=(1, 2))
@@ -47,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"wrote {stem}_visibility.exr and {stem}_visibility.png")
 
     if a.samples > 0:
-        from . import metrics, reference
+        from .. import metrics, reference
 
         t = time.perf_counter()
         ref = reference.reference_map(sm, scene.occluders, samples=a.samples)

@@ -1,0 +1,37 @@
+"""The methods a user picks, as typed configs, and the core's table of them.
+
+``Ssm``, ``Bitmask``, ``Exact`` and ``Auto`` are the core's classes
+(frozen, keyword-only, compared by value, picklable); their options,
+defaults and limits are the core's and :func:`capabilities` publishes them.
+An option left ``None`` is resolved when the config runs (the result's
+``method`` is the resolved config).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from . import _core
+from ._core import Auto, Bitmask, Exact, MethodInfo, OptionInfo, Ssm
+
+MethodConfig = Ssm | Bitmask | Exact | Auto
+"""Any method config."""
+
+
+def capabilities() -> dict[str, MethodInfo]:
+    """Per method (``"ssm"``, ``"bitmask"``, ``"exact"``, ``"auto"``): its
+    config class, options (kind, default, limits or allowed values, values a
+    backend restricts), the backends of this build that run it, and what it
+    reads of the occluders (``"occluder_layers"``, ``"occluder_triangles"``)."""
+    return dict(_core.capabilities())
+
+
+def limits() -> dict[str, Any]:
+    """Limits that are not one method's: ``max_texels`` per map,
+    ``max_extent`` (tangent half-extent), ``max_passes``, ``max_samples``
+    (``exact``), ``max_threads`` (``threads=``) and ``gpu_max_side`` (0
+    without a GPU backend)."""
+    return dict(_core.limits())
+
+
+__all__ = ["Auto", "Bitmask", "Exact", "MethodConfig", "MethodInfo", "OptionInfo", "Ssm", "capabilities", "limits"]

@@ -1,0 +1,225 @@
+//! Which backend runs a call, and the dispatch to it: the CPU pipelines
+//! (`crate::pipeline`, rayon) or the GPU's (`crate::gpu`, wgpu compute).
+//! Both take the same inputs and return the same outputs; a Rust user picks
+//! one with [`BackendChoice`], the bindings only pass the user's string.
+//!
+//! Every call resolves its method config here, against the backend that will
+//! run it (the GPU has no hierarchy and sums in f32 only), and runs on the
+//! worker threads `threads.rs` allows.
+
+use crate::error::{Error, Result};
+use crate::geom::light::{check_light_size, is_point, MapGrid, RectLight};
+use crate::geom::mesh::MeshRef;
+use crate::methods::config::{check_resolution, CallContext};
+use crate::methods::MethodConfig;
+use crate::pipeline::{self, MapSettings, ShadowResult, Timings};
+use crate::threads;
+
+/// A backend that runs shadow maps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Backend {
+    /// All cores (rayon); always built.
+    Cpu,
+    /// wgpu compute (cargo feature `gpu`).
+    Gpu,
+}
+
+/// What a user asks for: a backend, or `Auto`: the GPU when a real
+/// (non-software) adapter is present and runs the call, else the CPU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BackendChoice {
+    Cpu,
+    Gpu,
+    Auto,
+}
+
+impl Backend {
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+            Backend::Gpu => "gpu",
+        }
+    }
+
+    /// The backends this build has.
+    pub fn built() -> &'static [Backend] {
+        if cfg!(feature = "gpu") {
+            &[Backend::Cpu, Backend::Gpu]
+        } else {
+            &[Backend::Cpu]
+        }
+    }
+}
+
+impl BackendChoice {
+    /// `backend=` by name: "cpu", "gpu" or "auto".
+    pub fn parse(name: &str) -> Result<BackendChoice> {
+        match name {
+            "cpu" => Ok(BackendChoice::Cpu),
+            "gpu" => Ok(BackendChoice::Gpu),
+            "auto" => Ok(BackendChoice::Auto),
+            other => Err(Error::invalid(
+                "backend",
+                format!("must be one of \"cpu\", \"gpu\", \"auto\", got {other:?}"),
+            )),
+        }
+    }
+
+    /// The backend that runs `method` with a light of `light_size`: "auto"
+    /// takes a real GPU where the config resolves there (and the light is
+    /// not a point, which has no GPU kernel).
+    fn pick(self, method: &MethodConfig, ctx: CallContext, light_size: [f64; 2]) -> Backend {
+        match self {
+            BackendChoice::Cpu => Backend::Cpu,
+            BackendChoice::Gpu => Backend::Gpu,
+            BackendChoice::Auto => {
+                let gpu = CallContext {
+                    backend: Backend::Gpu,
+                    ..ctx
+                };
+                if real_gpu() && !is_point(light_size) && method.resolve(&gpu).is_ok() {
+                    Backend::Gpu
+                } else {
+                    Backend::Cpu
+                }
+            }
+        }
+    }
+}
+
+#[cfg(feature = "gpu")]
+fn real_gpu() -> bool {
+    crate::gpu::info().is_ok_and(|i| !i.software)
+}
+
+#[cfg(not(feature = "gpu"))]
+fn real_gpu() -> bool {
+    false
+}
+
+#[cfg(not(feature = "gpu"))]
+fn not_built() -> Error {
+    Error::gpu_unavailable("this build of softshadow has no GPU backend (cargo feature `gpu`)")
+}
+
+/// A call's output with what ran it.
+#[derive(Debug, Clone)]
+pub struct Run<T> {
+    pub output: T,
+    /// The config that ran ("auto" resolved, every default filled in).
+    pub method: MethodConfig,
+    pub backend: Backend,
+    /// Worker threads the CPU stages could use.
+    pub threads: usize,
+}
+
+/// A shadow map of meshes: what to compute and where.
+#[derive(Debug, Clone, Copy)]
+pub struct MeshCall<'a> {
+    pub occluders: MeshRef<'a>,
+    pub receivers: MeshRef<'a>,
+    pub light: &'a RectLight,
+    /// Output (W, H).
+    pub resolution: (i64, i64),
+    /// Tangent half-extents, or `None` to fit them.
+    pub extent: Option<[f64; 2]>,
+    pub method: MethodConfig,
+    pub backend: BackendChoice,
+    /// Worker threads; `None`: SOFTSHADOW_THREADS, else all cores.
+    pub threads: Option<i64>,
+}
+
+/// Meshes -> light-view maps -> visibility, on the chosen backend.
+pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
+    let (w, h) = check_resolution("resolution", call.resolution)?;
+    let cap = threads::resolve(call.threads)?;
+    let ctx = CallContext {
+        backend: Backend::Cpu,
+        resolution: (w, h),
+        depth_layers: None,
+    };
+    let backend = call.backend.pick(&call.method, ctx, call.light.size);
+    let method = call.method.resolve(&CallContext { backend, ..ctx })?;
+    let settings = MapSettings::new(w, h, call.extent, &method);
+    let (output, threads) = threads::run_capped(cap, || match backend {
+        Backend::Cpu => {
+            pipeline::from_meshes(call.occluders, call.receivers, call.light, &settings)
+        }
+        #[cfg(feature = "gpu")]
+        Backend::Gpu => {
+            crate::gpu::from_meshes(call.occluders, call.receivers, call.light, &settings)
+        }
+        #[cfg(not(feature = "gpu"))]
+        Backend::Gpu => Err(not_built()),
+    })?;
+    Ok(Run {
+        output,
+        method,
+        backend,
+        threads,
+    })
+}
+
+/// Depth maps the user rendered: what to shade and where.
+#[derive(Debug, Clone, Copy)]
+pub struct DepthCall<'a> {
+    /// The receiver map's grid, which the output shares.
+    pub grid: MapGrid,
+    /// The occluder maps' grid (same extent, their own resolution).
+    pub occluder_grid: MapGrid,
+    pub light_size: [f64; 2],
+    pub front: &'a [f32],
+    pub back: Option<&'a [f32]>,
+    pub receiver: &'a [f32],
+    pub method: MethodConfig,
+    pub backend: BackendChoice,
+    pub threads: Option<i64>,
+}
+
+/// Depth maps -> visibility, on the chosen backend.
+pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<(Vec<f32>, Timings)>> {
+    let cap = threads::resolve(call.threads)?;
+    let light_size = check_light_size("light_size", call.light_size)?;
+    let layers = 1 + call.back.is_some() as u32;
+    let og = &call.occluder_grid;
+    let ctx = CallContext {
+        backend: Backend::Cpu,
+        resolution: (call.grid.width, call.grid.height),
+        depth_layers: Some((layers, (og.width, og.height))),
+    };
+    let backend = call.backend.pick(&call.method, ctx, light_size);
+    let method = call.method.resolve(&CallContext { backend, ..ctx })?;
+    let kernel = method.kernel();
+    let (g, f, b, r) = (&call.grid, call.front, call.back, call.receiver);
+    let (output, threads) = threads::run_capped(cap, || match backend {
+        Backend::Cpu => pipeline::from_depth(g, og, light_size, f, b, r, kernel),
+        #[cfg(feature = "gpu")]
+        Backend::Gpu => crate::gpu::from_depth(g, og, light_size, f, b, r, kernel),
+        #[cfg(not(feature = "gpu"))]
+        Backend::Gpu => Err(not_built()),
+    })?;
+    Ok(Run {
+        output,
+        method,
+        backend,
+        threads,
+    })
+}
+
+/// Visibility at world points from a shadow map's occluders (the CPU: points
+/// are few and scattered). `method` is the config the map ran with.
+pub fn sample_points(
+    grid: &MapGrid,
+    light: &RectLight,
+    occluders: pipeline::OccluderSource,
+    points: &[[f64; 3]],
+    method: &MethodConfig,
+    threads: Option<i64>,
+) -> Result<(Vec<f32>, Vec<bool>)> {
+    let cap = threads::resolve(threads)?;
+    let kernel = method.kernel();
+    threads::run_capped(cap, || {
+        pipeline::sample_points(grid, light, occluders, points, kernel)
+    })
+    .map(|(v, _)| v)
+}

@@ -1,0 +1,235 @@
+//! The table of methods: their options, defaults, limits, the backends that
+//! run them and what they read. Built from the constants the configs check
+//! against (`config.rs`), so the table cannot drift from the checks; the
+//! Python package reads it from `_core` and copies nothing.
+
+use super::config::{DEFAULT_SAMPLES, MAX_PASSES, MAX_SAMPLES};
+use super::{bitmask, ssm::Precision, Input, HIERARCHY_DEFAULT_BITMASK, HIERARCHY_DEFAULT_SSM};
+use crate::backend::Backend;
+use crate::geom::light::{MAX_EXTENT, MAX_TEXELS};
+
+/// An option's value, for defaults and allowed values.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    /// Resolved when the config runs (see the option's `default_doc`).
+    Resolved,
+    Int(i64),
+    Bool(bool),
+    Str(&'static str),
+}
+
+/// What values an option takes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Kind {
+    /// An integer in [min, max].
+    Int {
+        min: i64,
+        max: i64,
+    },
+    /// One of these integers.
+    OneOf(Vec<i64>),
+    Bool,
+    /// One of these names.
+    Choice(Vec<&'static str>),
+    /// A map resolution: an int (square) or (W, H), each at least 1, at most
+    /// `max_texels` texels.
+    Resolution {
+        max_texels: i64,
+    },
+}
+
+/// One option of a method's config.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptionInfo {
+    pub name: &'static str,
+    pub kind: Kind,
+    pub default: Value,
+    /// The default in words (how a `Resolved` default is chosen).
+    pub default_doc: &'static str,
+    pub doc: &'static str,
+    /// Backends that accept only some values of it: (backend, the values).
+    pub restricted_on: Vec<(Backend, Vec<Value>)>,
+}
+
+/// One method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MethodInfo {
+    /// The name given as `method=`.
+    pub name: &'static str,
+    /// The config class (`softshadow.Ssm`, ...).
+    pub config: &'static str,
+    pub summary: &'static str,
+    /// What it reads of the occluders (the receivers are always read).
+    pub reads: Vec<Input>,
+    /// The backends of this build that run it.
+    pub backends: Vec<Backend>,
+    pub options: Vec<OptionInfo>,
+}
+
+/// Limits that are not one method's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Texels per map.
+    pub max_texels: usize,
+    /// Tangent half-extent of a light-view map.
+    pub max_extent: f64,
+    /// Occluder depth layers.
+    pub max_passes: u32,
+    /// Light samples of `exact`.
+    pub max_samples: u32,
+    /// Worker threads per call (`threads=`).
+    pub max_threads: usize,
+    /// Largest map side on the GPU backend (0 without one).
+    pub gpu_max_side: usize,
+}
+
+pub fn limits() -> Limits {
+    Limits {
+        max_texels: MAX_TEXELS,
+        max_extent: MAX_EXTENT,
+        max_passes: MAX_PASSES,
+        max_samples: MAX_SAMPLES,
+        max_threads: crate::threads::MAX_THREADS,
+        #[cfg(feature = "gpu")]
+        gpu_max_side: crate::gpu::MAX_SIDE,
+        #[cfg(not(feature = "gpu"))]
+        gpu_max_side: 0,
+    }
+}
+
+fn passes() -> OptionInfo {
+    OptionInfo {
+        name: "passes",
+        kind: Kind::Int {
+            min: 1,
+            max: MAX_PASSES as i64,
+        },
+        default: Value::Resolved,
+        default_doc: "2 (front and back) from meshes; the layers given from depth maps",
+        doc: "occluder depth layers: 1, the front; 2, front and back (paper §3.5); 3 to 8, \
+              front, passes - 2 layers found by depth peeling, and back",
+        restricted_on: vec![],
+    }
+}
+
+fn occluder_resolution() -> OptionInfo {
+    OptionInfo {
+        name: "occluder_resolution",
+        kind: Kind::Resolution {
+            max_texels: MAX_TEXELS as i64,
+        },
+        default: Value::Resolved,
+        default_doc: "the output's resolution; from depth maps, the occluder maps' shape",
+        doc: "resolution of the occluder maps (same extent as the output): coarser maps \
+              cost less, their error is the discretization of paper §4.1.1",
+        restricted_on: vec![],
+    }
+}
+
+fn hierarchy(default_on: bool) -> OptionInfo {
+    OptionInfo {
+        name: "hierarchy",
+        kind: Kind::Bool,
+        default: Value::Resolved,
+        default_doc: if default_on {
+            "on on the CPU; off on the GPU, which has no hierarchy"
+        } else {
+            "off (the paper's method, reproduced as published)"
+        },
+        doc: "read the occluder maps through a min/max pyramid: each 8x8 tile of receivers \
+              reads the coarsest level whose texels cover at most 3% of the light's width",
+        restricted_on: vec![(Backend::Gpu, vec![Value::Bool(false)])],
+    }
+}
+
+/// The methods, in the order a user meets them.
+pub fn methods() -> Vec<MethodInfo> {
+    let backends = Backend::built().to_vec();
+    let sampling_default = DEFAULT_SAMPLES as i64;
+    vec![
+        MethodInfo {
+            name: "ssm",
+            config: "Ssm",
+            summary: "Soft shadow maps (Atty et al. 2005) as published: micro-patches of the \
+                      occluder maps back-projected onto the light, their occlusions summed",
+            reads: vec![Input::OccluderLayers],
+            backends: backends.clone(),
+            options: vec![
+                passes(),
+                occluder_resolution(),
+                hierarchy(HIERARCHY_DEFAULT_SSM),
+                OptionInfo {
+                    name: "precision",
+                    kind: Kind::Choice(Precision::ALL.iter().map(|p| p.name()).collect()),
+                    default: Value::Str(Precision::default().name()),
+                    default_doc: "f32, each occluder row summed on its own",
+                    doc: "how the occlusions are summed (paper Appendix A): f32 two-level, f64, \
+                          emulated FP16 blending, or FP16 in batches of about sqrt(M)",
+                    restricted_on: vec![(Backend::Gpu, vec![Value::Str(Precision::F32.name())])],
+                },
+            ],
+        },
+        MethodInfo {
+            name: "bitmask",
+            config: "Bitmask",
+            summary: "The same micro-patches marking the light samples they hide in a bit mask \
+                      per receiver, merged by OR (Schwarz & Stamminger 2007)",
+            reads: vec![Input::OccluderLayers],
+            backends: backends.clone(),
+            options: vec![
+                OptionInfo {
+                    name: "samples",
+                    kind: Kind::OneOf(bitmask::SAMPLE_COUNTS.iter().map(|&n| n as i64).collect()),
+                    default: Value::Int(sampling_default),
+                    default_doc: "256",
+                    doc: "light samples per receiver, a multi-jittered pattern shared by all \
+                          receivers",
+                    restricted_on: vec![],
+                },
+                passes(),
+                occluder_resolution(),
+                hierarchy(HIERARCHY_DEFAULT_BITMASK),
+            ],
+        },
+        MethodInfo {
+            name: "exact",
+            config: "Exact",
+            summary: "Ray casting against the occluder triangles (a BVH) with stratified light \
+                      samples, jittered deterministically: converges to the true visibility",
+            reads: vec![Input::OccluderTriangles],
+            backends: backends.clone(),
+            options: vec![OptionInfo {
+                name: "samples",
+                kind: Kind::Int {
+                    min: 1,
+                    max: MAX_SAMPLES as i64,
+                },
+                default: Value::Int(sampling_default),
+                default_doc: "256 (a 16x16 stratification)",
+                doc: "light samples per receiver",
+                restricted_on: vec![],
+            }],
+        },
+        MethodInfo {
+            name: "auto",
+            config: "Auto",
+            summary: "A rule, not a method: \"ssm\" with two passes and occluder maps at a \
+                      quarter of the output's resolution (at least 64, at most the output's), \
+                      the point of the study's accuracy-time plane furthest ahead of ray tracing",
+            reads: vec![Input::OccluderLayers],
+            backends,
+            options: vec![],
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_method_name_has_one_row() {
+        let names: Vec<_> = methods().iter().map(|m| m.name).collect();
+        assert_eq!(names, super::super::config::METHOD_NAMES);
+    }
+}

@@ -1,0 +1,630 @@
+//! The typed configuration of each method, as a user writes it, and its
+//! resolution into what runs.
+//!
+//! A config holds the method's options. Options whose default depends on the
+//! call (the number of occluder layers, the occluder maps' resolution, the
+//! hierarchy on a backend that has none) are `None` until the config is
+//! resolved against that call ([`MethodConfig::resolve`]); the resolved
+//! config is what ran, and a result reports it. Every value is checked here,
+//! once, when the config is built: the bindings and the Python package only
+//! convert types.
+//!
+//! The defaults and limits below are the ones the capabilities table
+//! (`capabilities.rs`) publishes.
+
+use super::{bitmask, ssm::Precision, Method, HIERARCHY_DEFAULT_BITMASK, HIERARCHY_DEFAULT_SSM};
+use crate::backend::Backend;
+use crate::error::{Error, Result};
+use crate::geom::light::MAX_TEXELS;
+
+/// Default light samples per receiver for the sampling methods (a 16x16
+/// stratification).
+pub const DEFAULT_SAMPLES: u32 = 256;
+/// The most light samples per receiver `exact` accepts.
+pub const MAX_SAMPLES: u32 = 1 << 16;
+/// The most occluder depth layers we peel.
+pub const MAX_PASSES: u32 = 8;
+/// Occluder layers taken from meshes when `passes` is not given: front and
+/// back (§3.5 of the paper).
+pub const DEFAULT_PASSES: u32 = 2;
+
+/// The paper's soft shadow maps (Atty et al. 2005): additive micro-patches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct SsmConfig {
+    /// Occluder depth layers; `None`: 2 from meshes, the layers given from
+    /// depth maps.
+    pub passes: Option<u32>,
+    /// Occluder maps' (W, H); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
+    /// The occluder hierarchy; `None`: off (the paper has none).
+    pub hierarchy: Option<bool>,
+    pub precision: Precision,
+}
+
+/// Micro-patches marking light samples in a bit mask per receiver
+/// (Schwarz & Stamminger 2007).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BitmaskConfig {
+    /// One of `bitmask::SAMPLE_COUNTS`.
+    pub samples: u32,
+    pub passes: Option<u32>,
+    pub occluder_resolution: Option<(usize, usize)>,
+    /// `None`: on where the backend has a hierarchy (the CPU), else off.
+    pub hierarchy: Option<bool>,
+}
+
+/// Ray casting through a BVH of the occluder triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ExactConfig {
+    pub samples: u32,
+}
+
+/// What a user picks: a method with its options, or `Auto` (a rule that
+/// resolves to `Ssm`; the `SsmConfig` it holds are options given beside
+/// `method="auto"`, which override the rule's: `ss.Auto()` holds none).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MethodConfig {
+    Auto(SsmConfig),
+    Ssm(SsmConfig),
+    Bitmask(BitmaskConfig),
+    Exact(ExactConfig),
+}
+
+/// Options given loosely by name (the string form `method="bitmask",
+/// samples=64`); each must apply to the named method.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LooseOptions<'a> {
+    pub passes: Option<i64>,
+    pub samples: Option<i64>,
+    pub occluder_resolution: Option<(i64, i64)>,
+    pub hierarchy: Option<bool>,
+    pub precision: Option<&'a str>,
+}
+
+impl LooseOptions<'_> {
+    fn given(&self) -> Vec<&'static str> {
+        let mut v = vec![];
+        if self.passes.is_some() {
+            v.push("passes");
+        }
+        if self.samples.is_some() {
+            v.push("samples");
+        }
+        if self.occluder_resolution.is_some() {
+            v.push("occluder_resolution");
+        }
+        if self.hierarchy.is_some() {
+            v.push("hierarchy");
+        }
+        if self.precision.is_some() {
+            v.push("precision");
+        }
+        v
+    }
+}
+
+/// The method names a user can pass as `method=`, in the table's order.
+pub const METHOD_NAMES: [&str; 4] = ["ssm", "bitmask", "exact", "auto"];
+
+/// Light samples of `exact`: 1 to MAX_SAMPLES.
+pub fn check_exact_samples(n: i64) -> Result<u32> {
+    if (1..=MAX_SAMPLES as i64).contains(&n) {
+        Ok(n as u32)
+    } else {
+        Err(Error::invalid(
+            "samples",
+            format!("must be in [1, {MAX_SAMPLES}], got {n}"),
+        ))
+    }
+}
+
+/// Light samples of `bitmask`: one of its patterns' sizes.
+pub fn check_bitmask_samples(n: i64) -> Result<u32> {
+    match bitmask::SAMPLE_COUNTS.iter().find(|&&c| c as i64 == n) {
+        Some(&c) => Ok(c),
+        None => Err(Error::invalid(
+            "samples",
+            format!(
+                "bitmask takes one of {:?} samples, got {n}",
+                bitmask::SAMPLE_COUNTS
+            ),
+        )),
+    }
+}
+
+/// How many occluder depth layers are taken: 1, the front; 2, front and back
+/// (§3.5); more, front, the next layers by depth peeling, and back.
+pub fn check_passes(passes: i64) -> Result<u32> {
+    if (1..=MAX_PASSES as i64).contains(&passes) {
+        Ok(passes as u32)
+    } else {
+        Err(Error::invalid(
+            "passes",
+            format!(
+                "must be 1 (front layer), 2 (front and back) or up to {MAX_PASSES} (front, peeled layers, back), got {passes}"
+            ),
+        ))
+    }
+}
+
+/// A map resolution (W, H): at least 1x1, at most MAX_TEXELS texels.
+pub fn check_resolution(arg: &str, (w, h): (i64, i64)) -> Result<(usize, usize)> {
+    if w < 1 || h < 1 {
+        return Err(Error::invalid(
+            arg,
+            format!("must be at least 1x1, got {w}x{h}"),
+        ));
+    }
+    let texels = (w as u128) * (h as u128);
+    if texels > MAX_TEXELS as u128 {
+        return Err(Error::too_large(
+            arg,
+            format!(
+                "{w}x{h} would need {} bytes per map (limit {MAX_TEXELS} texels)",
+                texels * 4
+            ),
+        ));
+    }
+    Ok((w as usize, h as usize))
+}
+
+/// `precision=` by name.
+pub fn check_precision(name: &str) -> Result<Precision> {
+    Precision::parse(name).ok_or_else(|| {
+        Error::invalid(
+            "precision",
+            format!(
+                "must be one of {:?}, got {name:?}",
+                Precision::ALL.map(|p| p.name())
+            ),
+        )
+    })
+}
+
+impl SsmConfig {
+    /// Checks each given option; `None` keeps the default.
+    pub fn new(
+        passes: Option<i64>,
+        occluder_resolution: Option<(i64, i64)>,
+        hierarchy: Option<bool>,
+        precision: Option<&str>,
+    ) -> Result<Self> {
+        Ok(SsmConfig {
+            passes: passes.map(check_passes).transpose()?,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+            hierarchy,
+            precision: precision
+                .map(check_precision)
+                .transpose()?
+                .unwrap_or_default(),
+        })
+    }
+}
+
+impl BitmaskConfig {
+    pub fn new(
+        samples: Option<i64>,
+        passes: Option<i64>,
+        occluder_resolution: Option<(i64, i64)>,
+        hierarchy: Option<bool>,
+    ) -> Result<Self> {
+        Ok(BitmaskConfig {
+            samples: samples
+                .map(check_bitmask_samples)
+                .transpose()?
+                .unwrap_or(DEFAULT_SAMPLES),
+            passes: passes.map(check_passes).transpose()?,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+            hierarchy,
+        })
+    }
+}
+
+impl Default for BitmaskConfig {
+    fn default() -> Self {
+        BitmaskConfig {
+            samples: DEFAULT_SAMPLES,
+            passes: None,
+            occluder_resolution: None,
+            hierarchy: None,
+        }
+    }
+}
+
+impl ExactConfig {
+    pub fn new(samples: Option<i64>) -> Result<Self> {
+        Ok(ExactConfig {
+            samples: samples
+                .map(check_exact_samples)
+                .transpose()?
+                .unwrap_or(DEFAULT_SAMPLES),
+        })
+    }
+}
+
+impl Default for ExactConfig {
+    fn default() -> Self {
+        ExactConfig {
+            samples: DEFAULT_SAMPLES,
+        }
+    }
+}
+
+/// The call a config is resolved against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CallContext {
+    /// The backend that will run it.
+    pub backend: Backend,
+    /// The output map's (W, H).
+    pub resolution: (usize, usize),
+    /// From depth maps: how many occluder layers the user gave and their
+    /// (W, H). `None`: from meshes (the pipeline makes the layers).
+    pub depth_layers: Option<(u32, (usize, usize))>,
+}
+
+/// What `method="auto"` runs at output `resolution` (W, H): the paper's
+/// method with two passes and occluder maps at a quarter of the output's
+/// resolution, at least 64 (never more than the output's).
+///
+/// The rule comes from the study (`python -m softshadow.experiments.study`,
+/// docs/study/study.md): on its four scenes at 256², this is the point of the
+/// accuracy-time plane where softshadow is furthest ahead of Mitsuba's
+/// `ray_test` at equal error (4.7-8.4x faster, errors 0.030-0.037); finer
+/// occluder maps cost 2.5-8x more for at most 0.005 less error. Below 64
+/// texels an occluder map loses small occluders.
+pub fn auto_rule(resolution: (usize, usize)) -> SsmConfig {
+    let quarter = |n: usize| n.min((n / 4).max(64));
+    SsmConfig {
+        passes: Some(DEFAULT_PASSES),
+        occluder_resolution: Some((quarter(resolution.0), quarter(resolution.1))),
+        hierarchy: None,
+        precision: Precision::F32,
+    }
+}
+
+/// Options shared by the occluder-map methods, resolved for a call.
+fn resolve_maps(
+    passes: Option<u32>,
+    occluder_resolution: Option<(usize, usize)>,
+    hierarchy: Option<bool>,
+    default_hierarchy: bool,
+    ctx: &CallContext,
+) -> Result<(u32, (usize, usize), bool)> {
+    let hierarchy = match (hierarchy, ctx.backend) {
+        (Some(true), Backend::Gpu) => {
+            return Err(Error::invalid(
+                "hierarchy",
+                "the GPU backend has no occluder hierarchy yet; use backend=\"cpu\"",
+            ))
+        }
+        (Some(h), _) => h,
+        // The GPU kernels have no hierarchy: off there by default.
+        (None, Backend::Gpu) => false,
+        (None, Backend::Cpu) => default_hierarchy,
+    };
+    match ctx.depth_layers {
+        None => Ok((
+            passes.unwrap_or(DEFAULT_PASSES),
+            occluder_resolution.unwrap_or(ctx.resolution),
+            hierarchy,
+        )),
+        Some((layers, shape)) => {
+            if let Some(p) = passes.filter(|&p| p != layers) {
+                return Err(Error::invalid(
+                    "passes",
+                    format!(
+                        "the depth maps given hold {layers} occluder layer(s), not {p} \
+                         (occluder_depth, and occluder_depth_back for 2)"
+                    ),
+                ));
+            }
+            if let Some(r) = occluder_resolution.filter(|&r| r != shape) {
+                return Err(Error::invalid(
+                    "occluder_resolution",
+                    format!(
+                        "the occluder maps given are {}x{}, not {}x{}",
+                        shape.0, shape.1, r.0, r.1
+                    ),
+                ));
+            }
+            Ok((layers, shape, hierarchy))
+        }
+    }
+}
+
+impl MethodConfig {
+    /// The config named `name` with the loose options given: each must apply
+    /// to that method.
+    pub fn from_name(name: &str, o: &LooseOptions) -> Result<Self> {
+        let refuse = |opt: &str, applies: &str| {
+            Err(Error::invalid(
+                opt,
+                format!("applies to {applies}, not to {name:?}"),
+            ))
+        };
+        let c = match name {
+            "ssm" => {
+                if o.samples.is_some() {
+                    return refuse("samples", "the sampling methods (\"bitmask\", \"exact\")");
+                }
+                MethodConfig::Ssm(SsmConfig::new(
+                    o.passes,
+                    o.occluder_resolution,
+                    o.hierarchy,
+                    o.precision,
+                )?)
+            }
+            "bitmask" => {
+                if o.precision.is_some() {
+                    return refuse(
+                        "precision",
+                        "\"ssm\" (sums of occlusions); the other methods count samples exactly",
+                    );
+                }
+                MethodConfig::Bitmask(BitmaskConfig::new(
+                    o.samples,
+                    o.passes,
+                    o.occluder_resolution,
+                    o.hierarchy,
+                )?)
+            }
+            "exact" => {
+                // `passes` beside "exact" is accepted and has no effect (the
+                // string form always allowed it: it reads no layers).
+                if let Some(p) = o.passes {
+                    check_passes(p)?;
+                }
+                for (given, opt) in [
+                    (o.occluder_resolution.is_some(), "occluder_resolution"),
+                    (o.hierarchy.is_some(), "hierarchy"),
+                ] {
+                    if given {
+                        return refuse(
+                            opt,
+                            "the occluder-map methods (\"ssm\", \"bitmask\"); \"exact\" traces the occluder triangles",
+                        );
+                    }
+                }
+                if o.precision.is_some() {
+                    return refuse(
+                        "precision",
+                        "\"ssm\" (sums of occlusions); the other methods count samples exactly",
+                    );
+                }
+                MethodConfig::Exact(ExactConfig::new(o.samples)?)
+            }
+            "auto" => {
+                // The rule's choice is "ssm": its options given beside
+                // "auto" replace the rule's.
+                if o.samples.is_some() {
+                    return refuse("samples", "the sampling methods (\"bitmask\", \"exact\")");
+                }
+                MethodConfig::Auto(SsmConfig::new(
+                    o.passes,
+                    o.occluder_resolution,
+                    o.hierarchy,
+                    o.precision,
+                )?)
+            }
+            other => {
+                return Err(Error::invalid(
+                    "method",
+                    format!("unknown method {other:?}; available: {METHOD_NAMES:?}"),
+                ))
+            }
+        };
+        Ok(c)
+    }
+
+    /// A typed config passed with loose options too: refused (one place says
+    /// each option).
+    pub fn refuse_loose(o: &LooseOptions) -> Result<()> {
+        match o.given().first() {
+            None => Ok(()),
+            Some(opt) => Err(Error::invalid(
+                *opt,
+                "give it inside the method config (for example method=Bitmask(samples=64)), \
+                 not beside it",
+            )),
+        }
+    }
+
+    /// The name a user passes as `method=`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            MethodConfig::Auto(_) => "auto",
+            MethodConfig::Ssm(_) => "ssm",
+            MethodConfig::Bitmask(_) => "bitmask",
+            MethodConfig::Exact(_) => "exact",
+        }
+    }
+
+    /// The config that runs for `ctx`: "auto" replaced by its rule, every
+    /// call-dependent default filled in, backend restrictions checked.
+    pub fn resolve(&self, ctx: &CallContext) -> Result<MethodConfig> {
+        Ok(match *self {
+            MethodConfig::Auto(given) => {
+                let rule = match ctx.depth_layers {
+                    // From depth maps the layers and their resolution are given.
+                    Some(_) => SsmConfig::default(),
+                    None => auto_rule(ctx.resolution),
+                };
+                let ssm = SsmConfig {
+                    passes: given.passes.or(rule.passes),
+                    occluder_resolution: given.occluder_resolution.or(rule.occluder_resolution),
+                    hierarchy: given.hierarchy.or(rule.hierarchy),
+                    precision: given.precision,
+                };
+                return MethodConfig::Ssm(ssm).resolve(ctx);
+            }
+            MethodConfig::Ssm(c) => {
+                if ctx.backend == Backend::Gpu && c.precision != Precision::F32 {
+                    return Err(Error::invalid(
+                        "precision",
+                        format!(
+                            "the GPU backend sums in \"f32\" only, got {:?}; use backend=\"cpu\"",
+                            c.precision.name()
+                        ),
+                    ));
+                }
+                let (passes, occ, hierarchy) = resolve_maps(
+                    c.passes,
+                    c.occluder_resolution,
+                    c.hierarchy,
+                    HIERARCHY_DEFAULT_SSM,
+                    ctx,
+                )?;
+                MethodConfig::Ssm(SsmConfig {
+                    passes: Some(passes),
+                    occluder_resolution: Some(occ),
+                    hierarchy: Some(hierarchy),
+                    precision: c.precision,
+                })
+            }
+            MethodConfig::Bitmask(c) => {
+                let (passes, occ, hierarchy) = resolve_maps(
+                    c.passes,
+                    c.occluder_resolution,
+                    c.hierarchy,
+                    HIERARCHY_DEFAULT_BITMASK,
+                    ctx,
+                )?;
+                MethodConfig::Bitmask(BitmaskConfig {
+                    samples: c.samples,
+                    passes: Some(passes),
+                    occluder_resolution: Some(occ),
+                    hierarchy: Some(hierarchy),
+                })
+            }
+            MethodConfig::Exact(c) => {
+                if ctx.depth_layers.is_some() {
+                    return Err(Error::invalid(
+                        "method",
+                        "\"exact\" traces the occluder triangles, which depth maps do not have; \
+                         use soft_shadow_map with meshes",
+                    ));
+                }
+                MethodConfig::Exact(c)
+            }
+        })
+    }
+
+    /// The kernel of a config; resolve it first for the backend's defaults.
+    pub fn kernel(&self) -> Method {
+        match *self {
+            MethodConfig::Ssm(c) => Method::Ssm {
+                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
+                precision: c.precision,
+            },
+            MethodConfig::Bitmask(c) => Method::Bitmask {
+                samples: c.samples,
+                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
+            },
+            MethodConfig::Exact(c) => Method::Exact { samples: c.samples },
+            // What "auto" always resolves to.
+            MethodConfig::Auto(c) => Method::Ssm {
+                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
+                precision: c.precision,
+            },
+        }
+    }
+
+    /// Occluder layers of a resolved config (0 for methods that read none).
+    pub fn passes(&self) -> u32 {
+        match *self {
+            MethodConfig::Ssm(c) => c.passes.unwrap_or(DEFAULT_PASSES),
+            MethodConfig::Bitmask(c) => c.passes.unwrap_or(DEFAULT_PASSES),
+            MethodConfig::Exact(_) | MethodConfig::Auto(_) => 0,
+        }
+    }
+
+    /// Occluder maps' (W, H) of a resolved config (None for methods that
+    /// read no maps).
+    pub fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        match *self {
+            MethodConfig::Ssm(c) => c.occluder_resolution,
+            MethodConfig::Bitmask(c) => c.occluder_resolution,
+            MethodConfig::Exact(_) | MethodConfig::Auto(_) => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cpu(resolution: (usize, usize)) -> CallContext {
+        CallContext {
+            backend: Backend::Cpu,
+            resolution,
+            depth_layers: None,
+        }
+    }
+
+    #[test]
+    fn auto_is_ssm_with_quarter_occluder_maps_at_least_64() {
+        let r = MethodConfig::Auto(SsmConfig::default())
+            .resolve(&cpu((512, 100)))
+            .unwrap();
+        assert_eq!(r.occluder_resolution(), Some((128, 64)));
+        assert_eq!(r.passes(), 2);
+        let r = MethodConfig::Auto(SsmConfig::default())
+            .resolve(&cpu((40, 40)))
+            .unwrap();
+        assert_eq!(r.occluder_resolution(), Some((40, 40)));
+    }
+
+    #[test]
+    fn defaults_depend_on_the_backend_and_the_entry() {
+        let b = MethodConfig::Bitmask(BitmaskConfig::default());
+        assert_eq!(
+            b.resolve(&cpu((8, 8))).unwrap().kernel(),
+            Method::Bitmask {
+                samples: 256,
+                hierarchy: true
+            }
+        );
+        let gpu = CallContext {
+            backend: Backend::Gpu,
+            ..cpu((8, 8))
+        };
+        assert_eq!(
+            b.resolve(&gpu).unwrap().kernel(),
+            Method::Bitmask {
+                samples: 256,
+                hierarchy: false
+            }
+        );
+        let depth = CallContext {
+            depth_layers: Some((1, (4, 4))),
+            ..cpu((8, 8))
+        };
+        let r = b.resolve(&depth).unwrap();
+        assert_eq!((r.passes(), r.occluder_resolution()), (1, Some((4, 4))));
+        let three = MethodConfig::Bitmask(BitmaskConfig::new(None, Some(3), None, None).unwrap());
+        assert!(
+            matches!(three.resolve(&depth), Err(Error::InvalidArgument { ref arg, .. }) if arg == "passes")
+        );
+    }
+
+    #[test]
+    fn options_that_do_not_apply_are_refused_by_name() {
+        let o = LooseOptions {
+            samples: Some(64),
+            ..Default::default()
+        };
+        let e = MethodConfig::from_name("ssm", &o).unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument { ref arg, .. } if arg == "samples"));
+        let o = LooseOptions {
+            hierarchy: Some(true),
+            ..Default::default()
+        };
+        let e = MethodConfig::from_name("exact", &o).unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument { ref arg, .. } if arg == "hierarchy"));
+        assert!(MethodConfig::refuse_loose(&o).is_err());
+    }
+}

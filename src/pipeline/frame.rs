@@ -1,0 +1,140 @@
+//! Framing: a scene's meshes checked, moved to light space in the kernels'
+//! depth unit (units.rs), and the map grids fitted to where its shadows can
+//! fall (extent.rs). Both backends start from a framed scene.
+
+use crate::error::{Error, Result};
+use crate::geom::extent::fit_extent;
+use crate::geom::light::{MapGrid, RectLight};
+use crate::geom::mesh::MeshRef;
+use crate::geom::units::{check_lateral, check_unit, depth_unit, light_size_in};
+use crate::memory::{check_fits, map_bytes};
+use crate::methods::Input;
+use glam::DVec3;
+use std::time::Instant;
+
+use super::MapSettings;
+
+/// Named stage durations in seconds, in the order they ran.
+pub type Timings = Vec<(&'static str, f64)>;
+
+pub(crate) struct Stopwatch {
+    t: Instant,
+    pub timings: Timings,
+}
+
+impl Stopwatch {
+    pub fn new() -> Self {
+        Stopwatch {
+            t: Instant::now(),
+            timings: Vec::new(),
+        }
+    }
+    /// Records the time since the last lap as stage `name`.
+    pub fn lap(&mut self, name: &'static str) {
+        let now = Instant::now();
+        self.timings.push((name, (now - self.t).as_secs_f64()));
+        self.t = now;
+    }
+}
+
+/// Clip distance for rasterization: a tiny fraction of the scene's depth range,
+/// so that geometry touching the light's plane keeps finite 1/Z.
+fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
+    let far = occ.iter().chain(rec).fold(0f64, |m, q| m.max(q.z.abs()));
+    (far * 1e-9).max(f64::MIN_POSITIVE)
+}
+
+/// A scene moved to light space with its map grids fitted: what both
+/// backends start from.
+pub(crate) struct FramedScene {
+    /// Light-space vertices in the kernels' depth unit (see units.rs).
+    pub occ_ls: Vec<DVec3>,
+    pub rec_ls: Vec<DVec3>,
+    pub grid: MapGrid,
+    pub occluder_grid: MapGrid,
+    pub near: f64,
+    /// The depth unit (a power of two): maps go back to the user's units
+    /// by multiplying with it.
+    pub unit: f64,
+    /// The light's size in that unit.
+    pub light_size: [f64; 2],
+}
+
+/// Checks the input, moves the meshes to light space and fits the grids
+/// (stages "transform" and "extent").
+pub(crate) fn frame_scene(
+    occluders: &MeshRef,
+    receivers: &MeshRef,
+    light: &RectLight,
+    s: &MapSettings,
+    sw: &mut Stopwatch,
+) -> Result<FramedScene> {
+    // Passes were checked when the config was built (methods/config.rs).
+    if occluders.is_empty() {
+        return Err(Error::invalid(
+            "occluders",
+            "the scene has no occluder triangles",
+        ));
+    }
+    if receivers.is_empty() {
+        return Err(Error::invalid(
+            "receivers",
+            "the scene has no receiver triangles",
+        ));
+    }
+    // Refuse an absurd resolution before touching the meshes.
+    MapGrid::new(s.width, s.height, s.extent.unwrap_or([1.0, 1.0]))?;
+    let (ow, oh) = s.occluder_resolution.unwrap_or((s.width, s.height));
+    MapGrid::new(ow, oh, s.extent.unwrap_or([1.0, 1.0]))
+        .map_err(|e| Error::invalid("occluder_resolution", e.to_string()))?;
+    // Receiver and visibility maps; each occluder layer and the kernels'
+    // 1/depth copy of it.
+    let layers = if s.method.reads_input(Input::OccluderLayers) {
+        s.passes as usize
+    } else {
+        0
+    };
+    check_fits(
+        "resolution",
+        &format!(
+            "{}x{} with {}x{} occluder maps and {} layers",
+            s.width, s.height, ow, oh, layers
+        ),
+        map_bytes(s.width * s.height, 2) + map_bytes(ow * oh, 2 * layers),
+    )?;
+    occluders.validate("occluders")?;
+    receivers.validate("receivers")?;
+
+    let mut occ_ls = occluders.to_light_space(light);
+    let mut rec_ls = receivers.to_light_space(light);
+    // Light space in the kernels' depth unit (see units.rs); maps go back to
+    // the user's units at the end.
+    let unit = depth_unit(rec_ls.iter().fold(0f64, |m, q| m.max(q.z)));
+    check_unit("receivers", unit)?;
+    let light_size = light_size_in("size", light.size, unit)?;
+    if unit != 1.0 {
+        for q in occ_ls.iter_mut().chain(rec_ls.iter_mut()) {
+            *q /= unit;
+        }
+    }
+    check_lateral("occluders", &occ_ls, unit)?;
+    check_lateral("receivers", &rec_ls, unit)?;
+    sw.lap("transform");
+    let extent = match s.extent {
+        Some(e) => e,
+        None => fit_extent(&occ_ls, &rec_ls, light_size)?,
+    };
+    let grid = MapGrid::new(s.width, s.height, extent)?;
+    let occluder_grid = MapGrid::new(ow, oh, extent)?;
+    sw.lap("extent");
+    let near = near_plane(&occ_ls, &rec_ls);
+    Ok(FramedScene {
+        occ_ls,
+        rec_ls,
+        grid,
+        occluder_grid,
+        near,
+        unit,
+        light_size,
+    })
+}

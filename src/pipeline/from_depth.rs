@@ -1,0 +1,209 @@
+//! Depth maps the user rendered -> visibility on the CPU, and the checks
+//! and unit change both backends apply to such maps.
+
+use crate::error::{Error, Result};
+use crate::geom::light::{check_light_size, MapGrid};
+use crate::geom::units::{depth_unit, farthest, light_size_in, scaled_map};
+use crate::memory::{check_fits, map_bytes};
+use crate::methods::{Input, Method, ShadowInputs};
+use rayon::prelude::*;
+use std::borrow::Cow;
+
+use super::frame::{Stopwatch, Timings};
+use super::from_meshes::shade_map;
+
+/// Checks a user depth map: finite and > 0, or +inf for "nothing here".
+pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
+    if let Some(k) = depth.par_iter().position_any(|&z| !(z > 0.0)) {
+        return Err(Error::invalid(
+            arg,
+            format!(
+                "depths must be > 0 (planar distance from the light) or +inf where empty; \
+                 texel {k} holds {}",
+                depth[k]
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks the inputs of `from_depth` (both backends): the light size, a
+/// method that reads maps, each map's size and depths. Returns the light size.
+pub(crate) fn check_depth_inputs(
+    grid: &MapGrid,
+    occluder_grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> Result<[f64; 2]> {
+    let light_size = check_light_size("light_size", light_size)?;
+    if !method.reads_input(Input::OccluderLayers) {
+        return Err(Error::invalid(
+            "method",
+            "traces the occluder triangles, which depth maps do not have; use soft_shadow_map with meshes",
+        ));
+    }
+    for (arg, d, g) in [
+        ("occluder_depth", Some(front), occluder_grid),
+        ("occluder_depth_back", back, occluder_grid),
+        ("receiver_depth", Some(receiver), grid),
+    ] {
+        if let Some(d) = d {
+            if d.len() != g.len() {
+                return Err(Error::shape(
+                    arg,
+                    format!("has {} texels, expected {}x{}", d.len(), g.height, g.width),
+                ));
+            }
+            check_depth(arg, d)?;
+        }
+    }
+    Ok(light_size)
+}
+
+/// The user's depth maps and light size in the kernels' depth unit (see
+/// units.rs), shared by both backends; the maps are copied only when the unit
+/// is not 1.
+pub(crate) struct DepthInUnit<'a> {
+    pub light_size: [f64; 2],
+    pub front: Cow<'a, [f32]>,
+    pub back: Option<Cow<'a, [f32]>>,
+    pub receiver: Cow<'a, [f32]>,
+}
+
+impl<'a> DepthInUnit<'a> {
+    pub(crate) fn new(
+        unit: f64,
+        light_size: [f64; 2],
+        front: &'a [f32],
+        back: Option<&'a [f32]>,
+        receiver: &'a [f32],
+    ) -> Result<DepthInUnit<'a>> {
+        Ok(DepthInUnit {
+            light_size: light_size_in("light_size", light_size, unit)?,
+            front: scaled_map(front, unit),
+            back: back.map(|b| scaled_map(b, unit)),
+            receiver: scaled_map(receiver, unit),
+        })
+    }
+}
+
+/// Soft shadow map from depth maps the user rendered.
+pub fn from_depth(
+    grid: &MapGrid,
+    occluder_grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> Result<(Vec<f32>, Timings)> {
+    let light_size = check_depth_inputs(
+        grid,
+        occluder_grid,
+        light_size,
+        front,
+        back,
+        receiver,
+        method,
+    )?;
+    let mut sw = Stopwatch::new();
+    // The kernels' depth unit (see units.rs): copies only far from 1.
+    let unit = depth_unit(farthest(receiver));
+    // Visibility, the kernels' 1/depth layers, and the copies in that unit.
+    let copies = if unit == 1.0 { 0 } else { 1 };
+    let layers = 1 + back.is_some() as usize;
+    check_fits(
+        "receiver_depth",
+        &format!("{}x{} maps", grid.width, grid.height),
+        map_bytes(grid.len(), 1 + copies) + map_bytes(occluder_grid.len(), layers * (1 + copies)),
+    )?;
+    let d = DepthInUnit::new(unit, light_size, front, back, receiver)?;
+    let mut layers: Vec<&[f32]> = vec![&d.front];
+    if let Some(b) = &d.back {
+        layers.push(b);
+    }
+    let inputs = ShadowInputs {
+        grid: *grid,
+        occluder_grid: *occluder_grid,
+        light_size: d.light_size,
+        receiver: &d.receiver,
+        occluder_layers: layers,
+        occluder_triangles: None,
+    };
+    let v = shade_map(method, &inputs);
+    sw.lap("shadow");
+    Ok((v, sw.timings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A texel-aligned plate at depth 2 over receivers at depth 4, times `s`.
+    fn plate_maps(n: usize, s: f32) -> (Vec<f32>, Vec<f32>) {
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let front = (0..n * n)
+            .map(|k| {
+                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
+                if x.abs() < 0.25 && y.abs() < 0.2 {
+                    2.0 * s
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        (front, vec![4.0 * s; n * n])
+    }
+
+    #[test]
+    fn depth_maps_at_any_power_of_two_scale_give_the_same_visibility() {
+        // The kernels get depths in a unit near the receivers' (units.rs):
+        // without it the SSM loses these shadows at 2^60 and 2^-70.
+        let n = 24;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let ssm = Method::Ssm {
+            hierarchy: false,
+            precision: Default::default(),
+        };
+        let bitmask = Method::Bitmask {
+            samples: 64,
+            hierarchy: true,
+        };
+        for method in [ssm, bitmask] {
+            let (f, r) = plate_maps(n, 1.0);
+            let (base, _) = from_depth(&grid, &grid, [1.0, 0.6], &f, None, &r, method).unwrap();
+            assert!(base.iter().any(|&v| v < 1e-6));
+            for k in [-90, -70, 50, 60, 90] {
+                let s = 2f32.powi(k);
+                let (f, r) = plate_maps(n, s);
+                let size = [s as f64, 0.6 * s as f64];
+                let (v, _) = from_depth(&grid, &grid, size, &f, None, &r, method).unwrap();
+                assert_eq!(v, base, "{method:?} at 2^{k}");
+            }
+        }
+    }
+
+    #[test]
+    fn light_sizes_beyond_f32_relative_to_depth_are_refused() {
+        let n = 8;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let (f, r) = plate_maps(n, 1.0);
+        let err = from_depth(
+            &grid,
+            &grid,
+            [1e-35, 1.0],
+            &f,
+            None,
+            &r,
+            Method::Ssm {
+                hierarchy: false,
+                precision: Default::default(),
+            },
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::InvalidArgument { ref arg, .. } if arg == "light_size"));
+    }
+}

@@ -1,0 +1,54 @@
+//! The end-to-end pipelines on the CPU, one file a stage of the data flow:
+//! `frame` (meshes to light space, grids fitted), `from_meshes` (light-view
+//! maps rasterized, then shaded), `from_depth` (the user's depth maps shaded),
+//! `points` (visibility at world points). Timings are kept per stage.
+//! `crate::backend` picks the CPU pipeline or the GPU's.
+
+mod frame;
+mod from_depth;
+mod from_meshes;
+mod points;
+
+// The GPU pipelines start from the same framing and checks.
+pub use frame::Timings;
+#[cfg(feature = "gpu")]
+pub(crate) use frame::{frame_scene, FramedScene, Stopwatch};
+pub use from_depth::{check_depth, from_depth};
+#[cfg(feature = "gpu")]
+pub(crate) use from_depth::{check_depth_inputs, DepthInUnit};
+pub use from_meshes::{from_meshes, light_space_triangles, ShadowResult};
+pub use points::{receiver_points, sample_points, OccluderSource};
+
+use crate::methods::{Method, MethodConfig};
+
+/// Settings of the mesh pipeline.
+#[derive(Debug, Clone, Copy)]
+pub struct MapSettings {
+    pub width: usize,
+    pub height: usize,
+    /// Tangent half-extents, or `None` to fit them (see `extent.rs`).
+    pub extent: Option<[f64; 2]>,
+    /// Resolution of the occluder maps (same extent); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
+    pub passes: u32,
+    pub method: Method,
+}
+
+impl MapSettings {
+    /// The settings of a resolved config (see `MethodConfig::resolve`).
+    pub fn new(
+        width: usize,
+        height: usize,
+        extent: Option<[f64; 2]>,
+        method: &MethodConfig,
+    ) -> MapSettings {
+        MapSettings {
+            width,
+            height,
+            extent,
+            occluder_resolution: method.occluder_resolution(),
+            passes: method.passes(),
+            method: method.kernel(),
+        }
+    }
+}

@@ -1,0 +1,318 @@
+//! The method configs as Python classes: `Ssm`, `Bitmask`, `Exact`, `Auto`.
+//! Frozen, keyword-only, compared and hashed by value, picklable (pickle
+//! calls the keyword-only constructor again through `__getnewargs_ex__`).
+//! The values are checked by the core's constructors (`methods/config.rs`);
+//! `None` means "resolved when the config runs".
+
+use super::convert::{opt_bool, opt_int, opt_resolution, opt_string, string};
+use crate::methods::config::{auto_rule, check_resolution, LooseOptions};
+use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+fn py_bool(b: bool) -> &'static str {
+    if b {
+        "True"
+    } else {
+        "False"
+    }
+}
+
+/// Python's repr of an option value.
+fn opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {
+    v.map(f).unwrap_or_else(|| "None".into())
+}
+
+fn res(r: (usize, usize)) -> String {
+    format!("({}, {})", r.0, r.1)
+}
+
+/// Soft shadow maps as published (Atty et al. 2005). See `capabilities()["ssm"]`.
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Ssm")]
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct PySsm(pub SsmConfig);
+
+#[pymethods]
+impl PySsm {
+    #[new]
+    #[pyo3(signature = (*, passes=None, occluder_resolution=None, hierarchy=None, precision=None))]
+    fn new(
+        passes: Option<&Bound<'_, PyAny>>,
+        occluder_resolution: Option<&Bound<'_, PyAny>>,
+        hierarchy: Option<&Bound<'_, PyAny>>,
+        precision: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let precision = opt_string("precision", precision)?;
+        Ok(PySsm(SsmConfig::new(
+            opt_int("passes", passes)?,
+            opt_resolution("occluder_resolution", occluder_resolution)?,
+            opt_bool("hierarchy", hierarchy)?,
+            precision.as_deref(),
+        )?))
+    }
+    /// "ssm", the name given as ``method=``.
+    #[getter]
+    fn name(&self) -> &'static str {
+        "ssm"
+    }
+    #[getter]
+    fn passes(&self) -> Option<u32> {
+        self.0.passes
+    }
+    #[getter]
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.0.occluder_resolution
+    }
+    #[getter]
+    fn hierarchy(&self) -> Option<bool> {
+        self.0.hierarchy
+    }
+    #[getter]
+    fn precision(&self) -> &'static str {
+        self.0.precision.name()
+    }
+    /// The options as keyword arguments: ``Ssm(**c.to_dict()) == c``.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("passes", self.0.passes)?;
+        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
+        d.set_item("hierarchy", self.0.hierarchy)?;
+        d.set_item("precision", self.0.precision.name())?;
+        Ok(d)
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        Ok((PyTuple::empty(py), self.to_dict(py)?))
+    }
+    fn __repr__(&self) -> String {
+        let c = self.0;
+        format!(
+            "Ssm(passes={}, occluder_resolution={}, hierarchy={}, precision='{}')",
+            opt(c.passes, |p| p.to_string()),
+            opt(c.occluder_resolution, res),
+            opt(c.hierarchy, |h| py_bool(h).into()),
+            c.precision.name()
+        )
+    }
+}
+
+/// Micro-patches marking light samples in a bit mask per receiver. See
+/// `capabilities()["bitmask"]`.
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Bitmask")]
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct PyBitmask(pub BitmaskConfig);
+
+#[pymethods]
+impl PyBitmask {
+    #[new]
+    #[pyo3(signature = (*, samples=None, passes=None, occluder_resolution=None, hierarchy=None))]
+    fn new(
+        samples: Option<&Bound<'_, PyAny>>,
+        passes: Option<&Bound<'_, PyAny>>,
+        occluder_resolution: Option<&Bound<'_, PyAny>>,
+        hierarchy: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(PyBitmask(BitmaskConfig::new(
+            opt_int("samples", samples)?,
+            opt_int("passes", passes)?,
+            opt_resolution("occluder_resolution", occluder_resolution)?,
+            opt_bool("hierarchy", hierarchy)?,
+        )?))
+    }
+    /// "bitmask", the name given as ``method=``.
+    #[getter]
+    fn name(&self) -> &'static str {
+        "bitmask"
+    }
+    #[getter]
+    fn samples(&self) -> u32 {
+        self.0.samples
+    }
+    #[getter]
+    fn passes(&self) -> Option<u32> {
+        self.0.passes
+    }
+    #[getter]
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.0.occluder_resolution
+    }
+    #[getter]
+    fn hierarchy(&self) -> Option<bool> {
+        self.0.hierarchy
+    }
+    /// The options as keyword arguments: ``Bitmask(**c.to_dict()) == c``.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("samples", self.0.samples)?;
+        d.set_item("passes", self.0.passes)?;
+        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
+        d.set_item("hierarchy", self.0.hierarchy)?;
+        Ok(d)
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        Ok((PyTuple::empty(py), self.to_dict(py)?))
+    }
+    fn __repr__(&self) -> String {
+        let c = self.0;
+        format!(
+            "Bitmask(samples={}, passes={}, occluder_resolution={}, hierarchy={})",
+            c.samples,
+            opt(c.passes, |p| p.to_string()),
+            opt(c.occluder_resolution, res),
+            opt(c.hierarchy, |h| py_bool(h).into()),
+        )
+    }
+}
+
+/// Ray casting against the occluder triangles. See `capabilities()["exact"]`.
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Exact")]
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct PyExact(pub ExactConfig);
+
+#[pymethods]
+impl PyExact {
+    #[new]
+    #[pyo3(signature = (*, samples=None))]
+    fn new(samples: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        Ok(PyExact(ExactConfig::new(opt_int("samples", samples)?)?))
+    }
+    /// "exact", the name given as ``method=``.
+    #[getter]
+    fn name(&self) -> &'static str {
+        "exact"
+    }
+    #[getter]
+    fn samples(&self) -> u32 {
+        self.0.samples
+    }
+    /// The options as keyword arguments: ``Exact(**c.to_dict()) == c``.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("samples", self.0.samples)?;
+        Ok(d)
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        Ok((PyTuple::empty(py), self.to_dict(py)?))
+    }
+    fn __repr__(&self) -> String {
+        format!("Exact(samples={})", self.0.samples)
+    }
+}
+
+/// The rule ``method="auto"`` names; it resolves to an ``Ssm`` when run
+/// (the result's ``method`` says which). See `capabilities()["auto"]`.
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Auto")]
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct PyAuto;
+
+#[pymethods]
+impl PyAuto {
+    #[new]
+    fn new() -> Self {
+        PyAuto
+    }
+    /// "auto", the name given as ``method=``.
+    #[getter]
+    fn name(&self) -> &'static str {
+        "auto"
+    }
+    /// No options: ``{}``.
+    fn to_dict<'py>(&self, py: Python<'py>) -> Bound<'py, PyDict> {
+        PyDict::new(py)
+    }
+    /// The ``Ssm`` the rule picks for an output ``resolution`` (an int or
+    /// (W, H)) from meshes.
+    fn rule(&self, resolution: &Bound<'_, PyAny>) -> PyResult<PySsm> {
+        let r = check_resolution(
+            "resolution",
+            super::convert::resolution("resolution", resolution)?,
+        )?;
+        Ok(PySsm(auto_rule(r)))
+    }
+    fn __getnewargs_ex__<'py>(&self, py: Python<'py>) -> (Bound<'py, PyTuple>, Bound<'py, PyDict>) {
+        (PyTuple::empty(py), PyDict::new(py))
+    }
+    fn __repr__(&self) -> &'static str {
+        "Auto()"
+    }
+}
+
+/// The core config of a config object, if it is one.
+fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
+    if let Ok(c) = v.cast::<PySsm>() {
+        return Some(MethodConfig::Ssm(c.get().0));
+    }
+    if let Ok(c) = v.cast::<PyBitmask>() {
+        return Some(MethodConfig::Bitmask(c.get().0));
+    }
+    if let Ok(c) = v.cast::<PyExact>() {
+        return Some(MethodConfig::Exact(c.get().0));
+    }
+    if v.cast::<PyAuto>().is_ok() {
+        return Some(MethodConfig::Auto(SsmConfig::default()));
+    }
+    None
+}
+
+/// The loose options beside `method=` (the string shorthand).
+pub struct Loose<'py> {
+    pub passes: Option<Bound<'py, PyAny>>,
+    pub samples: Option<Bound<'py, PyAny>>,
+    pub occluder_resolution: Option<Bound<'py, PyAny>>,
+    pub hierarchy: Option<Bound<'py, PyAny>>,
+    pub precision: Option<Bound<'py, PyAny>>,
+}
+
+/// `method=` (a config object, or a name with loose options) as a core
+/// config. A config object with loose options beside it is refused.
+pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<MethodConfig> {
+    let precision = opt_string("precision", loose.precision.as_ref())?;
+    let o = LooseOptions {
+        passes: opt_int("passes", loose.passes.as_ref())?,
+        samples: opt_int("samples", loose.samples.as_ref())?,
+        occluder_resolution: opt_resolution(
+            "occluder_resolution",
+            loose.occluder_resolution.as_ref(),
+        )?,
+        hierarchy: opt_bool("hierarchy", loose.hierarchy.as_ref())?,
+        precision: precision.as_deref(),
+    };
+    if let Some(c) = config_of(method) {
+        MethodConfig::refuse_loose(&o)?;
+        return Ok(c);
+    }
+    if method.extract::<String>().is_err() {
+        return Err(PyTypeError::new_err(format!(
+            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto), got {}",
+            method.get_type().name()?
+        )));
+    }
+    Ok(MethodConfig::from_name(&string("method", method)?, &o)?)
+}
+
+/// A method config as its Python object.
+pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
+    Ok(match *c {
+        MethodConfig::Ssm(c) => Py::new(py, PySsm(c))?.into_any(),
+        MethodConfig::Bitmask(c) => Py::new(py, PyBitmask(c))?.into_any(),
+        MethodConfig::Exact(c) => Py::new(py, PyExact(c))?.into_any(),
+        MethodConfig::Auto(_) => Py::new(py, PyAuto)?.into_any(),
+    })
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PySsm>()?;
+    m.add_class::<PyBitmask>()?;
+    m.add_class::<PyExact>()?;
+    m.add_class::<PyAuto>()?;
+    Ok(())
+}

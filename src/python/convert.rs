@@ -1,0 +1,156 @@
+//! Python values to core values: types are checked here (TypeError naming
+//! the argument), values by the core (ValueError from its `Error`).
+
+use crate::geom::light::RectLight;
+use crate::geom::mesh::MeshRef;
+use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyInt, PyTuple};
+
+/// A light as the package passes it: (center, normal, up, size).
+pub type Light = ([f64; 3], [f64; 3], [f64; 3], [f64; 2]);
+
+pub fn light_of(l: Light) -> PyResult<RectLight> {
+    Ok(RectLight::new(l.0, l.1, l.2, l.3)?)
+}
+
+fn type_name(v: &Bound<'_, PyAny>) -> String {
+    v.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
+/// An int (Python or numpy; not a bool). A value beyond i64 is clamped to
+/// i64's range so that the core refuses it by value, naming the argument.
+pub fn int(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<i64> {
+    if v.is_instance_of::<PyBool>() || v.get_type().name()?.to_str()? == "bool_" {
+        return Err(PyTypeError::new_err(format!(
+            "{arg}: must be an int, got bool"
+        )));
+    }
+    match v.extract::<i64>() {
+        Ok(n) => Ok(n),
+        Err(_) => {
+            let i = v.call_method0("__index__").map_err(|_| {
+                PyTypeError::new_err(format!("{arg}: must be an int, got {}", type_name(v)))
+            })?;
+            let i = i.cast_into::<PyInt>()?;
+            Ok(if i.lt(0)? { i64::MIN } else { i64::MAX })
+        }
+    }
+}
+
+pub fn opt_int(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<i64>> {
+    v.filter(|v| !v.is_none()).map(|v| int(arg, v)).transpose()
+}
+
+/// A bool (Python or numpy).
+pub fn opt_bool(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<bool>> {
+    match v.filter(|v| !v.is_none()) {
+        None => Ok(None),
+        Some(v) => {
+            if !(v.is_instance_of::<PyBool>() || v.get_type().name()?.to_str()? == "bool_") {
+                return Err(PyTypeError::new_err(format!(
+                    "{arg}: must be a bool or None, got {}",
+                    type_name(v)
+                )));
+            }
+            Ok(Some(v.is_truthy()?))
+        }
+    }
+}
+
+/// A str.
+pub fn string(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
+    v.extract::<String>()
+        .map_err(|_| PyTypeError::new_err(format!("{arg}: must be a str, got {}", type_name(v))))
+}
+
+pub fn opt_string(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<String>> {
+    v.filter(|v| !v.is_none())
+        .map(|v| string(arg, v))
+        .transpose()
+}
+
+/// A resolution: an int (square) or a pair (W, H) of ints.
+pub fn resolution(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<(i64, i64)> {
+    if let Ok(t) = v.cast::<PyTuple>() {
+        return pair(arg, t.as_any());
+    }
+    if v.is_instance_of::<pyo3::types::PyList>() {
+        return pair(arg, v);
+    }
+    let n = int(arg, v).map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{arg}: must be an int or (W, H), got {}",
+            type_name(v)
+        ))
+    })?;
+    Ok((n, n))
+}
+
+fn pair(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<(i64, i64)> {
+    let n = v.len()?;
+    if n != 2 {
+        return Err(PyValueError::new_err(format!(
+            "{arg}: must be an int or (W, H), got {n} values"
+        )));
+    }
+    Ok((int(arg, &v.get_item(0)?)?, int(arg, &v.get_item(1)?)?))
+}
+
+pub fn opt_resolution(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<(i64, i64)>> {
+    v.filter(|v| !v.is_none())
+        .map(|v| resolution(arg, v))
+        .transpose()
+}
+
+/// Borrows a C-contiguous array as a slice, naming the argument if it is not.
+pub fn slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    arg: &str,
+    a: &'a numpy::PyReadonlyArray<'_, T, D>,
+) -> PyResult<&'a [T]> {
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{arg}: must be a C-contiguous array")))
+}
+
+/// Reinterprets a (n, 3) array's buffer as n triples.
+pub fn triples<'a, T: numpy::Element>(
+    arg: &str,
+    a: &'a PyReadonlyArray2<'_, T>,
+) -> PyResult<&'a [[T; 3]]> {
+    if a.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{arg}: must have shape (n, 3), got {:?}",
+            a.shape()
+        )));
+    }
+    let s = slice(arg, a)?;
+    // SAFETY: [T; 3] has T's alignment and no padding; the buffer is
+    // contiguous with a multiple of 3 elements, and it outlives the borrow.
+    Ok(unsafe { std::slice::from_raw_parts(s.as_ptr() as *const [T; 3], s.len() / 3) })
+}
+
+/// A mesh from its (n, 3) vertex and face arrays.
+pub fn mesh<'a>(
+    arg: &str,
+    vertices: &'a PyReadonlyArray2<'_, f64>,
+    faces: &'a PyReadonlyArray2<'_, u32>,
+) -> PyResult<MeshRef<'a>> {
+    Ok(MeshRef {
+        vertices: triples(arg, vertices)?,
+        faces: triples(arg, faces)?,
+    })
+}
+
+pub fn same_shape(arg: &str, got: &[usize], want: &[usize]) -> PyResult<()> {
+    if got == want {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{arg}: shape {got:?} differs from {want:?}"
+        )))
+    }
+}

@@ -1,0 +1,251 @@
+//! The entry points: convert, release the GIL, call the core's dispatch
+//! (`crate::backend`), wrap the result.
+
+use super::configs::{method_arg, Loose};
+use super::convert::{light_of, mesh, opt_int, same_shape, slice, triples, Light};
+use super::errors;
+use super::results::{DepthShadowResult, MeshShadowResult};
+use crate::backend::{self, BackendChoice, DepthCall, MeshCall};
+use crate::geom::light::MapGrid;
+use crate::methods::MethodConfig;
+use crate::pipeline::{self, OccluderSource};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// Validates a light and returns its frame (u, v, n).
+#[pyfunction]
+pub fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
+    errors::guard(|| {
+        let l = light_of(light)?;
+        Ok((l.u.to_array(), l.v.to_array(), l.n.to_array()))
+    })
+}
+
+/// Meshes -> light-view maps -> visibility.
+#[pyfunction]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, resolution, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn shadow_map_from_meshes<'py>(
+    py: Python<'py>,
+    occ_vertices: PyReadonlyArray2<'py, f64>,
+    occ_faces: PyReadonlyArray2<'py, u32>,
+    rec_vertices: PyReadonlyArray2<'py, f64>,
+    rec_faces: PyReadonlyArray2<'py, u32>,
+    light: Light,
+    resolution: &Bound<'py, PyAny>,
+    extent: Option<(f64, f64)>,
+    method: &Bound<'py, PyAny>,
+    passes: Option<Bound<'py, PyAny>>,
+    samples: Option<Bound<'py, PyAny>>,
+    occluder_resolution: Option<Bound<'py, PyAny>>,
+    hierarchy: Option<Bound<'py, PyAny>>,
+    precision: Option<Bound<'py, PyAny>>,
+    backend: &str,
+    threads: Option<Bound<'py, PyAny>>,
+) -> PyResult<MeshShadowResult> {
+    errors::guard(|| {
+        let light = light_of(light)?;
+        let loose = Loose {
+            passes,
+            samples,
+            occluder_resolution,
+            hierarchy,
+            precision,
+        };
+        let call = MeshCall {
+            occluders: mesh("occluders", &occ_vertices, &occ_faces)?,
+            receivers: mesh("receivers", &rec_vertices, &rec_faces)?,
+            light: &light,
+            resolution: super::convert::resolution("resolution", resolution)?,
+            extent: extent.map(|e| [e.0, e.1]),
+            method: method_arg(method, &loose)?,
+            backend: BackendChoice::parse(backend)?,
+            threads: opt_int("threads", threads.as_ref())?,
+        };
+        let run = py.detach(|| backend::shadow_map(&call))?;
+        MeshShadowResult::new(py, run)
+    })
+}
+
+/// Depth maps -> visibility.
+#[pyfunction]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn shadow_map_from_depth<'py>(
+    py: Python<'py>,
+    occluder_depth: PyReadonlyArray2<'py, f32>,
+    occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
+    receiver_depth: PyReadonlyArray2<'py, f32>,
+    light_size: [f64; 2],
+    extent: (f64, f64),
+    method: &Bound<'py, PyAny>,
+    passes: Option<Bound<'py, PyAny>>,
+    samples: Option<Bound<'py, PyAny>>,
+    occluder_resolution: Option<Bound<'py, PyAny>>,
+    hierarchy: Option<Bound<'py, PyAny>>,
+    precision: Option<Bound<'py, PyAny>>,
+    backend: &str,
+    threads: Option<Bound<'py, PyAny>>,
+) -> PyResult<DepthShadowResult> {
+    errors::guard(|| {
+        let loose = Loose {
+            passes,
+            samples,
+            occluder_resolution,
+            hierarchy,
+            precision,
+        };
+        let method = method_arg(method, &loose)?;
+        let shape = receiver_depth.shape();
+        // The occluder maps may be coarser or finer than the receiver map (same extent).
+        let oshape = occluder_depth.shape();
+        if let Some(b) = &occluder_depth_back {
+            same_shape("occluder_depth_back", b.shape(), oshape)?;
+        }
+        let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+        let occluder_grid = MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?;
+        let call = DepthCall {
+            grid,
+            occluder_grid,
+            light_size,
+            front: slice("occluder_depth", &occluder_depth)?,
+            back: match &occluder_depth_back {
+                Some(b) => Some(slice("occluder_depth_back", b)?),
+                None => None,
+            },
+            receiver: slice("receiver_depth", &receiver_depth)?,
+            method,
+            backend: BackendChoice::parse(backend)?,
+            threads: opt_int("threads", threads.as_ref())?,
+        };
+        let run = py.detach(|| backend::shadow_map_from_depth(&call))?;
+        DepthShadowResult::new(py, &grid, run)
+    })
+}
+
+/// Visibility at world points from a shadow map's occluders: its occluder
+/// maps (map methods) or the occluder mesh (ray-traced methods). `method` is
+/// the config the map ran with.
+#[pyfunction]
+#[pyo3(signature = (light, extent, resolution, points, method, *, occluder_depth=None, occluder_depth_back=None, occ_vertices=None, occ_faces=None, occluder_depth_middle=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn sample_points<'py>(
+    py: Python<'py>,
+    light: Light,
+    extent: (f64, f64),
+    resolution: (i64, i64),
+    points: PyReadonlyArray2<'py, f64>,
+    method: &Bound<'py, PyAny>,
+    occluder_depth: Option<PyReadonlyArray2<'py, f32>>,
+    occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
+    occ_vertices: Option<PyReadonlyArray2<'py, f64>>,
+    occ_faces: Option<PyReadonlyArray2<'py, u32>>,
+    occluder_depth_middle: Option<Vec<PyReadonlyArray2<'py, f32>>>,
+    threads: Option<Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    errors::guard(|| {
+        let light = light_of(light)?;
+        let none = Loose {
+            passes: None,
+            samples: None,
+            occluder_resolution: None,
+            hierarchy: None,
+            precision: None,
+        };
+        let method: MethodConfig = method_arg(method, &none)?;
+        let (w, h) = crate::methods::config::check_resolution("resolution", resolution)?;
+        let grid = MapGrid::new(w, h, [extent.0, extent.1])?;
+        let middle = occluder_depth_middle.unwrap_or_default();
+        let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
+            (Some(front), None, None) => {
+                let oshape = front.shape();
+                // Front first, the peeled layers, back last (the order of the map
+                // pipeline's layers).
+                let mut layers = vec![slice("occluder_depth", front)?];
+                for m in &middle {
+                    same_shape("occluder_depth_middle", m.shape(), oshape)?;
+                    layers.push(slice("occluder_depth_middle", m)?);
+                }
+                if let Some(b) = &occluder_depth_back {
+                    same_shape("occluder_depth_back", b.shape(), oshape)?;
+                    layers.push(slice("occluder_depth_back", b)?);
+                }
+                OccluderSource::Maps {
+                    grid: MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?,
+                    layers,
+                }
+            }
+            (None, Some(v), Some(f)) => OccluderSource::Mesh(mesh("occluders", v, f)?),
+            _ => {
+                return Err(PyValueError::new_err(
+                    "occluders: pass either occluder_depth (and occluder_depth_back) or occ_vertices and occ_faces",
+                ))
+            }
+        };
+        let pts = triples("points", &points)?;
+        let threads = opt_int("threads", threads.as_ref())?;
+        let (v, inside) =
+            py.detach(|| backend::sample_points(&grid, &light, source, pts, &method, threads))?;
+        Ok((
+            v.into_pyarray(py).into_any(),
+            inside.into_pyarray(py).into_any(),
+        ))
+    })
+}
+
+/// World points of the receiver texels and their flat indices.
+#[pyfunction]
+pub fn receiver_points<'py>(
+    py: Python<'py>,
+    receiver_depth: PyReadonlyArray2<'py, f32>,
+    light: Light,
+    extent: (f64, f64),
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    errors::guard(|| {
+        let light = light_of(light)?;
+        let shape = receiver_depth.shape();
+        let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+        let rec = slice("receiver_depth", &receiver_depth)?;
+        pipeline::check_depth("receiver_depth", rec)?;
+        let (pts, idx) = py.detach(|| pipeline::receiver_points(&grid, &light, rec));
+        let n = pts.len();
+        let flat: Vec<f64> = pts.into_iter().flatten().collect();
+        let pts = Array2::from_shape_vec((n, 3), flat)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok((
+            pts.into_pyarray(py).into_any(),
+            idx.into_pyarray(py).into_any(),
+        ))
+    })
+}
+
+/// The worker threads a call would run on with `threads` (None:
+/// SOFTSHADOW_THREADS, else every core).
+#[pyfunction]
+#[pyo3(signature = (threads=None))]
+pub fn worker_threads(py: Python<'_>, threads: Option<Bound<'_, PyAny>>) -> PyResult<usize> {
+    errors::guard(|| {
+        let cap = crate::threads::resolve(opt_int("threads", threads.as_ref())?)?;
+        let (_, n) = py.detach(|| crate::threads::run_capped(cap, || Ok(())))?;
+        Ok(n)
+    })
+}
+
+/// Panics on purpose, in a rayon worker thread when `in_worker`: lets the
+/// tests check that a panic in the core becomes a RuntimeError and leaves the
+/// module usable. Not part of the API.
+#[pyfunction]
+pub fn _panic_for_tests(py: Python<'_>, in_worker: bool) -> PyResult<()> {
+    errors::guard(|| {
+        py.detach(|| {
+            if in_worker {
+                rayon::join(|| (), || panic!("deliberate panic in a worker thread"));
+            } else {
+                panic!("deliberate panic");
+            }
+        });
+        Ok(())
+    })
+}
