@@ -3,14 +3,16 @@
     python benchmarks/methods_table.py [--repeats 5] [--no-write]
 
 On the bunny floating over the floor (``softshadow.scenes.bunny_floating()``,
-256² maps), for each call in ``CALLS``: the median wall time end to end from
-meshes over ``--repeats`` runs (after one warm-up) and the error against a
-1024-sample Mitsuba reference (the paper's §4.2.1 metric: the mean |V - V_ref|
-over the texels the reference has in umbra or penumbra). Then Mitsuba's own
-``ray_test`` time (rays already in Dr.Jit arrays) at 4 to 512 samples per
-texel (medians of ``--repeats`` runs after a warm-up), and, for each call, Mitsuba's time to reach that call's error,
-interpolated log-log between those sample counts (the study's
-``mitsuba_seconds_at``; * where it extrapolates).
+256² maps), for each call in ``CALLS``: the wall time end to end from meshes
+and the error against a 1024-sample Mitsuba reference (the paper's §4.2.1
+metric: the mean |V - V_ref| over the texels the reference has in umbra or
+penumbra); Mitsuba's own ``ray_test`` time (rays already in Dr.Jit arrays) and
+error at 4 to 512 samples per texel; and, for each call, Mitsuba's time to
+reach that call's error, interpolated log-log between those sample counts (the
+study's ``mitsuba_seconds_at``; * where it extrapolates). Times are medians of
+``--repeats`` rounds after a warm-up round; each round times every call and
+every sample count once, so that on a shared machine both sides of a ratio
+see the same load.
 
 Prints the markdown table, writes it to ``docs/benchmarks/methods.md`` with a
 header naming the command, the machine and the date, and rewrites the README's
@@ -23,54 +25,18 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import hashlib
 import os
 import platform
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
-
-import softshadow as ss  # noqa: E402
-from softshadow import metrics, reference, scenes  # noqa: E402
-
-
-@dataclass
-class Point:
-    """One measured setting, as the study's ``Point``: what ``mitsuba_seconds_at`` reads."""
-
-    scene: str
-    method: str
-    setting: str
-    seconds: float
-    error: float
-
-
-def _local_mitsuba_seconds_at(error: float, points: list[Point]) -> tuple[float, bool]:
-    """The study's ``mitsuba_seconds_at``, for when the study cannot be imported:
-    Mitsuba's time at ``error``, log-log between its sample counts (the last
-    segment's slope beyond them), and whether that extrapolates."""
-    mi = sorted((p.error, p.seconds) for p in points if p.method == "mitsuba")
-    le, lt = np.log([m[0] for m in mi]), np.log([m[1] for m in mi])
-    x = np.log(error)
-    outside = not (le[0] <= x <= le[-1])
-    i = 0 if x < le[0] else max(0, min(len(le) - 2, int(np.searchsorted(le, x)) - 1))
-    slope = (lt[i + 1] - lt[i]) / (le[i + 1] - le[i])
-    return float(np.exp(lt[i] + slope * (x - le[i]))), outside
-
-
-try:  # the study's own interpolation (softshadow.experiments.study in 0.2, softshadow.study before)
-    from softshadow.experiments.study import mitsuba_seconds_at  # noqa: E402
-except ImportError:
-    try:
-        from softshadow.study import mitsuba_seconds_at  # noqa: E402
-    except ImportError as e:
-        print(f"the study does not import ({e}); using this script's copy of mitsuba_seconds_at", file=sys.stderr)
-        mitsuba_seconds_at = _local_mitsuba_seconds_at
+import softshadow as ss
+from softshadow import metrics, reference, scenes
+from softshadow.experiments.study import Point, mitsuba_seconds_at
+from softshadow.reference.cache import cached_reference_map
 
 ROOT = Path(__file__).resolve().parent.parent
 CACHE = ROOT / ".cache" / "references"
@@ -94,62 +60,19 @@ CALLS: list[tuple[str, dict[str, object]]] = [
 ]
 
 
-def _key(*parts: object) -> str:
-    """The cache key of tests/conftest.py, so the tests and this script share references."""
-    h = hashlib.sha256()
-    for p in parts:
-        if isinstance(p, np.ndarray):
-            h.update(np.ascontiguousarray(p).tobytes())
-        else:
-            h.update(repr(p).encode())
-    return h.hexdigest()[:24]
-
-
-def reference_map(sm: ss.ShadowMap, occluders: list, samples: int) -> np.ndarray:
-    key = _key(SCENE, sm.light, sm.extent, sm.receiver_depth, samples, [m[0] for m in occluders])
-    path = CACHE / f"{SCENE}-{key}.npy"
-    if path.exists():
-        return np.load(path)
-    ref = reference.reference_map(sm, occluders, samples=samples)
-    CACHE.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(f".{os.getpid()}.tmp.npy")
-    np.save(tmp, ref)
-    tmp.replace(path)
-    return ref
-
-
-def median_seconds(fn, repeats: int) -> float:
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return float(np.median(times))
-
-
-def _setting(sm: ss.ShadowMap, name: str) -> object:
-    """A resolved setting of a result: from its typed config (0.2) or its attributes (0.1)."""
-    config = sm.method
-    if not isinstance(config, str) and hasattr(config, name):
-        return getattr(config, name)
-    return getattr(sm, name, None)
-
-
 def what_ran(sm: ss.ShadowMap) -> str:
     """A short description of the method and settings a result was computed with."""
     config = sm.method
-    name = config if isinstance(config, str) else type(config).__name__.lower()
-    parts = [name]
+    parts = [config.name]
     if sm.occluder_depth is not None:
-        passes = _setting(sm, "passes")
+        passes = sm.passes
         parts.append(f"{passes} pass{'es' if passes != 1 else ''}")
         h, w = sm.occluder_depth.shape
         parts.append(f"occluders {w}²" if w == h else f"occluders {w}×{h}")
-    samples = _setting(sm, "samples")
+    samples = getattr(config, "samples", None)
     if samples:
         parts.append(f"{samples} samples")
-    hierarchy = _setting(sm, "hierarchy")
+    hierarchy = getattr(config, "hierarchy", None)
     if hierarchy is not None:
         parts.append("hierarchy" if hierarchy else "no hierarchy")
     return ", ".join(parts)
@@ -166,36 +89,47 @@ def cpu_name() -> str:
 
 
 def measure(repeats: int) -> tuple[list[tuple[str, str, Point]], list[tuple[int, Point]]]:
+    """Times every call and every Mitsuba sample count once per round, for
+    ``repeats`` rounds after a warm-up round, and takes the medians: on a
+    machine shared with other jobs, both sides of a ratio see the same load."""
     scene, light = scenes.bunny_floating()
     occluders = list(scene.occluders)
     base = ss.soft_shadow_map(scene, light, resolution=RESOLUTION)
-    ref = reference_map(base, occluders, REFERENCE_SAMPLES)
+    ref = cached_reference_map(SCENE, base, occluders, samples=REFERENCE_SAMPLES, cache=CACHE)
+    rscene = reference.ReferenceScene(occluders)
+
+    def run(kwargs: dict[str, object]) -> ss.ShadowMap:
+        return ss.soft_shadow_map(scene, light, resolution=RESOLUTION, **kwargs)
+
+    def trace(k: int, seed: int) -> tuple[np.ndarray, float]:
+        v = reference.reference_map(base, rscene, samples=k, seed=seed)
+        return v, rscene.last_stats.trace_seconds
+
+    results = {label: run(kwargs) for label, kwargs in CALLS}  # warm-up round
+    mitsuba_maps = {k: trace(k, repeats)[0] for k in MITSUBA_SAMPLES}
+    times: dict[object, list[float]] = {key: [] for key in [*results, *MITSUBA_SAMPLES]}
+    for seed in range(repeats):
+        for label, kwargs in CALLS:
+            t = time.perf_counter()
+            run(kwargs)
+            times[label].append(time.perf_counter() - t)
+        for k in MITSUBA_SAMPLES:
+            mitsuba_maps[k], seconds = trace(k, seed)
+            times[k].append(seconds)
 
     rows = []
-    for label, kwargs in CALLS:
-
-        def run(kwargs=kwargs) -> ss.ShadowMap:
-            return ss.soft_shadow_map(scene, light, resolution=RESOLUTION, **kwargs)
-
-        seconds = median_seconds(run, repeats)
-        sm = run()
+    for label, _ in CALLS:
+        sm = results[label]
         if tuple(sm.extent) != tuple(base.extent):
             raise SystemExit(f"{label}: fitted extent {sm.extent} differs from the reference's {base.extent}")
-        error = metrics.shadow_error(sm.visibility, ref)
+        seconds, error = float(np.median(times[label])), metrics.shadow_error(sm.visibility, ref)
         rows.append((label, what_ran(sm), Point(SCENE, "softshadow", label, seconds, error)))
         print(f"  {label}: {seconds * 1e3:.1f} ms, error {error:.4f}", file=sys.stderr)
-
-    rscene = reference.ReferenceScene(occluders)
     mitsuba = []
     for k in MITSUBA_SAMPLES:
-        reference.reference_map(base, rscene, samples=k, seed=repeats)  # warm-up at this size
-        times, error = [], 0.0
-        for seed in range(repeats):
-            v = reference.reference_map(base, rscene, samples=k, seed=seed)
-            times.append(rscene.last_stats.trace_seconds)
-            error = metrics.shadow_error(v, ref)
-        mitsuba.append((k, Point(SCENE, "mitsuba", f"{k} samples", float(np.median(times)), error)))
-        print(f"  Mitsuba {k} samples: {np.median(times) * 1e3:.1f} ms, error {error:.4f}", file=sys.stderr)
+        seconds, error = float(np.median(times[k])), metrics.shadow_error(mitsuba_maps[k], ref)
+        mitsuba.append((k, Point(SCENE, "mitsuba", f"{k} samples", seconds, error)))
+        print(f"  Mitsuba {k} samples: {seconds * 1e3:.1f} ms, error {error:.4f}", file=sys.stderr)
     return rows, mitsuba
 
 
@@ -254,8 +188,10 @@ def main(argv: list[str] | None = None) -> int:
         f"Generated by `{command}` on {today}: {machine}; softshadow {ss.__version__}, "
         f"Mitsuba {reference.variant()}.\n\n"
         f"Scene: the bunny floating over the floor (`softshadow.scenes.bunny_floating()`), "
-        f"{RESOLUTION}² maps. Times are medians of {a.repeats} runs end to end from meshes "
-        "(all cores); Mitsuba's are `ray_test` alone, with the rays already in Dr.Jit arrays. "
+        f"{RESOLUTION}² maps. Times are medians of {a.repeats} rounds after a warm-up round, each round "
+        "timing every call and every Mitsuba sample count once (so both sides of a ratio see the same load): "
+        "softshadow's end to end from meshes on all cores, Mitsuba's `ray_test` alone, with the rays "
+        "already in Dr.Jit arrays. "
         f"Errors are the paper's §4.2.1 metric (mean |V − V_ref| over the texels in umbra or penumbra) "
         f"against a {REFERENCE_SAMPLES}-sample Mitsuba reference. Mitsuba's time at a call's error is "
         "interpolated log-log between its sample counts (* where it extrapolates).\n\n"

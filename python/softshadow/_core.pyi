@@ -25,6 +25,7 @@ __all__ = [
     "capabilities",
     "limits",
     "light_frame",
+    "check_mesh",
     "shadow_map_from_meshes",
     "shadow_map_from_depth",
     "sample_points",
@@ -209,6 +210,9 @@ def capabilities() -> dict[str, MethodInfo]:
 
 def limits() -> dict[str, Any]:
     """The limits that are not one method's."""
+
+def check_mesh(arg: str, vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.uint32]) -> None:
+    """Refuses non-finite vertices and face indices out of range, naming ``arg``."""
 
 def light_frame(light: _Light) -> tuple[list[float], list[float], list[float]]:
     """Validates a light and returns its frame (u, v, n) as unit vectors."""

@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from . import _core
+
 Mesh = tuple[np.ndarray, np.ndarray]
 
 
@@ -30,13 +32,13 @@ def as_mesh(obj: Any, name: str) -> Mesh:
     if f.ndim != 2 or f.shape[1] != 3:
         raise ValueError(f"{name}: faces must have shape (m, 3), got {f.shape}")
     v = np.ascontiguousarray(v, dtype=np.float64)
-    bad = ~np.isfinite(v).all(axis=1)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise ValueError(f"{name}: vertex {k} is not finite: {v[k].tolist()}")
-    if f.size and (f.min() < 0 or f.max() >= len(v)):
-        raise ValueError(f"{name}: face indices must lie in [0, {len(v)}), got [{f.min()}, {f.max()}]")
-    return v, np.ascontiguousarray(f, dtype=np.uint32)
+    # The conversion to the core's uint32 indices must not wrap; the values
+    # (finite vertices, indices below the vertex count) are the core's to check.
+    if f.size and (f.min() < 0 or f.max() > np.iinfo(np.uint32).max):
+        raise ValueError(f"{name}: face indices must lie in [0, 2^32), got [{f.min()}, {f.max()}]")
+    faces32 = np.ascontiguousarray(f, dtype=np.uint32)
+    _core.check_mesh(name, v, faces32)
+    return v, faces32
 
 
 def _concat(meshes: list[Mesh]) -> Mesh:

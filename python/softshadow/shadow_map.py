@@ -177,8 +177,9 @@ def soft_shadow_map(
     scene, light
         The geometry and the rectangular area light.
     resolution
-        ``int`` for a square map or ``(W, H)``. The occluder and receiver maps
-        share it.
+        ``int`` for a square map or ``(W, H)``. The receiver map shares it, and
+        the occluder maps unless the method's ``occluder_resolution`` says
+        otherwise.
     extent
         Tangent half-extents ``(tx, ty)`` of the map (a number means both).
         ``None`` fits them to where the occluders' shadows (umbra and penumbra)
@@ -190,7 +191,8 @@ def soft_shadow_map(
         wider (by no more than the largest penumbra reach): the map methods
         see only occluders inside the map, and one just outside the
         receivers can shadow them. Fitting needs every occluder vertex in
-        front of the light's plane. Tangent half-extents are at most 1e6.
+        front of the light's plane. Tangent half-extents are at most
+        ``softshadow.limits()["max_extent"]``.
         Geometry at or behind the light's plane casts no shadow (it is
         clipped), and an occluder at or beyond a receiver's depth does not
         shadow that receiver.
@@ -213,7 +215,8 @@ def soft_shadow_map(
         and where they do not apply): ``passes``, the occluder depth layers
         (1, the front; 2, front and back, §3.5; 3 to 8 adds layers found by
         depth peeling; default 2); ``samples``, light samples per receiver
-        (``bitmask``: 16, 64 or 256; ``exact``: 1 to 65536; default 256);
+        (``bitmask``: 16, 64 or 256; ``exact``: up to
+        ``limits()["max_samples"]``; default 256);
         ``occluder_resolution``, the occluder maps' resolution (default: the
         output's; coarser maps cost much less, their error is §4.1.1's);
         ``hierarchy``, the occluder min/max pyramid (default on for
@@ -230,9 +233,10 @@ def soft_shadow_map(
         raises ``GpuUnavailableError``. ``"auto"``: the GPU when a real
         (non-software) one is present, else the CPU. ``timings`` then hold the device's stages
         (``gpu_*``, from timestamp queries where the adapter has them).
-
+        The result's ``backend`` says which ran.
     threads
-        Worker threads the core may use for this call (1 to 1024); default:
+        Worker threads the core may use for this call (1 to
+        ``softshadow.limits()["max_threads"]``); default:
         ``SOFTSHADOW_THREADS`` from the environment, else every core. The
         result does not depend on it.
 

@@ -35,7 +35,7 @@ impl<'a> MeshRef<'a> {
             return Err(Error::invalid(
                 arg,
                 format!(
-                    "face {k} indexes a vertex out of range: {:?} with {nv} vertices",
+                    "face {k} has vertex indices {:?} out of range for {nv} vertices",
                     self.faces[k]
                 ),
             ));

@@ -273,7 +273,7 @@ pub struct CallContext {
 /// The rule comes from the study (`python -m softshadow.experiments.study`,
 /// docs/study/study.md): on its four scenes at 256², this is the point of the
 /// accuracy-time plane where softshadow is furthest ahead of Mitsuba's
-/// `ray_test` at equal error (4.7-8.4x faster, errors 0.030-0.037); finer
+/// `ray_test` at equal error (4.4-7.9x faster, errors 0.030-0.037); finer
 /// occluder maps cost 2.5-8x more for at most 0.005 less error. Below 64
 /// texels an occluder map loses small occluders.
 pub fn auto_rule(resolution: (usize, usize)) -> SsmConfig {

@@ -15,7 +15,7 @@
 //!     |xq - xr| < L/2 (wO - wR)
 //! which is its penumbra extent (§3.3) in tangent units.
 //!
-//! The traversal is the shared gather of `gather.rs`; this module adds the
+//! The traversal is the shared gather of `gather/`; this module adds the
 //! published arithmetic: each pair adds its clipped area, the layers merge by max.
 
 use super::gather::{

@@ -48,12 +48,12 @@ pub struct OptionInfo {
 impl OptionInfo {
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         Ok(format!(
-            "OptionInfo(name={:?}, kind={:?}, default={}, min={:?}, max={:?}, choices={})",
+            "OptionInfo(name='{}', kind='{}', default={}, min={}, max={}, choices={})",
             self.name,
             self.kind,
             self.default.bind(py).repr()?,
-            self.min,
-            self.max,
+            self.min.map_or("None".into(), |v| v.to_string()),
+            self.max.map_or("None".into(), |v| v.to_string()),
             match &self.choices {
                 Some(c) => c.bind(py).repr()?.to_string(),
                 None => "None".into(),
@@ -86,20 +86,13 @@ pub struct MethodInfo {
 #[pymethods]
 impl MethodInfo {
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        let names: Vec<String> = self
-            .options
-            .bind(py)
-            .keys()
-            .iter()
-            .map(|k| k.to_string())
-            .collect();
         Ok(format!(
-            "MethodInfo(name={:?}, config={}, options={:?}, backends={:?}, reads={:?})",
+            "MethodInfo(name='{}', config={}, options={}, backends={}, reads={})",
             self.name,
             self.config.bind(py).getattr("__name__")?,
-            names,
-            self.backends,
-            self.reads
+            self.options.bind(py).keys().repr()?,
+            self.backends.clone().into_pyobject(py)?.repr()?,
+            self.reads.clone().into_pyobject(py)?.repr()?
         ))
     }
 }

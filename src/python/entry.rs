@@ -23,6 +23,17 @@ pub fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
     })
 }
 
+/// Checks a mesh's values (finite vertices, face indices in range); `arg`
+/// names it in the error.
+#[pyfunction]
+pub fn check_mesh<'py>(
+    arg: &str,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+) -> PyResult<()> {
+    errors::guard(|| Ok(mesh(arg, &vertices, &faces)?.validate(arg)?))
+}
+
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
 #[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, resolution, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]

@@ -31,6 +31,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capabilities::capabilities, m)?)?;
     m.add_function(wrap_pyfunction!(capabilities::limits, m)?)?;
     m.add_function(wrap_pyfunction!(entry::light_frame, m)?)?;
+    m.add_function(wrap_pyfunction!(entry::check_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(entry::shadow_map_from_meshes, m)?)?;
     m.add_function(wrap_pyfunction!(entry::shadow_map_from_depth, m)?)?;
     m.add_function(wrap_pyfunction!(entry::sample_points, m)?)?;
