@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -163,3 +164,10 @@ def test_threads_cap_the_call_and_change_no_bit(monkeypatch):
     monkeypatch.setenv("SOFTSHADOW_THREADS", "lots")
     with pytest.raises(ValueError, match="^SOFTSHADOW_THREADS: "):
         ss.soft_shadow_map(scene, light, resolution=16)
+
+
+def test_the_docs_option_tables_are_the_cores():
+    from softshadow.experiments import method_docs
+
+    docs = Path(__file__).resolve().parent.parent / "docs" / "methods"
+    assert method_docs.main(["--check", "--docs", str(docs)]) == 0, "run python -m softshadow.experiments.method_docs"
