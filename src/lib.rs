@@ -1,7 +1,37 @@
 //! softshadow: soft shadows cast by rectangular area lights.
 //!
 //! The core (everything but `python`) has no Python in it: the pyo3 bindings
-//! are one thin layer behind the `python` feature.
+//! are one thin layer behind the `python` feature. A Rust user calls the
+//! same dispatch the bindings do, picking the method with a typed config and
+//! the backend with [`BackendChoice`]:
+//!
+//! ```
+//! use softshadow::backend::{shadow_map, MeshCall};
+//! use softshadow::geom::mesh::MeshRef;
+//! use softshadow::{BackendChoice, BitmaskConfig, MethodConfig, RectLight};
+//!
+//! // A unit plate at height 2 over a floor at 0, lit by a unit light 4 above:
+//! // its umbra on the floor is one unit wide.
+//! let quad = |y: f64, h: f64| [[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
+//! let faces = [[0u32, 1, 2], [0, 2, 3]];
+//! let (plate, floor) = (quad(2.0, 0.5), quad(0.0, 4.0));
+//! let light = RectLight::new([0.0, 4.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0])?;
+//! let run = shadow_map(&MeshCall {
+//!     occluders: MeshRef { vertices: &plate, faces: &faces },
+//!     receivers: MeshRef { vertices: &floor, faces: &faces },
+//!     light: &light,
+//!     resolution: (64, 64),
+//!     extent: None,
+//!     method: MethodConfig::Bitmask(BitmaskConfig::new(Some(64), None, None, None)?),
+//!     backend: BackendChoice::Cpu,
+//!     threads: Some(1),
+//! })?;
+//! // The config that ran, every default filled in; visibility in [0, 1].
+//! assert_eq!(run.method.passes(), 2);
+//! let v = &run.output.visibility;
+//! assert!(v.iter().all(|x| (0.0..=1.0).contains(x)) && v.iter().any(|&x| x < 0.01));
+//! # Ok::<(), softshadow::Error>(())
+//! ```
 
 // `!(x > 0.0)` is how the core says "not positive, or NaN": the negated
 // comparison is the point, not an accident.
