@@ -171,3 +171,12 @@ def test_the_docs_option_tables_are_the_cores():
 
     docs = Path(__file__).resolve().parent.parent / "docs" / "methods"
     assert method_docs.main(["--check", "--docs", str(docs)]) == 0, "run python -m softshadow.experiments.method_docs"
+
+
+def test_numpy_scalars_are_accepted_where_python_ones_are():
+    assert ss.Ssm(hierarchy=np.True_, passes=np.int32(3)) == ss.Ssm(hierarchy=True, passes=3)
+    assert ss.Bitmask(samples=np.uint16(64), occluder_resolution=(np.int64(8), 4)).occluder_resolution == (8, 4)
+    with pytest.raises(TypeError, match="^samples: must be an int, got bool"):
+        ss.Exact(samples=np.True_)
+    with pytest.raises(ValueError, match="^samples: .* beyond"):
+        ss.Exact(samples=2**70)

@@ -22,10 +22,16 @@ fn type_name(v: &Bound<'_, PyAny>) -> String {
         .unwrap_or_else(|_| "?".into())
 }
 
-/// An int (Python or numpy; not a bool). A value beyond i64 is clamped to
-/// i64's range so that the core refuses it by value, naming the argument.
+/// Whether `v` is a bool: Python's, or numpy's (`numpy.bool`, which is not a
+/// subclass of Python's).
+fn is_bool(v: &Bound<'_, PyAny>) -> PyResult<bool> {
+    Ok(v.is_instance_of::<PyBool>() || matches!(v.get_type().name()?.to_str()?, "bool" | "bool_"))
+}
+
+/// An int (Python or numpy; not a bool). A value beyond i64 is refused here
+/// by value (the core's checks see only i64).
 pub fn int(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<i64> {
-    if v.is_instance_of::<PyBool>() || v.get_type().name()?.to_str()? == "bool_" {
+    if is_bool(v)? {
         return Err(PyTypeError::new_err(format!(
             "{arg}: must be an int, got bool"
         )));
@@ -36,8 +42,10 @@ pub fn int(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<i64> {
             let i = v.call_method0("__index__").map_err(|_| {
                 PyTypeError::new_err(format!("{arg}: must be an int, got {}", type_name(v)))
             })?;
-            let i = i.cast_into::<PyInt>()?;
-            Ok(if i.lt(0)? { i64::MIN } else { i64::MAX })
+            Err(PyValueError::new_err(format!(
+                "{arg}: {} is beyond any accepted value (64-bit integers)",
+                i.cast_into::<PyInt>()?
+            )))
         }
     }
 }
@@ -51,7 +59,7 @@ pub fn opt_bool(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<bool
     match v.filter(|v| !v.is_none()) {
         None => Ok(None),
         Some(v) => {
-            if !(v.is_instance_of::<PyBool>() || v.get_type().name()?.to_str()? == "bool_") {
+            if !is_bool(v)? {
                 return Err(PyTypeError::new_err(format!(
                     "{arg}: must be a bool or None, got {}",
                     type_name(v)
