@@ -1,7 +1,7 @@
 //! Rasterization on the GPU: the set-up triangles of the CPU rasterizer
 //! (projected, clipped and snapped in f64 on the CPU, since WGSL has no f64)
 //! are uploaded once and drawn by `raster.wgsl` into depth layers held as u32
-//! bits in one `maps` buffer. The CPU twin is `raster::raster_tri`.
+//! bits in one `maps` buffer. The CPU twin is `raster::scan::raster_tri`.
 
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform, upload};

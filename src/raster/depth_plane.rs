@@ -1,5 +1,5 @@
 //! The depth of a triangle at a texel center, in the one f32 form that both
-//! the CPU rasterizer (`raster.rs`) and the GPU one (`gpu/raster.wgsl`)
+//! the CPU rasterizer (`raster/`) and the GPU one (`gpu/raster.wgsl`)
 //! evaluate, so that their depth maps agree bit for bit.
 //!
 //! 1/Z is linear in the map's plane. Per triangle we keep 1/Z at the center

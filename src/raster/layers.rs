@@ -1,0 +1,151 @@
+//! Depth layers of a mesh: `Prepared` bins the set-up triangles by band, and
+//! each band is rasterized by one task into its own rows of the outputs
+//! (parallel without locks), giving the nearest and farthest depth per texel
+//! or, by depth peeling, the next layer beyond a previous one.
+
+use super::scan::{band_rows, raster_tri};
+use super::setup::{setup_triangles, SetupTri};
+use crate::geom::light::MapGrid;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Depth maps produced by one traversal of a mesh.
+#[derive(Debug, Clone)]
+pub struct DepthLayers {
+    /// Nearest depth per texel, `inf` where nothing is hit.
+    pub nearest: Vec<f32>,
+    /// Farthest depth per texel (when asked for), `inf` where nothing is hit.
+    pub farthest: Option<Vec<f32>>,
+}
+
+/// A mesh set up for rasterization: triangles snapped and binned by band.
+pub struct Prepared<'g> {
+    grid: &'g MapGrid,
+    tris: Vec<SetupTri>,
+    /// Triangle indices of band b: binned[counts[b]..counts[b + 1]].
+    binned: Vec<u32>,
+    counts: Vec<u32>,
+    rows_per_band: usize,
+}
+
+/// Relative depth gap under which a surface counts as the layer already peeled
+/// (interpolated depths of one surface differ by a few f32 ulps).
+pub(crate) const PEEL_GAP: f32 = 1e-5;
+
+impl<'g> Prepared<'g> {
+    /// Sets up a mesh whose vertices are already in light space. `near` is
+    /// the clip distance from the light's plane: geometry closer than it (or
+    /// behind the light) is cut away.
+    pub fn new(grid: &'g MapGrid, verts: &[DVec3], faces: &[[u32; 3]], near: f64) -> Prepared<'g> {
+        let tris = setup_triangles(grid, verts, faces, near);
+
+        // Bin triangle indices by band (counting sort).
+        let rows_per_band = band_rows(grid.height);
+        let n_bands = grid.height.div_ceil(rows_per_band);
+        let mut counts = vec![0u32; n_bands + 1];
+        for t in &tris {
+            for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
+                counts[b + 1] += 1;
+            }
+        }
+        for b in 0..n_bands {
+            counts[b + 1] += counts[b];
+        }
+        let mut fill = counts.clone();
+        let mut binned = vec![0u32; counts[n_bands] as usize];
+        for (k, t) in tris.iter().enumerate() {
+            for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
+                binned[fill[b] as usize] = k as u32;
+                fill[b] += 1;
+            }
+        }
+        Prepared {
+            grid,
+            tris,
+            binned,
+            counts,
+            rows_per_band,
+        }
+    }
+
+    /// Runs `visit(band's rows, band's slice of each output, triangle)` for every
+    /// band in parallel, each band owning its rows of the outputs.
+    fn bands(
+        &self,
+        outputs: &mut [Vec<f32>],
+        visit: impl Fn(&SetupTri, std::ops::Range<usize>, &mut [&mut [f32]]) + Sync,
+    ) {
+        let band_len = self.rows_per_band * self.grid.width;
+        let mut per_band: Vec<Vec<&mut [f32]>> =
+            (0..self.counts.len() - 1).map(|_| Vec::new()).collect();
+        for out in outputs.iter_mut() {
+            for (b, chunk) in out.chunks_mut(band_len).enumerate() {
+                per_band[b].push(chunk);
+            }
+        }
+        per_band
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(b, mut slices)| {
+                let rows =
+                    b * self.rows_per_band..((b + 1) * self.rows_per_band).min(self.grid.height);
+                for &k in &self.binned[self.counts[b] as usize..self.counts[b + 1] as usize] {
+                    visit(&self.tris[k as usize], rows.clone(), &mut slices);
+                }
+            });
+    }
+
+    /// The nearest depth per texel, and the farthest when asked for.
+    pub fn nearest_farthest(&self, want_farthest: bool) -> DepthLayers {
+        let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
+        if want_farthest {
+            outs.push(vec![f32::INFINITY; self.grid.len()]);
+        }
+        self.bands(&mut outs, |t, rows, o| {
+            raster_tri(t, self.grid, rows, |idx, z| {
+                if z < o[0][idx] {
+                    o[0][idx] = z;
+                }
+                if let Some(f) = o.get_mut(1) {
+                    if !(f[idx] < f32::INFINITY) || z > f[idx] {
+                        f[idx] = z;
+                    }
+                }
+            })
+        });
+        let farthest = want_farthest.then(|| outs.pop().unwrap());
+        DepthLayers {
+            nearest: outs.pop().unwrap(),
+            farthest,
+        }
+    }
+
+    /// Depth peeling: per texel, the nearest depth strictly beyond `previous`
+    /// (by more than PEEL_GAP relative), `inf` where there is none.
+    pub fn peel(&self, previous: &[f32]) -> Vec<f32> {
+        let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
+        let band_len = self.rows_per_band * self.grid.width;
+        self.bands(&mut outs, |t, rows, o| {
+            let base = rows.start / self.rows_per_band * band_len;
+            raster_tri(t, self.grid, rows, |idx, z| {
+                let floor = previous[base + idx];
+                if z > floor * (1.0 + PEEL_GAP) && z < o[0][idx] {
+                    o[0][idx] = z;
+                }
+            })
+        });
+        outs.pop().unwrap()
+    }
+}
+
+/// Rasterizes a mesh whose vertices are already in light space into its
+/// nearest (and farthest) depth maps.
+pub fn rasterize(
+    grid: &MapGrid,
+    verts: &[DVec3],
+    faces: &[[u32; 3]],
+    near: f64,
+    want_farthest: bool,
+) -> DepthLayers {
+    Prepared::new(grid, verts, faces, near).nearest_farthest(want_farthest)
+}
