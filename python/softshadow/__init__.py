@@ -10,6 +10,7 @@ docs/ for the conventions.
 
 from ._core import __version__
 from .backend import gpu_available, gpu_info
+from .camera import Camera
 from .errors import GpuUnavailableError, TooLargeError
 from .light import RectLight
 from .methods import Auto, Bitmask, Exact, MethodConfig, MethodInfo, OptionInfo, Ssm, capabilities, limits
@@ -19,6 +20,7 @@ from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 __all__ = [
     "Auto",
     "Bitmask",
+    "Camera",
     "Exact",
     "GpuUnavailableError",
     "MethodConfig",

@@ -18,6 +18,7 @@ __all__ = [
     "Bitmask",
     "Exact",
     "Auto",
+    "Camera",
     "MeshShadowResult",
     "DepthShadowResult",
     "MethodInfo",
@@ -121,6 +122,52 @@ class Auto:
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
 
 _MethodArg = str | Ssm | Bitmask | Exact | Auto
+
+@final
+class Camera:
+    """A pinhole camera (conventions in src/geom/camera.rs)."""
+
+    def __new__(
+        cls,
+        K: npt.ArrayLike,
+        world_from_camera: npt.ArrayLike,
+        *,
+        resolution: _Resolution,
+    ) -> Camera: ...
+    @staticmethod
+    def from_intrinsics(K: npt.ArrayLike, world_from_camera: npt.ArrayLike, *, resolution: _Resolution) -> Camera:
+        """OpenCV's K (no skew, fx == fy) and a rigid world_from_camera."""
+    @staticmethod
+    def look_at(
+        *,
+        eye: tuple[float, float, float] | npt.ArrayLike,
+        target: tuple[float, float, float] | npt.ArrayLike,
+        up: tuple[float, float, float] | npt.ArrayLike,
+        fov_y: float,
+        resolution: _Resolution,
+    ) -> Camera:
+        """Mitsuba's perspective sensor with fov_axis="y"; fov_y in degrees."""
+    @property
+    def eye(self) -> tuple[float, float, float]: ...
+    @property
+    def forward(self) -> tuple[float, float, float]: ...
+    @property
+    def right(self) -> tuple[float, float, float]: ...
+    @property
+    def up(self) -> tuple[float, float, float]: ...
+    @property
+    def fov_y(self) -> float: ...
+    @property
+    def resolution(self) -> tuple[int, int]: ...
+    @property
+    def K(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def world_from_camera(self) -> npt.NDArray[np.float64]: ...
+    def to_opencv(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def to_mitsuba(self) -> dict[str, Any]: ...
+    def ray_directions(self) -> npt.NDArray[np.float64]:
+        """Unit directions through every pixel centre, (H, W, 3)."""
+    def __getnewargs_ex__(self) -> tuple[tuple[Any, ...], dict[str, Any]]: ...
 
 @final
 class OptionInfo:

@@ -136,6 +136,27 @@ pub const MAX_TEXELS: usize = 1 << 28;
 /// this, texel positions overflow and shadows silently vanish.
 pub const MAX_EXTENT: f64 = 1e6;
 
+/// A map resolution (W, H): at least 1x1, at most MAX_TEXELS texels.
+pub fn check_resolution(arg: &str, (w, h): (i64, i64)) -> Result<(usize, usize)> {
+    if w < 1 || h < 1 {
+        return Err(Error::invalid(
+            arg,
+            format!("must be at least 1x1, got {w}x{h}"),
+        ));
+    }
+    let texels = (w as u128) * (h as u128);
+    if texels > MAX_TEXELS as u128 {
+        return Err(Error::too_large(
+            arg,
+            format!(
+                "{w}x{h} would need {} bytes per map (limit {MAX_TEXELS} texels)",
+                texels * 4
+            ),
+        ));
+    }
+    Ok((w as usize, h as usize))
+}
+
 impl MapGrid {
     pub fn new(width: usize, height: usize, extent: [f64; 2]) -> Result<Self> {
         if width == 0 || height == 0 {

@@ -1,6 +1,7 @@
-//! Geometry: the light and its map grid, meshes, the depth unit the kernels
+//! Geometry: the light and its map grid, the camera, meshes, the depth unit the kernels
 //! compute in, and the fitted extent of a light-view map.
 
+pub mod camera;
 pub mod extent;
 pub mod light;
 pub mod mesh;

@@ -15,7 +15,7 @@
 use super::{bitmask, ssm::Precision, Method, HIERARCHY_DEFAULT_BITMASK, HIERARCHY_DEFAULT_SSM};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
-use crate::geom::light::MAX_TEXELS;
+pub use crate::geom::light::check_resolution;
 
 /// Default light samples per receiver for the sampling methods (a 16x16
 /// stratification).
@@ -145,27 +145,6 @@ pub fn check_passes(passes: i64) -> Result<u32> {
             ),
         ))
     }
-}
-
-/// A map resolution (W, H): at least 1x1, at most MAX_TEXELS texels.
-pub fn check_resolution(arg: &str, (w, h): (i64, i64)) -> Result<(usize, usize)> {
-    if w < 1 || h < 1 {
-        return Err(Error::invalid(
-            arg,
-            format!("must be at least 1x1, got {w}x{h}"),
-        ));
-    }
-    let texels = (w as u128) * (h as u128);
-    if texels > MAX_TEXELS as u128 {
-        return Err(Error::too_large(
-            arg,
-            format!(
-                "{w}x{h} would need {} bytes per map (limit {MAX_TEXELS} texels)",
-                texels * 4
-            ),
-        ));
-    }
-    Ok((w as usize, h as usize))
 }
 
 /// `precision=` by name.

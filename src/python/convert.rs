@@ -162,3 +162,22 @@ pub fn same_shape(arg: &str, got: &[usize], want: &[usize]) -> PyResult<()> {
         )))
     }
 }
+
+/// An R x C matrix of numbers (nested sequences or a numpy array).
+pub fn matrix<const R: usize, const C: usize>(
+    arg: &str,
+    v: &Bound<'_, PyAny>,
+) -> PyResult<[[f64; C]; R]> {
+    if v.is_instance_of::<pyo3::types::PyString>() || v.is_instance_of::<pyo3::types::PyBytes>() {
+        return Err(PyTypeError::new_err(format!(
+            "{arg}: must be a {R}x{C} matrix of numbers, got {}",
+            type_name(v)
+        )));
+    }
+    v.extract::<[[f64; C]; R]>().map_err(|e| {
+        PyValueError::new_err(format!(
+            "{arg}: must be a {R}x{C} matrix of numbers ({})",
+            e.value(v.py())
+        ))
+    })
+}

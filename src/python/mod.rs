@@ -5,12 +5,14 @@
 //!
 //! * `convert.rs`: Python values to core values (TypeError naming the argument).
 //! * `configs.rs`: the method configs `Ssm`, `Bitmask`, `Exact`, `Auto`.
+//! * `camera.rs`: the eye view's `Camera`.
 //! * `entry.rs`: the entry points.
 //! * `results.rs`: the typed results.
 //! * `capabilities.rs`: the method table and limits.
 //! * `errors.rs`: core errors and panics to Python exceptions.
 //! * `gpu.rs`: what the GPU adapter is.
 
+mod camera;
 mod capabilities;
 mod configs;
 mod convert;
@@ -24,6 +26,7 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     configs::register(m)?;
+    m.add_class::<camera::PyCamera>()?;
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;
     m.add_class::<capabilities::MethodInfo>()?;

@@ -40,6 +40,8 @@ Modules
     :class:`ReferenceScene`, :func:`visibility_at_points`, :func:`reference_map`.
 ``render``
     :func:`render_image`.
+``camera``
+    :func:`camera_sensor`: Mitsuba's sensor for a :class:`softshadow.Camera`.
 """
 
 from __future__ import annotations
@@ -52,10 +54,12 @@ from ._mitsuba import VARIANT_ENV as VARIANT_ENV
 from ._mitsuba import _import_mitsuba as _import_mitsuba
 from ._mitsuba import variant
 from ._rays import MAX_RAYS_PER_BATCH as MAX_RAYS_PER_BATCH
+from .camera import camera_sensor
 from .render import render_image
 from .visibility import ReferenceScene, TraceStats, reference_map, visibility_at_points
 
 __all__ = [
+    "camera_sensor",
     "ReferenceScene",
     "TraceStats",
     "render_image",
