@@ -21,7 +21,7 @@
 //! Frames are computed in f64; a camera far from the origin keeps its rays.
 
 use crate::error::{Error, Result};
-use crate::geom::light::check_resolution;
+use crate::geom::light::{check_resolution, finite3};
 use glam::DVec3;
 
 /// A pinhole camera: its frame in world space and its intrinsics in pixels.
@@ -45,14 +45,6 @@ pub struct Camera {
 /// units: beyond it a pixel sees almost along the image plane, and f32
 /// rasterization loses it. 1e6 is 89.99994 degrees, as for light-view maps.
 pub const MAX_TANGENT: f64 = 1e6;
-
-fn finite3(arg: &str, a: [f64; 3]) -> Result<DVec3> {
-    if a.iter().all(|x| x.is_finite()) {
-        Ok(DVec3::from_array(a))
-    } else {
-        Err(Error::invalid(arg, format!("must be finite, got {a:?}")))
-    }
-}
 
 impl Camera {
     /// The camera at `eye` looking at `target`, `up` giving the image's up

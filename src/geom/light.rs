@@ -28,7 +28,8 @@ pub struct RectLight {
     pub size: [f64; 2],
 }
 
-fn finite3(arg: &str, a: [f64; 3]) -> Result<DVec3> {
+/// A finite 3-vector, or an error naming `arg`.
+pub(crate) fn finite3(arg: &str, a: [f64; 3]) -> Result<DVec3> {
     if a.iter().all(|x| x.is_finite()) {
         Ok(DVec3::from_array(a))
     } else {
