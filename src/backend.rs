@@ -97,8 +97,9 @@ fn real_gpu() -> bool {
     false
 }
 
+/// What a GPU request gets from a build without the `gpu` feature.
 #[cfg(not(feature = "gpu"))]
-fn not_built() -> Error {
+pub fn not_built() -> Error {
     Error::gpu_unavailable("this build of softshadow has no GPU backend (cargo feature `gpu`)")
 }
 

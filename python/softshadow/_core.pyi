@@ -31,7 +31,6 @@ __all__ = [
     "shadow_map_from_depth",
     "sample_points",
     "receiver_points",
-    "worker_threads",
     "gpu_available",
     "gpu_info",
     "GpuUnavailableError",
@@ -326,9 +325,6 @@ def receiver_points(
     extent: tuple[float, float],
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint64]]:
     """World points (M, 3) of the texels with a receiver, and their flat indices."""
-
-def worker_threads(threads: int | None = None) -> int:
-    """The worker threads a call would run on with ``threads``."""
 
 class GpuUnavailableError(RuntimeError):
     """backend="gpu" was asked for and no GPU adapter can be opened."""

@@ -148,13 +148,6 @@ class ShadowMap:
         return _core.receiver_points(self.receiver_depth, self.light._core_args(), self.extent)
 
 
-def _resolution(value: Any) -> Any:
-    """An int or a (W, H) pair, passed on as given (the core checks it)."""
-    if isinstance(value, list):
-        return tuple(value)
-    return value
-
-
 def soft_shadow_map(
     scene: Scene,
     light: RectLight,
@@ -261,12 +254,12 @@ def soft_shadow_map(
         rv,
         rf,
         light._core_args(),
-        _resolution(resolution),
+        resolution,
         ext,
         method,
         passes=passes,
         samples=samples,
-        occluder_resolution=_resolution(occluder_resolution),
+        occluder_resolution=occluder_resolution,
         hierarchy=hierarchy,
         precision=precision,
         backend=backend,
@@ -341,7 +334,7 @@ def soft_shadow_map_from_depth(
         method,
         passes=passes,
         samples=samples,
-        occluder_resolution=_resolution(occluder_resolution),
+        occluder_resolution=occluder_resolution,
         hierarchy=hierarchy,
         precision=precision,
         backend=backend,

@@ -272,6 +272,19 @@ pub struct Loose<'py> {
     pub precision: Option<Bound<'py, PyAny>>,
 }
 
+impl Loose<'_> {
+    /// No loose options.
+    pub fn none() -> Self {
+        Loose {
+            passes: None,
+            samples: None,
+            occluder_resolution: None,
+            hierarchy: None,
+            precision: None,
+        }
+    }
+}
+
 /// `method=` (a config object, or a name with loose options) as a core
 /// config. A config object with loose options beside it is refused.
 pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<MethodConfig> {

@@ -158,14 +158,7 @@ pub fn sample_points<'py>(
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     errors::guard(|| {
         let light = light_of(light)?;
-        let none = Loose {
-            passes: None,
-            samples: None,
-            occluder_resolution: None,
-            hierarchy: None,
-            precision: None,
-        };
-        let method: MethodConfig = method_arg(method, &none)?;
+        let method: MethodConfig = method_arg(method, &Loose::none())?;
         let (w, h) = crate::methods::config::check_resolution("resolution", resolution)?;
         let grid = MapGrid::new(w, h, [extent.0, extent.1])?;
         let middle = occluder_depth_middle.unwrap_or_default();
@@ -229,18 +222,6 @@ pub fn receiver_points<'py>(
             pts.into_pyarray(py).into_any(),
             idx.into_pyarray(py).into_any(),
         ))
-    })
-}
-
-/// The worker threads a call would run on with `threads` (None:
-/// SOFTSHADOW_THREADS, else every core).
-#[pyfunction]
-#[pyo3(signature = (threads=None))]
-pub fn worker_threads(py: Python<'_>, threads: Option<Bound<'_, PyAny>>) -> PyResult<usize> {
-    errors::guard(|| {
-        let cap = crate::threads::resolve(opt_int("threads", threads.as_ref())?)?;
-        let (_, n) = py.detach(|| crate::threads::run_capped(cap, || Ok(())))?;
-        Ok(n)
     })
 }
 

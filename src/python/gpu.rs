@@ -5,13 +5,6 @@
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-#[cfg(not(feature = "gpu"))]
-fn not_built() -> crate::error::Error {
-    crate::error::Error::gpu_unavailable(
-        "this build of softshadow has no GPU backend (cargo feature `gpu`)",
-    )
-}
-
 /// Whether backend="gpu" can run: an adapter opens (software or not).
 #[pyfunction]
 pub fn gpu_available(py: Python<'_>) -> bool {
@@ -43,5 +36,5 @@ pub fn gpu_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 #[pyfunction]
 pub fn gpu_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let _ = py;
-    Err(not_built().into())
+    Err(crate::backend::not_built().into())
 }

@@ -39,7 +39,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entry::shadow_map_from_depth, m)?)?;
     m.add_function(wrap_pyfunction!(entry::sample_points, m)?)?;
     m.add_function(wrap_pyfunction!(entry::receiver_points, m)?)?;
-    m.add_function(wrap_pyfunction!(entry::worker_threads, m)?)?;
     m.add_function(wrap_pyfunction!(gpu::gpu_available, m)?)?;
     m.add_function(wrap_pyfunction!(gpu::gpu_info, m)?)?;
     m.add(
