@@ -8,7 +8,8 @@
 //! worker threads `threads.rs` allows.
 
 use crate::error::{Error, Result};
-use crate::geom::light::{check_light_size, is_point, MapGrid, RectLight};
+use crate::geom::light::{check_light_size, is_point, MapGrid};
+use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::mesh::MeshRef;
 use crate::methods::config::{check_resolution, CallContext};
 use crate::methods::MethodConfig;
@@ -119,7 +120,7 @@ pub struct Run<T> {
 pub struct MeshCall<'a> {
     pub occluders: MeshRef<'a>,
     pub receivers: MeshRef<'a>,
-    pub light: &'a RectLight,
+    pub light: &'a Light,
     /// Output (W, H).
     pub resolution: (i64, i64),
     /// Tangent half-extents, or `None` to fit them.
@@ -139,19 +140,26 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         resolution: (w, h),
         depth_layers: None,
     };
-    let backend = call.backend.pick(&call.method, ctx, call.light.size);
+    let backend = call
+        .backend
+        .pick(&call.method, ctx, call.light.kernel_size());
     let method = call.method.resolve(&CallContext { backend, ..ctx })?;
-    let settings = MapSettings::new(w, h, call.extent, &method);
-    let (output, threads) = threads::run_capped(cap, || match backend {
-        Backend::Cpu => {
-            pipeline::from_meshes(call.occluders, call.receivers, call.light, &settings)
+    let (output, threads) = threads::run_capped(cap, || {
+        let space = mesh_space(call.light, &[call.occluders, call.receivers])?;
+        // A sun's map extent is given in world units; the kernels' in tangents.
+        let extent = call.extent.map(|e| space.kernel_extent(e));
+        let settings = MapSettings::new(w, h, extent, &method);
+        match backend {
+            Backend::Cpu => {
+                pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
+            }
+            #[cfg(feature = "gpu")]
+            Backend::Gpu => {
+                crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
+            }
+            #[cfg(not(feature = "gpu"))]
+            Backend::Gpu => Err(not_built()),
         }
-        #[cfg(feature = "gpu")]
-        Backend::Gpu => {
-            crate::gpu::from_meshes(call.occluders, call.receivers, call.light, &settings)
-        }
-        #[cfg(not(feature = "gpu"))]
-        Backend::Gpu => Err(not_built()),
     })?;
     Ok(Run {
         output,
@@ -159,6 +167,22 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         backend,
         threads,
     })
+}
+
+/// The light space of a scene made of `meshes`: a sun's depth origin and
+/// range are fitted to their vertices (checked first: a non-finite vertex
+/// is named, not folded into the bounds).
+pub fn mesh_space(light: &Light, meshes: &[MeshRef]) -> Result<LightSpace> {
+    if let Light::Sun(_) = light {
+        for (m, arg) in meshes.iter().zip(["occluders", "receivers"]) {
+            m.validate(arg)?;
+        }
+    }
+    let verts = meshes
+        .iter()
+        .flat_map(|m| m.vertices.iter())
+        .map(|p| glam::DVec3::from_array(*p));
+    light.space_for(verts)
 }
 
 /// Depth maps the user rendered: what to shade and where.
@@ -211,7 +235,7 @@ pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<(Vec<f32>, Timings)
 /// are few and scattered). `method` is the config the map ran with.
 pub fn sample_points(
     grid: &MapGrid,
-    light: &RectLight,
+    light: &LightSpace,
     occluders: pipeline::OccluderSource,
     points: &[[f64; 3]],
     method: &MethodConfig,

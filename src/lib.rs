@@ -1,4 +1,4 @@
-//! softshadow: soft shadows cast by rectangular area lights.
+//! softshadow: soft shadows cast by rectangular area lights and the sun.
 //!
 //! The core (everything but `python`) has no Python in it: the pyo3 bindings
 //! are one thin layer behind the `python` feature. A Rust user calls the
@@ -8,7 +8,7 @@
 //! ```
 //! use softshadow::backend::{shadow_map, MeshCall};
 //! use softshadow::geom::mesh::MeshRef;
-//! use softshadow::{BackendChoice, BitmaskConfig, MethodConfig, RectLight};
+//! use softshadow::{BackendChoice, BitmaskConfig, Light, MethodConfig, RectLight};
 //!
 //! // A unit plate at height 2 over a floor at 0, lit by a unit light 4 above:
 //! // its umbra on the floor is one unit wide.
@@ -19,7 +19,7 @@
 //! let run = shadow_map(&MeshCall {
 //!     occluders: MeshRef { vertices: &plate, faces: &faces },
 //!     receivers: MeshRef { vertices: &floor, faces: &faces },
-//!     light: &light,
+//!     light: &Light::Rect(light),
 //!     resolution: (64, 64),
 //!     extent: None,
 //!     method: MethodConfig::Bitmask(BitmaskConfig::new(Some(64), None, None, None)?),
@@ -42,6 +42,7 @@
 // pipelines that chain them; `gpu` mirrors raster and methods on the device.
 pub mod backend;
 pub mod error;
+pub mod eye;
 pub mod geom;
 #[cfg(feature = "gpu")]
 pub mod gpu;
@@ -57,4 +58,6 @@ mod python;
 pub use backend::{Backend, BackendChoice};
 pub use error::{Error, Result};
 pub use geom::light::{MapGrid, RectLight};
+pub use geom::light_space::{Light, LightSpace};
+pub use geom::sun::DirectionalLight;
 pub use methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};

@@ -1,4 +1,4 @@
-"""softshadow: soft shadows cast by rectangular area lights.
+"""softshadow: soft shadows cast by rectangular area lights and the sun.
 
 Soft shadow maps (Atty et al. 2005), their bitmask variant and exact ray
 casting, computed by a Rust core on all CPU cores or on a GPU through wgpu
@@ -12,8 +12,9 @@ from ._core import __version__
 from .backend import gpu_available, gpu_info
 from .camera import Camera
 from .errors import GpuUnavailableError, TooLargeError
-from .light import RectLight
+from .light import DirectionalLight, RectLight
 from .methods import Auto, Bitmask, Exact, MethodConfig, MethodInfo, OptionInfo, Ssm, capabilities, limits
+from .render import Image, render
 from .scene import Scene
 from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
@@ -21,8 +22,10 @@ __all__ = [
     "Auto",
     "Bitmask",
     "Camera",
+    "DirectionalLight",
     "Exact",
     "GpuUnavailableError",
+    "Image",
     "MethodConfig",
     "MethodInfo",
     "OptionInfo",
@@ -35,6 +38,7 @@ __all__ = [
     "gpu_available",
     "gpu_info",
     "limits",
+    "render",
     "soft_shadow_map",
     "soft_shadow_map_from_depth",
     "__version__",

@@ -26,6 +26,8 @@ __all__ = [
     "capabilities",
     "limits",
     "light_frame",
+    "render",
+    "EyeResult",
     "check_mesh",
     "shadow_map_from_meshes",
     "shadow_map_from_depth",
@@ -43,7 +45,14 @@ __version__: str
 ENV_THREADS: str
 
 #: (center, normal, up, size)
-_Light = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float], tuple[float, float]]
+_Vec3 = tuple[float, float, float]
+# A rectangle (center, normal, up, size); a sun (direction, up, angular_size);
+# a sun with its map's orthographic space (..., depth_origin, depth_range).
+_Light = (
+    tuple[_Vec3, _Vec3, _Vec3, tuple[float, float]]
+    | tuple[_Vec3, _Vec3, tuple[float, float]]
+    | tuple[_Vec3, _Vec3, tuple[float, float], _Vec3, float]
+)
 _Resolution = int | tuple[int, int]
 
 @final
@@ -228,6 +237,10 @@ class MeshShadowResult:
     @property
     def extent(self) -> tuple[float, float]: ...
     @property
+    def depth_origin(self) -> tuple[float, float, float] | None: ...
+    @property
+    def depth_range(self) -> float | None: ...
+    @property
     def timings(self) -> dict[str, float]: ...
     @property
     def method(self) -> Ssm | Bitmask | Exact: ...
@@ -235,6 +248,57 @@ class MeshShadowResult:
     def backend(self) -> str: ...
     @property
     def threads(self) -> int: ...
+
+@final
+class EyeResult:
+    """An image: visibility, G-buffer, light-view maps, and what ran it."""
+
+    @property
+    def visibility(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def depth(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def position(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def normal(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def mesh_id(self) -> npt.NDArray[np.int32]: ...
+    @property
+    def shadow_maps(self) -> list[npt.NDArray[np.float32]]: ...
+    @property
+    def map_extent(self) -> tuple[float, float] | None: ...
+    @property
+    def depth_origin(self) -> tuple[float, float, float] | None: ...
+    @property
+    def depth_range(self) -> float | None: ...
+    @property
+    def timings(self) -> dict[str, float]: ...
+    @property
+    def method(self) -> Ssm | Bitmask | Exact: ...
+    @property
+    def backend(self) -> str: ...
+    @property
+    def threads(self) -> int: ...
+
+def render(
+    meshes: list[tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]],
+    light: _Light,
+    camera: Camera,
+    method: _MethodArg,
+    *,
+    map_resolution: _Resolution | None = None,
+    normal_offset: float | None = None,
+    depth_bias: float | None = None,
+    passes: int | None = None,
+    samples: int | None = None,
+    occluder_resolution: _Resolution | None = None,
+    hierarchy: bool | None = None,
+    precision: str | None = None,
+    backend: str = "cpu",
+    threads: int | None = None,
+) -> EyeResult:
+    """The eye view: first hits, then each pixel's visibility with every mesh
+    casting and receiving."""
 
 @final
 class DepthShadowResult:

@@ -84,3 +84,54 @@ class RectLight:
 
     def _core_args(self) -> tuple[Any, ...]:
         return (self.center, self.normal, self.up, self.size)
+
+
+@dataclass(frozen=True, init=False)
+class DirectionalLight:
+    """A directional light (the sun): a rectangle of directions at infinity.
+
+    Frame: ``n = normalize(direction)`` is the direction the light travels,
+    ``v = normalize(up - (up . n) n)``, ``u = n x v``. The light is the set of
+    travel directions ``n + x u + y v`` with ``|x| <= tan(a_u / 2)`` and
+    ``|y| <= tan(a_v / 2)``, uniform in (x, y); ``angular_size = (a_u, a_v)``
+    are full angles in degrees (the sun is about 0.53). ``(0, 0)`` is a hard
+    directional light. Its light-view maps are orthographic (see
+    docs/conventions.md).
+
+    Raises ValueError for a non-finite or zero ``direction`` or ``up``, an
+    ``up`` parallel to ``direction``, or an angle that is negative, NaN, or
+    beyond 179 degrees (and one zero angle beside a non-zero one).
+    """
+
+    direction: tuple[float, float, float]
+    up: tuple[float, float, float]
+    angular_size: tuple[float, float]
+    _frame: tuple[Any, Any, Any] = field(repr=False, compare=False)
+
+    def __init__(self, direction: Any, up: Any, angular_size: Any = (0.53, 0.53)) -> None:
+        d = check.vector3("direction", direction)
+        u = check.vector3("up", up)
+        a = check.pair("angular_size", angular_size)
+        frame = _core.light_frame((d, u, a))
+        object.__setattr__(self, "direction", d)
+        object.__setattr__(self, "up", u)
+        object.__setattr__(self, "angular_size", a)
+        object.__setattr__(self, "_frame", tuple(np.array(x) for x in frame))
+
+    @property
+    def u(self) -> np.ndarray:
+        """Unit vector along the first angle (map columns grow along it)."""
+        return self._frame[0].copy()
+
+    @property
+    def v(self) -> np.ndarray:
+        """Unit vector along the second angle (map rows grow against it)."""
+        return self._frame[1].copy()
+
+    @property
+    def n(self) -> np.ndarray:
+        """Unit direction the light travels."""
+        return self._frame[2].copy()
+
+    def _core_args(self) -> tuple[Any, ...]:
+        return (self.direction, self.up, self.angular_size)

@@ -9,16 +9,24 @@ reference shadow (umbra or penumbra), i.e. the mean absolute error over the
 actual soft shadow. Dividing by all texels would under-estimate the error when
 the shadow covers a small part of the map.
 
-Every function rejects NaN and inf with a ``ValueError``.
+The map functions reject NaN and inf with a ``ValueError``.
+
+Eye-view images (:func:`compare_images`) are compared only where both see
+the same surface point: both hit (``mask``), the same mesh (``mesh_id``),
+at positions within ``position_tol`` times the reference's depth of each
+other. The errors ``|V - V_ref|`` over those *matched* pixels are reported
+as mean, RMSE, maximum and 99th percentile, with the fraction of the pixels
+where either image hits that are matched.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-__all__ = ["compare", "max_error", "rmse", "shadow_error", "shadow_mask"]
+__all__ = ["ImageComparison", "compare", "compare_images", "max_error", "rmse", "shadow_error", "shadow_mask"]
 
 #: Default occlusion above which a reference texel counts as in shadow.
 DEFAULT_THRESHOLD = 1e-3
@@ -190,3 +198,137 @@ def compare(v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD) -> dict
         "max": max_error(a, b),
         "shadow_texels": int(np.count_nonzero(shadow_mask(b, threshold=threshold))),
     }
+
+
+# --------------------------------------------------------------------------
+# Eye-view images
+# --------------------------------------------------------------------------
+
+#: The fields :func:`compare_images` reads, and their trailing shape after (H, W).
+_IMAGE_FIELDS = (("visibility", ()), ("mask", ()), ("depth", ()), ("position", (3,)), ("mesh_id", ()))
+
+
+@dataclass(frozen=True, eq=False)
+class ImageComparison:
+    """Visibility errors of an eye-view image against a reference one.
+
+    Attributes
+    ----------
+    matched : int
+        Pixels where both images see the same surface point (see
+        :func:`compare_images`).
+    matched_fraction : float
+        ``matched`` over the pixels where either image hits a surface (1.0
+        when neither hits anything).
+    mean_abs, rmse, max_abs, p99_abs : float
+        Mean, root-mean-square, largest and 99th-percentile ``|V - V_ref|``
+        over the matched pixels (0.0 when none is matched).
+    mismatched : int
+        Pixels where either image hits a surface but they are not matched.
+    mask : numpy.ndarray, (H, W) bool
+        The matched pixels.
+    """
+
+    matched: int
+    matched_fraction: float
+    mean_abs: float
+    rmse: float
+    max_abs: float
+    p99_abs: float
+    mismatched: int
+    mask: np.ndarray
+
+    def __repr__(self) -> str:
+        return (
+            f"ImageComparison(matched={self.matched} ({self.matched_fraction:.1%}), "
+            f"mean_abs={self.mean_abs:.4g}, rmse={self.rmse:.4g}, max_abs={self.max_abs:.4g}, "
+            f"p99_abs={self.p99_abs:.4g}, mismatched={self.mismatched})"
+        )
+
+
+def _image_fields(image: Any, name: str) -> dict[str, np.ndarray]:
+    """Read and shape-check an image's fields: (H, W) maps and (H, W, 3) positions."""
+    fields: dict[str, np.ndarray] = {}
+    for field, _trailing in _IMAGE_FIELDS:
+        if not hasattr(image, field):
+            raise TypeError(f"{name} has no attribute {field!r}")
+        fields[field] = np.asarray(getattr(image, field))
+    shape = fields["visibility"].shape
+    if len(shape) != 2:
+        raise ValueError(f"{name}.visibility must be 2-D (H, W), got shape {shape}")
+    for field, trailing in _IMAGE_FIELDS:
+        if fields[field].shape != shape + trailing:
+            raise ValueError(f"{name}.{field} has shape {fields[field].shape}, expected {shape + trailing}")
+    if fields["mask"].dtype != np.bool_:
+        raise TypeError(f"{name}.mask must be boolean, got dtype {fields['mask'].dtype}")
+    return fields
+
+
+def compare_images(image: Any, reference: Any, *, position_tol: float = 1e-4) -> ImageComparison:
+    """Visibility errors of an eye-view image over the pixels that see the same point.
+
+    A pixel is *matched* when both images hit a surface there (``mask``),
+    the same mesh (``mesh_id``), at positions within ``position_tol`` times
+    the reference's distance: ``|position - position_ref| <= position_tol *
+    depth_ref``. Only matched pixels are compared, so silhouettes that the
+    two renderers place differently do not count as shadow errors; they show
+    up in ``matched_fraction`` and ``mismatched`` instead.
+
+    Parameters
+    ----------
+    image, reference : object
+        Anything with ``visibility``, ``mask``, ``depth`` ((H, W)),
+        ``position`` ((H, W, 3)) and ``mesh_id`` ((H, W)), e.g. a
+        :class:`softshadow.reference.ReferenceImage`.
+    position_tol : float, optional
+        Tolerance on the positions, relative to the reference depth.
+
+    Returns
+    -------
+    ImageComparison
+
+    Raises
+    ------
+    ValueError
+        On a shape mismatch (naming the argument and field), a negative or
+        non-finite ``position_tol``, or a NaN or inf visibility at a matched pixel.
+    """
+    tol = float(position_tol)
+    if not (np.isfinite(tol) and tol >= 0.0):
+        raise ValueError(f"position_tol must be finite and non-negative, got {position_tol}")
+    a = _image_fields(image, "image")
+    b = _image_fields(reference, "reference")
+    if a["visibility"].shape != b["visibility"].shape:
+        raise ValueError(
+            f"reference.visibility has shape {b['visibility'].shape} but image.visibility has {a['visibility'].shape}"
+        )
+    both = a["mask"] & b["mask"] & (a["mesh_id"] == b["mesh_id"])
+    # Compare positions only where both hit (elsewhere they may be NaN).
+    distance = np.full(both.shape, np.inf)
+    pa = a["position"][both].astype(np.float64)
+    pb = b["position"][both].astype(np.float64)
+    distance[both] = np.linalg.norm(pa - pb, axis=-1)
+    with np.errstate(invalid="ignore"):
+        matched = both & (distance <= tol * b["depth"].astype(np.float64))
+    either = int(np.count_nonzero(a["mask"] | b["mask"]))
+    count = int(np.count_nonzero(matched))
+    errors = np.abs(a["visibility"][matched].astype(np.float64) - b["visibility"][matched].astype(np.float64))
+    if not np.all(np.isfinite(errors)):
+        raise ValueError("image.visibility or reference.visibility is NaN or inf at a matched pixel")
+    if count:
+        mean_abs = float(errors.mean())
+        rmse_value = float(np.sqrt(np.mean(errors**2)))
+        max_abs = float(errors.max())
+        p99_abs = float(np.percentile(errors, 99))
+    else:
+        mean_abs = rmse_value = max_abs = p99_abs = 0.0
+    return ImageComparison(
+        matched=count,
+        matched_fraction=count / either if either else 1.0,
+        mean_abs=mean_abs,
+        rmse=rmse_value,
+        max_abs=max_abs,
+        p99_abs=p99_abs,
+        mismatched=either - count,
+        mask=matched,
+    )

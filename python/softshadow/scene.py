@@ -1,4 +1,5 @@
-"""Scenes: occluders cast shadows, receivers catch them (the paper's split)."""
+"""Scenes: meshes that all cast and receive shadows, or the paper's split
+(occluders cast shadows, receivers catch them)."""
 
 from __future__ import annotations
 
@@ -51,23 +52,71 @@ def _concat(meshes: list[Mesh]) -> Mesh:
 
 
 class Scene:
-    """Occluder and receiver meshes.
+    """Meshes that cast and receive shadows.
+
+    ``Scene(meshes=[...])``: every mesh casts shadows on every mesh, itself
+    included (what :func:`softshadow.render` draws). ``Scene(occluders=...,
+    receivers=...)``: the split of Atty et al. 2005, where occluders shadow
+    receivers and neither shadows itself (what :func:`soft_shadow_map` maps;
+    in :func:`softshadow.render` its meshes are occluders then receivers, and
+    every one casts and receives).
 
     Each argument is one mesh or an iterable of meshes; a mesh is a
     ``trimesh.Trimesh`` (or anything with ``vertices`` and ``faces``) or a
-    ``(vertices (n, 3), faces (m, 3))`` pair. Occluders shadow receivers; neither
-    shadows itself (the split of Atty et al. 2005).
+    ``(vertices (n, 3), faces (m, 3))`` pair.
     """
 
-    def __init__(self, occluders: Any, receivers: Any) -> None:
-        self.occluders: list[Mesh] = self._meshes(occluders, "occluders")
-        self.receivers: list[Mesh] = self._meshes(receivers, "receivers")
-        if not any(len(f) for _, f in self.occluders):
-            raise ValueError("occluders: the scene has no occluder triangles")
-        if not any(len(f) for _, f in self.receivers):
-            raise ValueError("receivers: the scene has no receiver triangles")
+    def __init__(self, occluders: Any = None, receivers: Any = None, *, meshes: Any = None) -> None:
+        if meshes is not None and (occluders is not None or receivers is not None):
+            raise TypeError("meshes: pass either meshes or occluders and receivers, not both")
+        if meshes is None and (occluders is None or receivers is None):
+            raise TypeError("Scene: pass meshes=[...] (every mesh casts and receives) or both occluders and receivers")
+        self.split = meshes is None
+        if self.split:
+            self.occluders: list[Mesh] = self._meshes(occluders, "occluders")
+            self.receivers: list[Mesh] = self._meshes(receivers, "receivers")
+            if not any(len(f) for _, f in self.occluders):
+                raise ValueError("occluders: the scene has no occluder triangles")
+            if not any(len(f) for _, f in self.receivers):
+                raise ValueError("receivers: the scene has no receiver triangles")
+            self.meshes: list[Mesh] = self.occluders + self.receivers
+        else:
+            self.meshes = self._meshes(meshes, "meshes")
+            if not any(len(f) for _, f in self.meshes):
+                raise ValueError("meshes: the scene has no triangles")
+            self.occluders = self.meshes
+            self.receivers = self.meshes
         self._occ = _concat(self.occluders)
         self._rec = _concat(self.receivers)
+
+    @classmethod
+    def from_trimesh(cls, obj: Any) -> Scene:
+        """Every mesh of a ``trimesh.Scene`` (its node transforms applied; a
+        mesh instanced by several nodes appears once per node), a
+        ``trimesh.Trimesh``, or a path trimesh can load. Geometry without
+        faces (paths, point clouds) is skipped; a scene with no triangles
+        raises ValueError."""
+        import os
+
+        import trimesh
+
+        if isinstance(obj, (str, os.PathLike)):
+            obj = trimesh.load(os.fspath(obj))
+        if isinstance(obj, trimesh.Trimesh):
+            return cls(meshes=[obj])
+        if not isinstance(obj, trimesh.Scene):
+            raise TypeError(f"obj: must be a trimesh.Scene, a trimesh.Trimesh or a path, got {type(obj).__name__}")
+        meshes = []
+        for node in obj.graph.nodes_geometry:
+            transform, name = obj.graph[node]
+            geom = obj.geometry[name]
+            if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
+                continue
+            v = trimesh.transform_points(np.asarray(geom.vertices, dtype=np.float64), transform)
+            meshes.append((v, np.asarray(geom.faces)))
+        if not meshes:
+            raise ValueError("obj: the trimesh scene has no triangle meshes")
+        return cls(meshes=meshes)
 
     @staticmethod
     def _meshes(value: Any, name: str) -> list[Mesh]:
@@ -94,9 +143,13 @@ class Scene:
 
     @property
     def triangle_count(self) -> int:
+        if not self.split:
+            return len(self._occ[1])
         return len(self._occ[1]) + len(self._rec[1])
 
     def __repr__(self) -> str:
+        if not self.split:
+            return f"Scene({len(self.meshes)} meshes / {self.triangle_count} triangles)"
         return (
             f"Scene({len(self.occluders)} occluder meshes / {len(self._occ[1])} triangles, "
             f"{len(self.receivers)} receiver meshes / {len(self._rec[1])} triangles)"

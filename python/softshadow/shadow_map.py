@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
-from .light import RectLight
+from .light import DirectionalLight, RectLight
 from .methods import MethodConfig
 from .scene import Scene
 
@@ -42,9 +42,10 @@ class ShadowMap:
     occluder layers (``Exact`` traces the occluder triangles)."""
     occluder_depth_back: np.ndarray | None
     """Back (farthest) occluder depth; None with one pass or no layers."""
-    light: RectLight
+    light: RectLight | DirectionalLight
     extent: tuple[float, float]
-    """Tangent half-extents (tx, ty)."""
+    """Tangent half-extents (tx, ty); for a DirectionalLight, world
+    half-extents of the orthographic maps."""
     method: MethodConfig
     """The config that ran: ``"auto"`` resolved, every default filled in."""
     extent_fitted: bool
@@ -59,6 +60,17 @@ class ShadowMap:
     threads: int = 0
     """Worker threads the CPU stages could use."""
     _occluder_mesh: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    depth_origin: tuple[float, float, float] | None = None
+    """For a DirectionalLight: a world point on the maps' depth-0 plane (the
+    plane across the light's direction touching the scene on its side)."""
+    depth_range: float | None = None
+    """For a DirectionalLight: the scene's depth range along the light."""
+
+    def _light_args(self) -> tuple[Any, ...]:
+        if isinstance(self.light, DirectionalLight):
+            assert self.depth_origin is not None and self.depth_range is not None
+            return (*self.light._core_args(), self.depth_origin, self.depth_range)
+        return self.light._core_args()
 
     @property
     def resolution(self) -> tuple[int, int]:
@@ -124,7 +136,7 @@ class ShadowMap:
                 "occluder_depth_middle": list(self.occluder_depth_middle),
             }
         vis, inside = _core.sample_points(
-            self.light._core_args(),
+            self._light_args(),
             self.extent,
             self.resolution,
             np.ascontiguousarray(pts),
@@ -145,12 +157,12 @@ class ShadowMap:
     def receiver_points(self) -> tuple[np.ndarray, np.ndarray]:
         """World points (M, 3) float64 of the texels that have a receiver, and
         their flat texel indices (M,) into ``visibility.ravel()``."""
-        return _core.receiver_points(self.receiver_depth, self.light._core_args(), self.extent)
+        return _core.receiver_points(self.receiver_depth, self._light_args(), self.extent)
 
 
 def soft_shadow_map(
     scene: Scene,
-    light: RectLight,
+    light: RectLight | DirectionalLight,
     *,
     resolution: int | tuple[int, int] = 256,
     extent: float | tuple[float, float] | None = None,
@@ -168,7 +180,10 @@ def soft_shadow_map(
     Parameters
     ----------
     scene, light
-        The geometry and the rectangular area light.
+        The geometry (the split scene: occluders and receivers) and the
+        light: a rectangle, or a :class:`DirectionalLight`, whose maps are
+        orthographic (world half-extents; depth from the plane across the
+        light touching the scene, ``sm.depth_origin``).
     resolution
         ``int`` for a square map or ``(W, H)``. The receiver map shares it, and
         the occluder maps unless the method's ``occluder_resolution`` says
@@ -244,8 +259,13 @@ def soft_shadow_map(
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
-    if not isinstance(light, RectLight):
-        raise TypeError(f"light: must be a softshadow.RectLight, got {type(light).__name__}")
+    if not isinstance(light, (RectLight, DirectionalLight)):
+        raise TypeError(f"light: must be a softshadow.RectLight or DirectionalLight, got {type(light).__name__}")
+    if not scene.split:
+        raise ValueError(
+            "scene: soft_shadow_map maps the paper's split (Scene(occluders=..., receivers=...)); "
+            "for a scene where every mesh casts and receives, use softshadow.render"
+        )
     ext = None if extent is None else check.pair("extent", extent)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
     r = _core.shadow_map_from_meshes(
@@ -279,6 +299,8 @@ def soft_shadow_map(
         backend=r.backend,
         threads=r.threads,
         _occluder_mesh=(ov, of) if r.occluder_depth is None else None,
+        depth_origin=r.depth_origin,
+        depth_range=r.depth_range,
     )
 
 

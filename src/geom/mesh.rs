@@ -1,7 +1,7 @@
 //! Triangle meshes handed to the core: validation and the move to light space.
 
 use crate::error::{Error, Result};
-use crate::geom::light::RectLight;
+use crate::geom::light_space::LightSpace;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -44,7 +44,7 @@ impl<'a> MeshRef<'a> {
     }
 
     /// Vertices in light space (X, Y, Z), computed in f64.
-    pub fn to_light_space(&self, light: &RectLight) -> Vec<DVec3> {
+    pub fn to_light_space(&self, light: &LightSpace) -> Vec<DVec3> {
         self.vertices
             .par_iter()
             .map(|p| light.to_light(DVec3::from_array(*p)))

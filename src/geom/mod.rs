@@ -4,5 +4,7 @@
 pub mod camera;
 pub mod extent;
 pub mod light;
+pub mod light_space;
 pub mod mesh;
+pub mod sun;
 pub mod units;

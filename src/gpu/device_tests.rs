@@ -87,9 +87,9 @@ fn run_at(gpu: bool, passes: u32, method: Method, (width, height): (usize, usize
         faces: &rf,
     };
     if gpu {
-        super::from_meshes(occ, rec, &light, &s).unwrap()
+        super::from_meshes(occ, rec, &light.into(), &s).unwrap()
     } else {
-        pipeline::from_meshes(occ, rec, &light, &s).unwrap()
+        pipeline::from_meshes(occ, rec, &light.into(), &s).unwrap()
     }
 }
 

@@ -17,7 +17,8 @@ use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::geom::light::{is_point, RectLight};
+use crate::geom::light::is_point;
+use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::methods::{Input, Method};
 use crate::pipeline::{
@@ -56,7 +57,7 @@ enum Stage {
 pub fn from_meshes(
     occluders: MeshRef,
     receivers: MeshRef,
-    light: &RectLight,
+    light: &LightSpace,
     s: &MapSettings,
 ) -> Result<ShadowResult> {
     // Map methods shade occluder maps; `exact` traces the triangles.
@@ -188,6 +189,7 @@ pub fn from_meshes(
         occluder_middle: middle,
         occluder_back: back,
         timings,
+        light_space: *light,
     }
     .in_user_units(unit))
 }

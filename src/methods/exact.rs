@@ -42,9 +42,11 @@ struct Node {
 pub struct Bvh {
     nodes: Vec<Node>,
     tris: Vec<[Vec3; 3]>,
+    /// The index each triangle had in the input (`nearest` reports it).
+    order: Vec<u32>,
 }
 
-fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
+fn bounds<'a>(tris: impl Iterator<Item = &'a [Vec3; 3]>) -> (Vec3, Vec3) {
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for t in tris {
@@ -91,9 +93,14 @@ impl Bvh {
             .collect()
     }
 
-    pub fn build(mut tris: Vec<[Vec3; 3]>) -> Bvh {
+    pub fn build(tris: Vec<[Vec3; 3]>) -> Bvh {
+        let mut tris: Vec<([Vec3; 3], u32)> = tris
+            .into_iter()
+            .enumerate()
+            .map(|(k, t)| (t, k as u32))
+            .collect();
         let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
-        let (lo, hi) = bounds(&tris);
+        let (lo, hi) = bounds(tris.iter().map(|t| &t.0));
         nodes.push(Node {
             min: lo,
             max: hi,
@@ -111,7 +118,7 @@ impl Bvh {
             let slice = &mut tris[s..s + c];
             let (clo, chi) = slice.iter().fold(
                 (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(a, b), t| (a.min(centroid(t)), b.max(centroid(t))),
+                |(a, b), t| (a.min(centroid(&t.0)), b.max(centroid(&t.0))),
             );
             let ext = chi - clo;
             let axis = if ext.x >= ext.y && ext.x >= ext.z {
@@ -123,11 +130,11 @@ impl Bvh {
             };
             let mid = c / 2;
             slice.select_nth_unstable_by(mid, |a, b| {
-                centroid(a)[axis].total_cmp(&centroid(b)[axis])
+                centroid(&a.0)[axis].total_cmp(&centroid(&b.0)[axis])
             });
             let left = nodes.len();
             for (off, len) in [(0, mid), (mid, c - mid)] {
-                let (lo, hi) = bounds(&tris[s + off..s + off + len]);
+                let (lo, hi) = bounds(tris[s + off..s + off + len].iter().map(|t| &t.0));
                 nodes.push(Node {
                     min: lo,
                     max: hi,
@@ -140,7 +147,64 @@ impl Bvh {
             work.push(left);
             work.push(left + 1);
         }
-        Bvh { nodes, tris }
+        let (tris, order) = tris.into_iter().unzip();
+        Bvh { nodes, tris, order }
+    }
+
+    /// The nearest hit of the ray o + t d, t in (0, t1): its t and the
+    /// triangle's index in the input. Children are visited nearer first, so
+    /// a hit found early prunes the farther subtrees.
+    pub fn nearest(&self, o: Vec3, d: Vec3, t1: f32) -> Option<(f32, u32)> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let inv = d.recip();
+        let entry = |n: &Node, best: f32| {
+            let a = (n.min - o) * inv;
+            let b = (n.max - o) * inv;
+            let tmin = a.min(b).max_element().max(0.0);
+            let tmax = a.max(b).min_element().min(best);
+            (tmin <= tmax).then_some(tmin)
+        };
+        let mut best = t1;
+        let mut hit = None;
+        let mut stack = [0u32; 64];
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let node = &self.nodes[stack[sp] as usize];
+            if entry(node, best).is_none() {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.start as usize;
+                for (k, t) in self.tris[s..s + node.count as usize].iter().enumerate() {
+                    if let Some(th) = hit_t(t, o, d) {
+                        if th > 0.0 && th < best {
+                            best = th;
+                            hit = Some(s + k);
+                        }
+                    }
+                }
+            } else {
+                let (l, r) = (node.start, node.start + 1);
+                let (el, er) = (
+                    entry(&self.nodes[l as usize], best),
+                    entry(&self.nodes[r as usize], best),
+                );
+                // Push the farther child first so the nearer one pops next.
+                let order = match (el, er) {
+                    (Some(a), Some(b)) if b < a => [Some(l), Some(r)],
+                    _ => [er.and(Some(r)), el.and(Some(l))],
+                };
+                for c in order.into_iter().flatten() {
+                    debug_assert!(sp < stack.len());
+                    stack[sp] = c;
+                    sp += 1;
+                }
+            }
+        }
+        hit.map(|k| (best, self.order[k]))
     }
 
     /// Whether the segment o + t d, t in (t0, t1), hits any triangle.
@@ -186,26 +250,32 @@ impl Bvh {
 /// Möller-Trumbore, any hit with t in (t0, t1).
 #[inline]
 fn hits(tri: &[Vec3; 3], o: Vec3, d: Vec3, t0: f32, t1: f32) -> bool {
+    hit_t(tri, o, d).is_some_and(|t| t > t0 && t < t1)
+}
+
+/// Möller-Trumbore: the line's parameter t where it crosses the triangle
+/// (edges included), or None.
+#[inline]
+fn hit_t(tri: &[Vec3; 3], o: Vec3, d: Vec3) -> Option<f32> {
     let e1 = tri[1] - tri[0];
     let e2 = tri[2] - tri[0];
     let p = d.cross(e2);
     let det = e1.dot(p);
     if det == 0.0 || !det.is_finite() {
-        return false;
+        return None;
     }
     let inv = 1.0 / det;
     let s = o - tri[0];
     let u = s.dot(p) * inv;
     if !(0.0..=1.0).contains(&u) {
-        return false;
+        return None;
     }
     let q = s.cross(e1);
     let v = d.dot(q) * inv;
     if v < 0.0 || u + v > 1.0 {
-        return false;
+        return None;
     }
-    let t = e2.dot(q) * inv;
-    t > t0 && t < t1
+    Some(e2.dot(q) * inv)
 }
 
 /// A 32-bit mix (splitmix-style) for deterministic jitter.
@@ -220,6 +290,34 @@ fn hash(mut x: u64) -> u64 {
 #[inline]
 fn unit(h: u64) -> f32 {
     (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
+
+/// The fraction of `grid` stratified light samples whose segment is clear:
+/// `ray(x, y)` gives, for the light point (x, y, 0), the segment's origin
+/// o, its direction d = light point - o, and t0 (the segment is t in (t0,
+/// 1 - RAY_EPS)). The jitter is a hash of `key` and the sample.
+#[inline]
+pub(crate) fn stratified(
+    bvh: &Bvh,
+    key: u64,
+    grid: (u32, u32),
+    size: [f32; 2],
+    mut ray: impl FnMut(f32, f32) -> (Vec3, Vec3, f32),
+) -> f32 {
+    let (na, nb) = grid;
+    let mut seen = 0u32;
+    for sb in 0..nb {
+        for sa in 0..na {
+            let h = hash(key ^ hash(((sb * na + sa) as u64) << 1));
+            let x = ((sa as f32 + unit(h)) / na as f32 - 0.5) * size[0];
+            let y = ((sb as f32 + unit(hash(h))) / nb as f32 - 0.5) * size[1];
+            let (o, d, t0) = ray(x, y);
+            if !bvh.occluded(o, d, t0, 1.0 - RAY_EPS) {
+                seen += 1;
+            }
+        }
+    }
+    seen as f32 / (na * nb) as f32
 }
 
 /// The stratification grid a x b = samples, a the largest divisor <= sqrt,
@@ -241,20 +339,9 @@ pub fn sample_grid(samples: u32, light_size: [f64; 2]) -> (u32, u32) {
 impl Exact {
     /// Visibility at a receiver at light-space position p (planar depth p.z).
     fn visibility(&self, bvh: &Bvh, p: Vec3, key: u64, grid: (u32, u32), size: [f32; 2]) -> f32 {
-        let (na, nb) = grid;
-        let mut seen = 0u32;
-        for sb in 0..nb {
-            for sa in 0..na {
-                let h = hash(key ^ hash(((sb * na + sa) as u64) << 1));
-                let x = ((sa as f32 + unit(h)) / na as f32 - 0.5) * size[0];
-                let y = ((sb as f32 + unit(hash(h))) / nb as f32 - 0.5) * size[1];
-                let d = Vec3::new(x, y, 0.0) - p;
-                if !bvh.occluded(p, d, RAY_EPS, 1.0 - RAY_EPS) {
-                    seen += 1;
-                }
-            }
-        }
-        seen as f32 / (na * nb) as f32
+        stratified(bvh, key, grid, size, |x, y| {
+            (p, Vec3::new(x, y, 0.0) - p, RAY_EPS)
+        })
     }
 
     fn shade(&self, inputs: &ShadowInputs, pts: &[(u64, Option<Vec3>)]) -> Vec<f32> {

@@ -4,7 +4,8 @@
 
 use crate::error::{Error, Result};
 use crate::geom::extent::fit_extent;
-use crate::geom::light::{MapGrid, RectLight};
+use crate::geom::light::MapGrid;
+use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::geom::units::{check_lateral, check_unit, depth_unit, light_size_in};
 use crate::memory::{check_fits, map_bytes};
@@ -65,7 +66,7 @@ pub(crate) struct FramedScene {
 pub(crate) fn frame_scene(
     occluders: &MeshRef,
     receivers: &MeshRef,
-    light: &RectLight,
+    light: &LightSpace,
     s: &MapSettings,
     sw: &mut Stopwatch,
 ) -> Result<FramedScene> {
@@ -111,7 +112,7 @@ pub(crate) fn frame_scene(
     // the user's units at the end.
     let unit = depth_unit(rec_ls.iter().fold(0f64, |m, q| m.max(q.z)));
     check_unit("receivers", unit)?;
-    let light_size = light_size_in("size", light.size, unit)?;
+    let light_size = light_size_in("size", light.size(), unit)?;
     if unit != 1.0 {
         for q in occ_ls.iter_mut().chain(rec_ls.iter_mut()) {
             *q /= unit;

@@ -3,7 +3,8 @@
 //! occluder triangles), then the method's shading.
 
 use crate::error::Result;
-use crate::geom::light::{is_point, MapGrid, RectLight};
+use crate::geom::light::{is_point, MapGrid};
+use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::methods::{point_light, Input, Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared};
@@ -26,22 +27,35 @@ pub struct ShadowResult {
     pub occluder_middle: Vec<Vec<f32>>,
     pub occluder_back: Option<Vec<f32>>,
     pub timings: Timings,
+    /// The light space the maps were computed in (the sun's depth origin
+    /// and range are the scene's).
+    pub light_space: LightSpace,
 }
 
 impl ShadowResult {
     /// The depth maps, computed in the kernels' depth unit `unit` (see
-    /// units.rs), back in the user's units: a power of two, so exact.
+    /// units.rs), back in the user's units (a power of two, so exact), and
+    /// for the sun from the kernels' depth to the orthographic one.
     pub(crate) fn in_user_units(mut self, unit: f64) -> ShadowResult {
-        if unit != 1.0 {
+        let space = self.light_space;
+        let sun = matches!(space, LightSpace::Sun(_));
+        if unit != 1.0 || sun {
             let maps = std::iter::once(&mut self.receiver)
                 .chain(self.occluder_front.as_mut())
                 .chain(self.occluder_middle.iter_mut())
                 .chain(self.occluder_back.as_mut());
             for m in maps {
-                m.par_iter_mut().for_each(|z| *z *= unit as f32);
+                m.par_iter_mut()
+                    .for_each(|z| *z = space.user_depth(*z * unit as f32));
             }
         }
         self
+    }
+
+    /// The map's extent as the user reads it: tangent half-extents, or for
+    /// the sun world half-extents.
+    pub fn user_extent(&self) -> [f64; 2] {
+        self.light_space.user_extent([self.grid.tx, self.grid.ty])
     }
 }
 
@@ -49,7 +63,7 @@ impl ShadowResult {
 pub fn from_meshes(
     occluders: MeshRef,
     receivers: MeshRef,
-    light: &RectLight,
+    light: &LightSpace,
     s: &MapSettings,
 ) -> Result<ShadowResult> {
     let mut sw = Stopwatch::new();
@@ -114,6 +128,7 @@ pub fn from_meshes(
         occluder_middle: middle,
         occluder_back,
         timings: sw.timings,
+        light_space: *light,
     }
     .in_user_units(unit))
 }

@@ -17,6 +17,7 @@ pub use from_depth::{check_depth, from_depth};
 #[cfg(feature = "gpu")]
 pub(crate) use from_depth::{check_depth_inputs, DepthInUnit};
 pub use from_meshes::{from_meshes, light_space_triangles, ShadowResult};
+pub(crate) use points::shade_points;
 pub use points::{receiver_points, sample_points, OccluderSource};
 
 use crate::methods::{Method, MethodConfig};

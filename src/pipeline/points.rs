@@ -2,7 +2,8 @@
 //! occluders, and the world points of its receiver texels.
 
 use crate::error::{Error, Result};
-use crate::geom::light::{is_point, MapGrid, RectLight};
+use crate::geom::light::{is_point, MapGrid};
+use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::geom::units::{check_lateral, check_unit, depth_unit, light_size_in, scaled_map};
 use crate::methods::{point_light, Input, LightPoint, Method, ShadowInputs};
@@ -13,7 +14,7 @@ use super::from_depth::check_depth;
 use super::from_meshes::light_space_triangles;
 
 /// Visibility at receiver points, as `shade_map`.
-fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
+pub(crate) fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
     if is_point(inputs.light_size) && method.reads_input(Input::OccluderLayers) {
         point_light::visibility_points(inputs, pts)
     } else {
@@ -40,7 +41,7 @@ pub enum OccluderSource<'a> {
 /// outside it or at/behind the light's plane get visibility 1 and `false`).
 pub fn sample_points(
     grid: &MapGrid,
-    light: &RectLight,
+    light: &LightSpace,
     occluders: OccluderSource,
     points: &[[f64; 3]],
     method: Method,
@@ -65,7 +66,7 @@ pub fn sample_points(
             .fold(0f64, |m, q| m.max(q.z)),
     );
     check_unit("points", unit)?;
-    let light_size = light_size_in("size", light.size, unit)?;
+    let light_size = light_size_in("size", light.size(), unit)?;
     let (ls, inside): (Vec<LightPoint>, Vec<bool>) = ls_points
         .par_iter()
         .map(|q| {
@@ -107,9 +108,20 @@ pub fn sample_points(
                         ),
                     ));
                 }
-                check_depth(&arg, l)?;
             }
-            let scaled: Vec<_> = layers.iter().map(|l| scaled_map(l, unit)).collect();
+            // The user's depths (orthographic ones for the sun) -> the
+            // kernels', which must be > 0 (or inf where empty).
+            let kernel: Vec<Vec<f32>> = layers
+                .iter()
+                .map(|l| l.par_iter().map(|&z| light.kernel_depth(z)).collect())
+                .collect();
+            for (k, l) in kernel.iter().enumerate() {
+                check_depth(&format!("occluder layer {k}"), l)?;
+            }
+            let scaled: Vec<Vec<f32>> = kernel
+                .iter()
+                .map(|l| scaled_map(l, unit).into_owned())
+                .collect();
             (scaled, None, og)
         }
         OccluderSource::Mesh(mesh) => {
@@ -142,7 +154,7 @@ pub fn sample_points(
 /// depth) and their flat texel indices, in f64.
 pub fn receiver_points(
     grid: &MapGrid,
-    light: &RectLight,
+    light: &LightSpace,
     receiver: &[f32],
 ) -> (Vec<[f64; 3]>, Vec<u64>) {
     let w = grid.width;
@@ -151,7 +163,8 @@ pub fn receiver_points(
         .enumerate()
         .filter(|(_, z)| z.is_finite())
         .map(|(k, &z)| {
-            let p = light.point_at(grid.x_of(k % w), grid.y_of(k / w), z as f64);
+            let z = light.kernel_depth(z) as f64;
+            let p = light.point_at(grid.x_of(k % w), grid.y_of(k / w), z);
             (p.to_array(), k as u64)
         })
         .unzip()

@@ -2,17 +2,55 @@
 //! the argument), values by the core (ValueError from its `Error`).
 
 use crate::geom::light::RectLight;
+use crate::geom::light_space::{Light as CoreLight, LightSpace};
 use crate::geom::mesh::MeshRef;
+use crate::geom::sun::{DirectionalLight, SunSpace};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyInt, PyTuple};
 
-/// A light as the package passes it: (center, normal, up, size).
-pub type Light = ([f64; 3], [f64; 3], [f64; 3], [f64; 2]);
+/// A light as the package passes it: a rectangle (center, normal, up,
+/// size), a sun (direction, up, angular_size), or a sun with the
+/// orthographic space of the map it made (..., depth origin, depth range).
+#[derive(FromPyObject)]
+pub enum Light {
+    Rect(([f64; 3], [f64; 3], [f64; 3], [f64; 2])),
+    Sun(([f64; 3], [f64; 3], [f64; 2])),
+    SunSpace(([f64; 3], [f64; 3], [f64; 2], [f64; 3], f64)),
+}
 
-pub fn light_of(l: Light) -> PyResult<RectLight> {
-    Ok(RectLight::new(l.0, l.1, l.2, l.3)?)
+/// The light a user passed.
+pub fn light_of(l: Light) -> PyResult<CoreLight> {
+    Ok(match l {
+        Light::Rect(l) => CoreLight::Rect(RectLight::new(l.0, l.1, l.2, l.3)?),
+        Light::Sun((d, up, a)) | Light::SunSpace((d, up, a, _, _)) => {
+            CoreLight::Sun(DirectionalLight::new(d, up, a)?)
+        }
+    })
+}
+
+/// The light space of a map already made: a rectangle's, or a sun's with
+/// its depth origin and range.
+pub fn space_of(l: Light) -> PyResult<LightSpace> {
+    Ok(match l {
+        Light::Rect(l) => LightSpace::Rect(RectLight::new(l.0, l.1, l.2, l.3)?),
+        Light::SunSpace((d, up, a, origin, range)) => {
+            let sun = DirectionalLight::new(d, up, a)?;
+            let origin = crate::geom::light::finite3("depth_origin", origin)?;
+            if !(range.is_finite() && range >= 0.0) {
+                return Err(PyValueError::new_err(format!(
+                    "depth_range: must be finite and >= 0, got {range}"
+                )));
+            }
+            LightSpace::Sun(SunSpace::new(sun, origin, range))
+        }
+        Light::Sun(_) => {
+            return Err(PyValueError::new_err(
+                "light: a directional light's map needs its depth origin and range",
+            ))
+        }
+    })
 }
 
 fn type_name(v: &Bound<'_, PyAny>) -> String {

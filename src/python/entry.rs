@@ -2,11 +2,12 @@
 //! (`crate::backend`), wrap the result.
 
 use super::configs::{method_arg, Loose};
-use super::convert::{light_of, mesh, opt_int, same_shape, slice, triples, Light};
+use super::convert::{light_of, mesh, opt_int, same_shape, slice, space_of, triples, Light};
 use super::errors;
 use super::results::{DepthShadowResult, MeshShadowResult};
 use crate::backend::{self, BackendChoice, DepthCall, MeshCall};
 use crate::geom::light::MapGrid;
+use crate::geom::light_space::Light as CoreLight;
 use crate::methods::MethodConfig;
 use crate::pipeline::{self, OccluderSource};
 use numpy::ndarray::Array2;
@@ -18,8 +19,10 @@ use pyo3::prelude::*;
 #[pyfunction]
 pub fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
     errors::guard(|| {
-        let l = light_of(light)?;
-        Ok((l.u.to_array(), l.v.to_array(), l.n.to_array()))
+        Ok(match light_of(light)? {
+            CoreLight::Rect(l) => (l.u.to_array(), l.v.to_array(), l.n.to_array()),
+            CoreLight::Sun(l) => (l.u.to_array(), l.v.to_array(), l.n.to_array()),
+        })
     })
 }
 
@@ -157,10 +160,10 @@ pub fn sample_points<'py>(
     threads: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     errors::guard(|| {
-        let light = light_of(light)?;
+        let light = space_of(light)?;
         let method: MethodConfig = method_arg(method, &Loose::none())?;
         let (w, h) = crate::methods::config::check_resolution("resolution", resolution)?;
-        let grid = MapGrid::new(w, h, [extent.0, extent.1])?;
+        let grid = MapGrid::new(w, h, light.kernel_extent([extent.0, extent.1]))?;
         let middle = occluder_depth_middle.unwrap_or_default();
         let source = match (&occluder_depth, &occ_vertices, &occ_faces) {
             (Some(front), None, None) => {
@@ -177,7 +180,7 @@ pub fn sample_points<'py>(
                     layers.push(slice("occluder_depth_back", b)?);
                 }
                 OccluderSource::Maps {
-                    grid: MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?,
+                    grid: MapGrid::new(oshape[1], oshape[0], light.kernel_extent([extent.0, extent.1]))?,
                     layers,
                 }
             }
@@ -208,11 +211,18 @@ pub fn receiver_points<'py>(
     extent: (f64, f64),
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     errors::guard(|| {
-        let light = light_of(light)?;
+        let light = space_of(light)?;
         let shape = receiver_depth.shape();
-        let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
+        let grid = MapGrid::new(
+            shape[1],
+            shape[0],
+            light.kernel_extent([extent.0, extent.1]),
+        )?;
         let rec = slice("receiver_depth", &receiver_depth)?;
-        pipeline::check_depth("receiver_depth", rec)?;
+        // The kernels' depths must be > 0 (or inf): a sun's orthographic
+        // depths start at 0 and are checked once converted.
+        let kernel: Vec<f32> = rec.iter().map(|&z| light.kernel_depth(z)).collect();
+        pipeline::check_depth("receiver_depth", &kernel)?;
         let (pts, idx) = py.detach(|| pipeline::receiver_points(&grid, &light, rec));
         let n = pts.len();
         let flat: Vec<f64> = pts.into_iter().flatten().collect();

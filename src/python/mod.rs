@@ -7,6 +7,7 @@
 //! * `configs.rs`: the method configs `Ssm`, `Bitmask`, `Exact`, `Auto`.
 //! * `camera.rs`: the eye view's `Camera`.
 //! * `entry.rs`: the entry points.
+//! * `eye.rs`: the eye view's `render` and its result.
 //! * `results.rs`: the typed results.
 //! * `capabilities.rs`: the method table and limits.
 //! * `errors.rs`: core errors and panics to Python exceptions.
@@ -18,6 +19,7 @@ mod configs;
 mod convert;
 mod entry;
 mod errors;
+mod eye;
 mod gpu;
 mod results;
 
@@ -29,6 +31,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<camera::PyCamera>()?;
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;
+    m.add_class::<eye::EyeResult>()?;
+    m.add_function(wrap_pyfunction!(eye::render, m)?)?;
     m.add_class::<capabilities::MethodInfo>()?;
     m.add_class::<capabilities::OptionInfo>()?;
     m.add_function(wrap_pyfunction!(capabilities::capabilities, m)?)?;

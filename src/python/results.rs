@@ -4,6 +4,7 @@
 use super::configs;
 use crate::backend::Run;
 use crate::geom::light::MapGrid;
+use crate::geom::light_space::LightSpace;
 use crate::pipeline::{ShadowResult, Timings};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
@@ -45,9 +46,14 @@ pub struct MeshShadowResult {
     /// Peeled layers between front and back, nearest first.
     #[pyo3(get)]
     occluder_depth_middle: Vec<Py<PyAny>>,
-    /// Tangent half-extents (tx, ty).
+    /// Tangent half-extents (tx, ty); world half-extents for the sun.
     #[pyo3(get)]
     extent: (f64, f64),
+    /// For the sun: the orthographic maps' depth origin and depth range.
+    #[pyo3(get)]
+    depth_origin: Option<(f64, f64, f64)>,
+    #[pyo3(get)]
+    depth_range: Option<f64>,
     timings: Timings,
     /// The config that ran.
     #[pyo3(get)]
@@ -73,6 +79,7 @@ impl MeshShadowResult {
     pub fn new(py: Python<'_>, run: Run<ShadowResult>) -> PyResult<Self> {
         let r = run.output;
         let og = r.occluder_grid;
+        let [ex, ey] = r.user_extent();
         let layer = |m: Option<Vec<f32>>| m.map(|m| map(py, &og, m)).transpose();
         Ok(MeshShadowResult {
             visibility: map(py, &r.grid, r.visibility)?,
@@ -84,7 +91,15 @@ impl MeshShadowResult {
                 .into_iter()
                 .map(|m| map(py, &og, m))
                 .collect::<PyResult<_>>()?,
-            extent: (r.grid.tx, r.grid.ty),
+            extent: (ex, ey),
+            depth_origin: match r.light_space {
+                LightSpace::Sun(s) => Some(s.origin.into()),
+                LightSpace::Rect(_) => None,
+            },
+            depth_range: match r.light_space {
+                LightSpace::Sun(s) => Some(s.depth_range),
+                LightSpace::Rect(_) => None,
+            },
             timings: r.timings,
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),

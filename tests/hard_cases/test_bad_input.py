@@ -235,7 +235,8 @@ def test_bad_points_and_outside_values():
             ValueError,
             "while processing 'light_size'",
         ),
-        (lambda o, r: _core.light_frame((1, 2)), ValueError, "while processing 'light'"),
+        # A light is a rectangle's 4-tuple or a sun's 3-tuple: neither fits.
+        (lambda o, r: _core.light_frame((1, 2)), TypeError, "while processing 'light'"),
         # Values: the core's messages start with the name.
         (
             lambda o, r: _core.shadow_map_from_depth(o, None, r, (1, 1), (0.5, 0.5), "bitmask", samples=-1),

@@ -42,6 +42,11 @@ Modules
     :func:`render_image`.
 ``camera``
     :func:`camera_sensor`: Mitsuba's sensor for a :class:`softshadow.Camera`.
+``eye``
+    :func:`render_visibility`, :class:`ReferenceImage`: the visibility of the
+    surface seen through each pixel of a camera, under a rectangular or a
+    directional light, every mesh casting shadows (itself included), with
+    the first hits' mask, depth, position, normal and mesh index.
 """
 
 from __future__ import annotations
@@ -55,14 +60,17 @@ from ._mitsuba import _import_mitsuba as _import_mitsuba
 from ._mitsuba import variant
 from ._rays import MAX_RAYS_PER_BATCH as MAX_RAYS_PER_BATCH
 from .camera import camera_sensor
+from .eye import ReferenceImage, render_visibility
 from .render import render_image
 from .visibility import ReferenceScene, TraceStats, reference_map, visibility_at_points
 
 __all__ = [
     "camera_sensor",
+    "ReferenceImage",
     "ReferenceScene",
     "TraceStats",
     "render_image",
+    "render_visibility",
     "reference_map",
     "variant",
     "visibility_at_points",

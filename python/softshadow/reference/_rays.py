@@ -50,6 +50,41 @@ def _grid_shape(samples: int, sx: float, sy: float) -> tuple[int, int]:
     return (large, small) if sx >= sy else (small, large)
 
 
+def _stratified_offsets(
+    count: int,
+    grid: tuple[int, int],
+    sx: float,
+    sy: float,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Jittered stratified offsets (s, t) of ``count`` points' light samples.
+
+    ``s`` (along u) and ``t`` (along v), both float64 of shape (count, K) with
+    K = n_u * n_v, lie in [-sx/2, sx/2] and [-sy/2, sy/2]: sample k of a point
+    is uniform in stratum (k mod n_u, k div n_u) of the n_u x n_v grid over the
+    sx x sy rectangle. The jitter is drawn point-major, so consecutive calls
+    consume the generator's stream exactly as one call for all the points.
+    """
+    n_u, n_v = grid
+    samples = n_u * n_v
+    cells_u = np.tile(np.arange(n_u, dtype=np.float64), n_v)  # stratum index
+    cells_v = np.repeat(np.arange(n_v, dtype=np.float64), n_u)
+    # Point-major draw order, so consecutive batches consume the generator's
+    # stream exactly as a single batch would: results don't depend on batching.
+    jitter = rng.random((count, samples, 2))
+    # Offsets of the samples from the centre along u and v, (N, K); computed
+    # in place to keep the memory of large batches down.
+    s = jitter[..., 0]
+    s += cells_u
+    s *= sx / n_u
+    s -= 0.5 * sx
+    t = jitter[..., 1]
+    t += cells_v
+    t *= sy / n_v
+    t -= 0.5 * sy
+    return s, t
+
+
 def _shadow_rays(
     points: np.ndarray,
     frame: LightFrame,
@@ -63,24 +98,9 @@ def _shadow_rays(
     are ``i*K ... i*K + K-1``. Computed in float64, rounded at the end.
     """
     c, u, v, _n, sx, sy = frame
-    n_u, n_v = grid
-    samples = n_u * n_v
+    samples = grid[0] * grid[1]
     count = len(points)
-    cells_u = np.tile(np.arange(n_u, dtype=np.float64), n_v)  # stratum index
-    cells_v = np.repeat(np.arange(n_v, dtype=np.float64), n_u)
-    # Point-major draw order, so consecutive batches consume the generator's
-    # stream exactly as a single batch would: results don't depend on batching.
-    jitter = rng.random((count, samples, 2))
-    # Offsets of the samples from the light's center along u and v, (N, K);
-    # computed in place to keep the memory of large batches down.
-    s = jitter[..., 0]
-    s += cells_u
-    s *= sx / n_u
-    s -= 0.5 * sx
-    t = jitter[..., 1]
-    t += cells_v
-    t *= sy / n_v
-    t -= 0.5 * sy
+    s, t = _stratified_offsets(count, grid, sx, sy, rng)
     to_center = c - points  # (N, 3)
     direction = np.empty((3, count, samples))
     for axis in range(3):

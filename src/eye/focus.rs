@@ -1,0 +1,126 @@
+//! The light-view maps of an image, fitted to what the camera sees
+//! (Scherzer et al. 2005, §4.1: focusing; no texels on parts of the scene
+//! no pixel shows) and sized from the pixels' footprint.
+//!
+//! * Extent. The visible points (kernel light space) span tangents up to
+//!   r = max |x/z|. An occluder between a point at depth zR and the light
+//!   (size L) lies within tangent r + (L/2)(1/zO - 1/zR) of the axis
+//!   (extent.rs), so `fit_extent` over the occluders in front of the light
+//!   and the visible points bounds every texel that can shadow a pixel.
+//!   Occluders nearer the light than `NEAREST_OCCLUDER` of the nearest
+//!   visible point's depth would widen it without bound (a wall meeting a
+//!   ceiling light): the reach is cut there, and such occluders are seen
+//!   only inside the map.
+//! * Resolution. A pixel at distance d along the optical axis covers
+//!   d / focal world units; at the point, a texel covers its tangent width
+//!   times the point's light depth (a rectangle) or times the orthographic
+//!   scale (the sun). The map's texel is the median pixel footprint, so that
+//!   about one texel falls on a pixel, clamped to [MIN_SIDE, MAX_SIDE].
+
+use crate::error::Result;
+use crate::geom::extent::fit_extent;
+use crate::geom::light::MAX_EXTENT;
+use glam::DVec3;
+
+/// The nearest occluder depth the extent makes room for, as a fraction of
+/// the nearest visible point's depth.
+pub const NEAREST_OCCLUDER: f64 = 1.0 / 16.0;
+/// Sides of a fitted map.
+pub const MIN_SIDE: usize = 64;
+pub const MAX_SIDE: usize = 4096;
+
+/// Tangent half-extents holding every occluder texel that can shadow
+/// `points` (kernel light space, all in front of the light).
+pub fn focused_extent(
+    occluders: &[DVec3],
+    points: &[DVec3],
+    light_size: [f64; 2],
+) -> Result<[f64; 2]> {
+    let z_min = points.iter().fold(f64::INFINITY, |m, q| m.min(q.z));
+    let cut = z_min * NEAREST_OCCLUDER;
+    let occ: Vec<DVec3> = occluders
+        .iter()
+        .filter(|q| q.z > 0.0)
+        .map(|q| {
+            if q.z < cut {
+                DVec3::new(q.x / q.z * cut, q.y / q.z * cut, cut)
+            } else {
+                *q
+            }
+        })
+        .collect();
+    let mut e = fit_extent(&occ, points, light_size)?;
+    // The points themselves, with a texel's margin for the bias (mod.rs).
+    for q in points {
+        e[0] = e[0].max((q.x / q.z).abs());
+        e[1] = e[1].max((q.y / q.z).abs());
+    }
+    Ok(e.map(|t| (t * 1.01).min(MAX_EXTENT)))
+}
+
+/// Map sides (W, H) for `extent` whose texel matches `footprint` (the
+/// median tangent size of a pixel at its point).
+pub fn footprint_resolution(extent: [f64; 2], footprint: f64) -> (usize, usize) {
+    let side = |t: f64| {
+        let n = (2.0 * t / footprint).ceil();
+        if n.is_finite() {
+            (n as usize).clamp(MIN_SIDE, MAX_SIDE)
+        } else {
+            MAX_SIDE
+        }
+    };
+    let (w, h) = (side(extent[0]), side(extent[1]));
+    // Keep texels square-ish when one side hits a clamp: scale the other.
+    let aspect = extent[0] / extent[1];
+    if w == MAX_SIDE || h == MAX_SIDE {
+        if aspect >= 1.0 {
+            (
+                MAX_SIDE,
+                ((MAX_SIDE as f64 / aspect).ceil() as usize).clamp(MIN_SIDE, MAX_SIDE),
+            )
+        } else {
+            (
+                ((MAX_SIDE as f64 * aspect).ceil() as usize).clamp(MIN_SIDE, MAX_SIDE),
+                MAX_SIDE,
+            )
+        }
+    } else {
+        (w, h)
+    }
+}
+
+/// The median of `values` (NaN-free), or None when empty.
+pub fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let mid = values.len() / 2;
+    let (_, m, _) = values.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
+    Some(*m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolution_follows_the_footprint_and_its_clamps() {
+        assert_eq!(footprint_resolution([0.5, 0.25], 1.0 / 512.0), (512, 256));
+        assert_eq!(footprint_resolution([0.5, 0.5], 1.0), (MIN_SIDE, MIN_SIDE));
+        assert_eq!(
+            footprint_resolution([1.0, 0.5], 1e-9),
+            (MAX_SIDE, MAX_SIDE / 2)
+        );
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
+    }
+
+    #[test]
+    fn extent_holds_the_points_and_cuts_occluders_at_the_light() {
+        let pts = [DVec3::new(0.1, 0.0, 1.0), DVec3::new(-0.2, 0.1, 2.0)];
+        // An occluder touching the light's plane would need an unbounded map.
+        let occ = [DVec3::new(0.0, 0.0, 1e-12), DVec3::new(0.05, 0.05, 0.5)];
+        let e = focused_extent(&occ, &pts, [0.5, 0.5]).unwrap();
+        assert!(e[0] >= 0.1 && e[1] >= 0.05, "{e:?}");
+        assert!(e[0] < 0.25 * 16.0 + 0.2, "{e:?}");
+    }
+}

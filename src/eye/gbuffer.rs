@@ -1,0 +1,139 @@
+//! The eye view's G-buffer: the first surface each pixel sees.
+//!
+//! Camera rays through pixel centres (`geom/camera.rs`) are cast against a
+//! BVH of every mesh's triangles (closest hit), as Mitsuba's first hits
+//! are: the same pixel-centre rule, so the two agree pixel for pixel except
+//! where a pixel centre grazes an edge. The BVH holds triangles relative to
+//! the eye in f32; the hit distance is then recomputed in f64 against the
+//! hit triangle's plane, so positions keep f64 precision however far the
+//! scene is from the world origin.
+
+use crate::error::{Error, Result};
+use crate::geom::camera::Camera;
+use crate::geom::mesh::MeshRef;
+use crate::methods::exact::Bvh;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// What each pixel sees, row-major (H, W).
+#[derive(Debug, Clone)]
+pub struct GBuffer {
+    pub width: usize,
+    pub height: usize,
+    /// Distance along the optical axis; inf where no surface.
+    pub depth: Vec<f32>,
+    /// World position; NaN where no surface.
+    pub position: Vec<[f64; 3]>,
+    /// Unit geometric normal facing the camera; 0 where no surface.
+    pub normal: Vec<[f32; 3]>,
+    /// Index of the mesh hit, -1 where none.
+    pub mesh_id: Vec<i32>,
+}
+
+impl GBuffer {
+    pub fn len(&self) -> usize {
+        self.width * self.height
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Flat indices of the pixels that see a surface.
+    pub fn hits(&self) -> Vec<usize> {
+        (0..self.len()).filter(|&k| self.mesh_id[k] >= 0).collect()
+    }
+}
+
+/// Every mesh's triangles with the mesh each came from.
+pub struct SceneTriangles {
+    /// World-space corners (f64).
+    pub corners: Vec<[DVec3; 3]>,
+    pub mesh_of: Vec<i32>,
+}
+
+impl SceneTriangles {
+    /// Checks the meshes (named `meshes[k]`) and gathers their triangles.
+    pub fn new(meshes: &[MeshRef]) -> Result<SceneTriangles> {
+        if meshes.iter().all(|m| m.is_empty()) {
+            return Err(Error::invalid("meshes", "the scene has no triangles"));
+        }
+        if meshes.len() > i32::MAX as usize {
+            return Err(Error::invalid("meshes", "too many meshes"));
+        }
+        let mut corners = vec![];
+        let mut mesh_of = vec![];
+        for (k, m) in meshes.iter().enumerate() {
+            m.validate(&format!("meshes[{k}]"))?;
+            corners.extend(
+                m.faces
+                    .iter()
+                    .map(|f| f.map(|i| DVec3::from_array(m.vertices[i as usize]))),
+            );
+            mesh_of.extend(std::iter::repeat_n(k as i32, m.faces.len()));
+        }
+        Ok(SceneTriangles { corners, mesh_of })
+    }
+
+    /// Every corner, for bounds.
+    pub fn points(&self) -> impl Iterator<Item = DVec3> + Clone + '_ {
+        self.corners.iter().flat_map(|t| t.iter().copied())
+    }
+}
+
+/// Casts the camera's pixel-centre rays into the scene.
+pub fn first_hits(camera: &Camera, scene: &SceneTriangles) -> GBuffer {
+    let eye = camera.eye;
+    let bvh = Bvh::build(
+        scene
+            .corners
+            .par_iter()
+            .map(|t| t.map(|c| (c - eye).as_vec3()))
+            .collect(),
+    );
+    let (w, h) = (camera.width, camera.height);
+    let per_pixel: Vec<(f32, [f64; 3], [f32; 3], i32)> = (0..w * h)
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|k| {
+            let d = camera.pixel_direction(k % w, k / w);
+            let none = (f32::INFINITY, [f64::NAN; 3], [0.0; 3], -1);
+            let Some((_, tri)) = bvh.nearest(Vec3::ZERO, d.as_vec3(), f32::INFINITY) else {
+                return none;
+            };
+            let [a, b, c] = scene.corners[tri as usize];
+            let n = (b - a).cross(c - a);
+            let den = n.dot(d);
+            // The f32 hit refined in f64 on the triangle's plane.
+            let t = n.dot(a - eye) / den;
+            if !(t.is_finite() && t > 0.0) {
+                return none;
+            }
+            let p = eye + t * d;
+            let n = n.normalize();
+            let n = if den > 0.0 { -n } else { n };
+            let depth = (t * d.dot(camera.forward)) as f32;
+            (
+                depth,
+                p.to_array(),
+                n.as_vec3().to_array(),
+                scene.mesh_of[tri as usize],
+            )
+        })
+        .collect();
+    let mut g = GBuffer {
+        width: w,
+        height: h,
+        depth: Vec::with_capacity(w * h),
+        position: Vec::with_capacity(w * h),
+        normal: Vec::with_capacity(w * h),
+        mesh_id: Vec::with_capacity(w * h),
+    };
+    for (z, p, n, m) in per_pixel {
+        g.depth.push(z);
+        g.position.push(p);
+        g.normal.push(n);
+        g.mesh_id.push(m);
+    }
+    g
+}

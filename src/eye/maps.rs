@@ -1,0 +1,157 @@
+//! The map methods (`ssm`, `bitmask`, the hard shadow map) in the eye view:
+//! light-view occluder layers of every mesh, focused on the visible points
+//! (focus.rs), then each pixel shaded at its own surface point, as
+//! `ShadowMap.sample` shades points.
+//!
+//! Self-shadowing. Every mesh is an occluder, so the front layer holds the
+//! very surface a pixel sees. A texel of it back-projects, seen from a point
+//! a fraction of a texel away, onto much of the light: acne. Two biases,
+//! in texels of the map at the point (its tangent width times the point's
+//! light depth, or times the orthographic scale for the sun):
+//! * normal offset: the point moves `normal_offset` texels along its
+//!   geometric normal (toward the camera), off its own micro-patches;
+//! * depth bias: then `depth_bias` texels toward the light (along its ray
+//!   to the light's centre, or against the sun's direction): a texel of the
+//!   surface itself sits at most about half a texel times the slope nearer.
+//! Too little leaves acne on lit surfaces; too much lets light leak where
+//! an occluder touches a receiver (`docs/eye_view.md` measures both).
+
+use crate::error::Result;
+use crate::geom::light::MapGrid;
+use crate::geom::light_space::LightSpace;
+use crate::methods::{Input, LightPoint, Method, ShadowInputs};
+use crate::raster::Prepared;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// The biases of the map methods, in texels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bias {
+    pub normal_offset: f64,
+    pub depth_bias: f64,
+}
+
+/// The map methods' light-view maps of an image.
+#[derive(Debug, Clone)]
+pub struct EyeMaps {
+    pub grid: MapGrid,
+    /// Front first, back last, in the user's depth (planar from the light,
+    /// or orthographic from the sun's depth origin).
+    pub layers: Vec<Vec<f32>>,
+}
+
+/// A texel's world size at a point of kernel depth `z` on `grid`.
+fn texel_world(space: &LightSpace, grid: &MapGrid, z_world: f64) -> f64 {
+    // The coarser of the texel's two sides, in tangent units.
+    let t = (2.0 * grid.tx / grid.width as f64).max(2.0 * grid.ty / grid.height as f64);
+    match space {
+        LightSpace::Rect(_) => t * z_world,
+        LightSpace::Sun(s) => t * s.lateral_scale(),
+    }
+}
+
+/// The point moved by the biases, in world space.
+fn biased(space: &LightSpace, p: DVec3, n: DVec3, texel: f64, bias: &Bias) -> DVec3 {
+    let q = p + bias.normal_offset * texel * n;
+    let toward = match space {
+        LightSpace::Rect(l) => (l.center - q).normalize_or_zero(),
+        LightSpace::Sun(s) => -s.light.n,
+    };
+    q + bias.depth_bias * texel * toward
+}
+
+/// What the map methods need of the scene: its triangles in kernel light
+/// space (unit-scaled) as one indexed mesh.
+pub struct LightTriangles {
+    pub verts: Vec<DVec3>,
+    pub faces: Vec<[u32; 3]>,
+}
+
+/// Rasterizes the occluder layers on `grid` and shades `points` (world,
+/// with their camera-facing `normals`). Returns the visibility per point and
+/// the maps.
+#[allow(clippy::too_many_arguments)]
+pub fn shade(
+    space: &LightSpace,
+    unit: f64,
+    light_size: [f64; 2],
+    tris: &LightTriangles,
+    grid: MapGrid,
+    passes: u32,
+    method: Method,
+    points: &[[f64; 3]],
+    normals: &[[f32; 3]],
+    bias: &Bias,
+) -> Result<(Vec<f32>, EyeMaps)> {
+    let far = tris.verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
+    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
+    let prepared = Prepared::new(&grid, &tris.verts, &tris.faces, near);
+    let o = prepared.nearest_farthest(passes >= 2);
+    let mut layers = vec![o.nearest];
+    for k in 0..passes.saturating_sub(2) as usize {
+        let next = prepared.peel(&layers[k]);
+        layers.push(next);
+    }
+    if let Some(b) = o.farthest {
+        layers.push(b);
+    }
+    let lp: Vec<LightPoint> = points
+        .par_iter()
+        .zip(normals)
+        .map(|(p, n)| {
+            let p = DVec3::from_array(*p);
+            let n = glam::Vec3::from_array(*n).as_dvec3();
+            let z = space.to_light(p).z;
+            let texel = texel_world(space, &grid, z);
+            let q = space.to_light(biased(space, p, n, texel, bias)) / unit;
+            if !(q.z > 0.0) {
+                // At or behind the light's plane: the caller gives these 0.
+                return LightPoint {
+                    x: 0.0,
+                    y: 0.0,
+                    z: f32::NAN,
+                };
+            }
+            LightPoint {
+                x: (q.x / q.z) as f32,
+                y: (q.y / q.z) as f32,
+                z: q.z as f32,
+            }
+        })
+        .collect();
+    let inputs = ShadowInputs {
+        grid,
+        occluder_grid: grid,
+        light_size,
+        receiver: &[],
+        occluder_layers: layers.iter().map(|l| l.as_slice()).collect(),
+        occluder_triangles: None,
+    };
+    debug_assert!(method.reads_input(Input::OccluderLayers));
+    let valid: Vec<LightPoint> = lp
+        .iter()
+        .map(|p| {
+            if p.z.is_nan() {
+                LightPoint {
+                    x: 0.0,
+                    y: 0.0,
+                    z: f32::INFINITY,
+                }
+            } else {
+                *p
+            }
+        })
+        .collect();
+    let mut v = crate::pipeline::shade_points(method, &inputs, &valid);
+    for (v, p) in v.iter_mut().zip(&lp) {
+        if p.z.is_nan() {
+            *v = 0.0;
+        }
+    }
+    // The maps back in the user's depth.
+    for l in layers.iter_mut() {
+        l.par_iter_mut()
+            .for_each(|z| *z = space.user_depth(*z * unit as f32));
+    }
+    Ok((v, EyeMaps { grid, layers }))
+}

@@ -1,0 +1,130 @@
+//! The light space the kernels compute in, for either kind of light: a
+//! rectangle's perspective space (light.rs) or a directional light's
+//! orthographic one mapped onto it (sun.rs). The pipelines and both
+//! backends move geometry with this, never with a light directly.
+
+use crate::error::Result;
+use crate::geom::light::{is_point, RectLight};
+use crate::geom::sun::{DirectionalLight, SunSpace};
+use glam::DVec3;
+
+/// A light a user passes: a rectangle or the sun.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Light {
+    Rect(RectLight),
+    Sun(DirectionalLight),
+}
+
+impl From<RectLight> for Light {
+    fn from(l: RectLight) -> Light {
+        Light::Rect(l)
+    }
+}
+
+impl From<DirectionalLight> for Light {
+    fn from(l: DirectionalLight) -> Light {
+        Light::Sun(l)
+    }
+}
+
+impl Light {
+    /// The light's size in its kernel space (both 0: a hard light).
+    pub fn kernel_size(&self) -> [f64; 2] {
+        match self {
+            Light::Rect(l) => l.size,
+            Light::Sun(s) => s.kernel_size(),
+        }
+    }
+
+    /// Whether it casts hard shadows (a point light, a sun of size 0).
+    pub fn is_hard(&self) -> bool {
+        is_point(self.kernel_size())
+    }
+
+    /// Its light space for a scene made of `points` (the sun's depth origin
+    /// and range come from the scene; a rectangle's space is its own).
+    pub fn space_for(&self, points: impl Iterator<Item = DVec3> + Clone) -> Result<LightSpace> {
+        Ok(match self {
+            Light::Rect(l) => LightSpace::Rect(*l),
+            Light::Sun(s) => LightSpace::Sun(SunSpace::fit(*s, points)?),
+        })
+    }
+}
+
+/// The kernels' light space: perspective, relative to the light's centre,
+/// the light the rectangle `size` at depth 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightSpace {
+    Rect(RectLight),
+    Sun(SunSpace),
+}
+
+impl From<RectLight> for LightSpace {
+    fn from(l: RectLight) -> LightSpace {
+        LightSpace::Rect(l)
+    }
+}
+
+impl LightSpace {
+    /// World point -> kernel light space (X, Y, Z): tangent X/Z, depth Z.
+    #[inline]
+    pub fn to_light(&self, p: DVec3) -> DVec3 {
+        match self {
+            LightSpace::Rect(l) => l.to_light(p),
+            LightSpace::Sun(s) => s.to_kernel(p),
+        }
+    }
+
+    /// The world point at kernel depth `z` along tangent (x, y).
+    #[inline]
+    pub fn point_at(&self, x: f64, y: f64, z: f64) -> DVec3 {
+        match self {
+            LightSpace::Rect(l) => l.point_at(x, y, z),
+            LightSpace::Sun(s) => s.kernel_to_world(x, y, z),
+        }
+    }
+
+    /// The light's size in kernel units.
+    pub fn size(&self) -> [f64; 2] {
+        match self {
+            LightSpace::Rect(l) => l.size,
+            LightSpace::Sun(s) => s.light.kernel_size(),
+        }
+    }
+
+    /// A kernel depth as the user's maps hold it: planar depth from the
+    /// light's plane, or from the sun's depth origin.
+    #[inline]
+    pub fn user_depth(&self, z: f32) -> f32 {
+        match self {
+            LightSpace::Rect(_) => z,
+            LightSpace::Sun(s) => s.ortho_depth(z as f64) as f32,
+        }
+    }
+
+    /// A depth of the user's maps -> the kernels'.
+    #[inline]
+    pub fn kernel_depth(&self, z: f32) -> f32 {
+        match self {
+            LightSpace::Rect(_) => z,
+            LightSpace::Sun(s) => s.kernel_depth(z as f64) as f32,
+        }
+    }
+
+    /// Kernel tangent extents -> the user's: tangents, or world half-extents
+    /// of an orthographic map.
+    pub fn user_extent(&self, e: [f64; 2]) -> [f64; 2] {
+        match self {
+            LightSpace::Rect(_) => e,
+            LightSpace::Sun(s) => e.map(|t| t * s.lateral_scale()),
+        }
+    }
+
+    /// The user's extents -> kernel tangent extents.
+    pub fn kernel_extent(&self, e: [f64; 2]) -> [f64; 2] {
+        match self {
+            LightSpace::Rect(_) => e,
+            LightSpace::Sun(s) => e.map(|t| t / s.lateral_scale()),
+        }
+    }
+}

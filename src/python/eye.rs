@@ -1,0 +1,170 @@
+//! The eye view's entry point and its result: converts the arguments, runs
+//! `eye::render` without the GIL, moves the G-buffer and maps into arrays.
+
+use super::camera::PyCamera;
+use super::configs::{self, method_arg, Loose};
+use super::convert::{light_of, mesh, opt_int, opt_resolution, Light};
+use super::errors;
+use super::results::map;
+use crate::backend::{BackendChoice, Run};
+use crate::eye::{self, Bias, EyeCall, EyeImage};
+use crate::geom::light_space::LightSpace;
+use crate::geom::mesh::MeshRef;
+use crate::pipeline::Timings;
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A scene seen through a camera -> the visibility image and its G-buffer.
+#[pyfunction]
+#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn render<'py>(
+    py: Python<'py>,
+    meshes: Vec<(PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, u32>)>,
+    light: Light,
+    camera: &PyCamera,
+    method: &Bound<'py, PyAny>,
+    map_resolution: Option<Bound<'py, PyAny>>,
+    normal_offset: Option<f64>,
+    depth_bias: Option<f64>,
+    passes: Option<Bound<'py, PyAny>>,
+    samples: Option<Bound<'py, PyAny>>,
+    occluder_resolution: Option<Bound<'py, PyAny>>,
+    hierarchy: Option<Bound<'py, PyAny>>,
+    precision: Option<Bound<'py, PyAny>>,
+    backend: &str,
+    threads: Option<Bound<'py, PyAny>>,
+) -> PyResult<EyeResult> {
+    errors::guard(|| {
+        let light = light_of(light)?;
+        let loose = Loose {
+            passes,
+            samples,
+            occluder_resolution,
+            hierarchy,
+            precision,
+        };
+        let refs: Vec<MeshRef> = meshes
+            .iter()
+            .enumerate()
+            .map(|(k, (v, f))| mesh(&format!("meshes[{k}]"), v, f))
+            .collect::<PyResult<_>>()?;
+        let call = EyeCall {
+            meshes: &refs,
+            light: &light,
+            camera: &camera.0,
+            method: method_arg(method, &loose)?,
+            map_resolution: opt_resolution("map_resolution", map_resolution.as_ref())?,
+            bias: Bias::new(normal_offset, depth_bias)?,
+            backend: BackendChoice::parse(backend)?,
+            threads: opt_int("threads", threads.as_ref())?,
+        };
+        let run = py.detach(|| eye::render(&call))?;
+        EyeResult::new(py, run)
+    })
+}
+
+/// An image: visibility, G-buffer, the light-view maps, and what ran it.
+#[pyclass(frozen, module = "softshadow._core", name = "EyeResult")]
+pub struct EyeResult {
+    /// (H, W) float32; 1 where no surface.
+    #[pyo3(get)]
+    visibility: Py<PyAny>,
+    /// (H, W) float32 distance along the optical axis; inf where no surface.
+    #[pyo3(get)]
+    depth: Py<PyAny>,
+    /// (H, W, 3) float64 world position; NaN where no surface.
+    #[pyo3(get)]
+    position: Py<PyAny>,
+    /// (H, W, 3) float32 unit geometric normal facing the camera.
+    #[pyo3(get)]
+    normal: Py<PyAny>,
+    /// (H, W) int32 mesh index, -1 where no surface.
+    #[pyo3(get)]
+    mesh_id: Py<PyAny>,
+    /// The map methods' occluder layers, front first (empty for exact).
+    #[pyo3(get)]
+    shadow_maps: Vec<Py<PyAny>>,
+    /// Their half-extents: tangents, or world units for the sun.
+    #[pyo3(get)]
+    map_extent: Option<(f64, f64)>,
+    /// For the sun: the maps' depth origin and depth range.
+    #[pyo3(get)]
+    depth_origin: Option<(f64, f64, f64)>,
+    #[pyo3(get)]
+    depth_range: Option<f64>,
+    timings: Timings,
+    #[pyo3(get)]
+    method: Py<PyAny>,
+    #[pyo3(get)]
+    backend: &'static str,
+    #[pyo3(get)]
+    threads: usize,
+}
+
+#[pymethods]
+impl EyeResult {
+    /// Seconds per stage, in the order they ran.
+    #[getter]
+    fn timings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.timings {
+            d.set_item(*k, *v)?;
+        }
+        Ok(d)
+    }
+}
+
+fn image3<T: numpy::Element>(py: Python<'_>, h: usize, w: usize, v: Vec<T>) -> PyResult<Py<PyAny>> {
+    let a =
+        Array3::from_shape_vec((h, w, 3), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any().unbind())
+}
+
+fn image2<T: numpy::Element>(py: Python<'_>, h: usize, w: usize, v: Vec<T>) -> PyResult<Py<PyAny>> {
+    let a = Array2::from_shape_vec((h, w), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any().unbind())
+}
+
+impl EyeResult {
+    fn new(py: Python<'_>, run: Run<EyeImage>) -> PyResult<Self> {
+        let img = run.output;
+        let g = img.gbuffer;
+        let (w, h) = (g.width, g.height);
+        let (map_extent, shadow_maps) = match img.maps {
+            Some(m) => {
+                let e = img.light_space.user_extent([m.grid.tx, m.grid.ty]);
+                let grid = m.grid;
+                let layers = m
+                    .layers
+                    .into_iter()
+                    .map(|l| map(py, &grid, l))
+                    .collect::<PyResult<_>>()?;
+                (Some((e[0], e[1])), layers)
+            }
+            None => (None, vec![]),
+        };
+        let (depth_origin, depth_range) = match img.light_space {
+            LightSpace::Sun(s) => (Some(s.origin.into()), Some(s.depth_range)),
+            LightSpace::Rect(_) => (None, None),
+        };
+        Ok(EyeResult {
+            visibility: image2(py, h, w, img.visibility)?,
+            depth: image2(py, h, w, g.depth)?,
+            position: image3(py, h, w, g.position.into_iter().flatten().collect())?,
+            normal: image3(py, h, w, g.normal.into_iter().flatten().collect())?,
+            mesh_id: image2(py, h, w, g.mesh_id)?,
+            shadow_maps,
+            map_extent,
+            depth_origin,
+            depth_range,
+            timings: img.timings,
+            method: configs::to_py(py, &run.method)?,
+            backend: run.backend.name(),
+            threads: run.threads,
+        })
+    }
+}
