@@ -113,14 +113,16 @@ fn default_light() -> RectLight {
 struct Scene {
     occluders: Mesh,
     receivers: Mesh,
-    light: RectLight,
+    light: softshadow::Light,
+    rect: RectLight,
 }
 
 fn scene() -> Scene {
     Scene {
         occluders: sphere([0.0, 1.0, 0.0], 0.3, 48),
         receivers: floor(),
-        light: default_light(),
+        light: softshadow::Light::Rect(default_light()),
+        rect: default_light(),
     }
 }
 
@@ -202,12 +204,12 @@ fn bench_kernels(c: &mut Criterion) {
         maps.occluder_front.as_deref().unwrap(),
         maps.occluder_back.as_deref().unwrap(),
     );
-    let occ_ls = s.occluders.as_ref().to_light_space(&s.light);
+    let occ_ls = s.occluders.as_ref().to_light_space(&s.rect.into());
     let triangles = light_space_triangles(&occ_ls, &s.occluders.faces);
     let inputs = ShadowInputs {
         grid: maps.grid,
         occluder_grid: maps.occluder_grid,
-        light_size: s.light.size,
+        light_size: s.rect.size,
         receiver: &maps.receiver,
         occluder_layers: vec![front, back],
         occluder_triangles: Some(&triangles),
@@ -257,7 +259,7 @@ fn bench_kernels(c: &mut Criterion) {
 fn bench_raster(c: &mut Criterion) {
     let s = scene();
     let grid = maps(&s).occluder_grid;
-    let verts = s.occluders.as_ref().to_light_space(&s.light);
+    let verts = s.occluders.as_ref().to_light_space(&s.rect.into());
     let faces = &s.occluders.faces;
     let d = rasterize(&grid, &verts, faces, 1e-9, true);
     assert!(d.nearest.iter().any(|z| z.is_finite()));

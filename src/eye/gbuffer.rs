@@ -81,24 +81,55 @@ impl SceneTriangles {
     }
 }
 
-/// Casts the camera's pixel-centre rays into the scene.
-pub fn first_hits(camera: &Camera, scene: &SceneTriangles) -> GBuffer {
+/// The BVH the camera rays are cast against: every triangle relative to
+/// the eye, in f32 (the GPU twin traverses the same nodes).
+pub fn camera_bvh(camera: &Camera, scene: &SceneTriangles) -> Bvh {
     let eye = camera.eye;
-    let bvh = Bvh::build(
+    Bvh::build(
         scene
             .corners
             .par_iter()
             .map(|t| t.map(|c| (c - eye).as_vec3()))
             .collect(),
-    );
-    let (w, h) = (camera.width, camera.height);
-    let per_pixel: Vec<(f32, [f64; 3], [f32; 3], i32)> = (0..w * h)
+    )
+}
+
+/// The f32 direction of pixel k's ray, as both backends cast it.
+#[inline]
+pub fn pixel_ray(camera: &Camera, k: usize) -> Vec3 {
+    camera
+        .pixel_direction(k % camera.width, k / camera.width)
+        .as_vec3()
+}
+
+/// Casts the camera's pixel-centre rays into the scene.
+pub fn first_hits(camera: &Camera, scene: &SceneTriangles) -> GBuffer {
+    let bvh = camera_bvh(camera, scene);
+    let n = camera.width * camera.height;
+    let hit: Vec<Option<u32>> = (0..n)
         .into_par_iter()
         .with_min_len(256)
         .map(|k| {
+            bvh.nearest(Vec3::ZERO, pixel_ray(camera, k), f32::INFINITY)
+                .map(|(_, tri)| tri)
+        })
+        .collect();
+    from_hits(camera, scene, &hit)
+}
+
+/// The G-buffer from the triangle each pixel's ray hit first (`None`: no
+/// surface): position, normal and depth in f64 on the triangle's plane.
+pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -> GBuffer {
+    let eye = camera.eye;
+    let (w, h) = (camera.width, camera.height);
+    let per_pixel: Vec<(f32, [f64; 3], [f32; 3], i32)> = hit
+        .par_iter()
+        .enumerate()
+        .with_min_len(256)
+        .map(|(k, tri)| {
             let d = camera.pixel_direction(k % w, k / w);
             let none = (f32::INFINITY, [f64::NAN; 3], [0.0; 3], -1);
-            let Some((_, tri)) = bvh.nearest(Vec3::ZERO, d.as_vec3(), f32::INFINITY) else {
+            let Some(tri) = *tri else {
                 return none;
             };
             let [a, b, c] = scene.corners[tri as usize];

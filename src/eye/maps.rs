@@ -13,8 +13,9 @@
 //! * depth bias: then `depth_bias` texels toward the light (along its ray
 //!   to the light's centre, or against the sun's direction): a texel of the
 //!   surface itself sits at most about half a texel times the slope nearer.
+//!
 //! Too little leaves acne on lit surfaces; too much lets light leak where
-//! an occluder touches a receiver (`docs/eye_view.md` measures both).
+//! an occluder touches a receiver (`docs/benchmarks/bias.md` measures both).
 
 use crate::error::Result;
 use crate::geom::light::MapGrid;
@@ -67,6 +68,53 @@ pub struct LightTriangles {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// The occluder layers of every mesh on `grid` (kernel depths, unit-scaled),
+/// front first, the peeled ones, back last.
+pub fn occluder_layers(grid: &MapGrid, tris: &LightTriangles, passes: u32) -> Vec<Vec<f32>> {
+    let far = tris.verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
+    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
+    let prepared = Prepared::new(grid, &tris.verts, &tris.faces, near);
+    let o = prepared.nearest_farthest(passes >= 2);
+    let mut layers = vec![o.nearest];
+    for k in 0..passes.saturating_sub(2) as usize {
+        let next = prepared.peel(&layers[k]);
+        layers.push(next);
+    }
+    if let Some(b) = o.farthest {
+        layers.push(b);
+    }
+    layers
+}
+
+/// The points (world, with their camera-facing `normals`) moved by the
+/// biases, in kernel light space (unit-scaled); `None` for a point the
+/// biases move to or behind the light's plane.
+pub fn biased_points(
+    space: &LightSpace,
+    unit: f64,
+    grid: &MapGrid,
+    points: &[[f64; 3]],
+    normals: &[[f32; 3]],
+    bias: &Bias,
+) -> Vec<Option<LightPoint>> {
+    points
+        .par_iter()
+        .zip(normals)
+        .map(|(p, n)| {
+            let p = DVec3::from_array(*p);
+            let n = glam::Vec3::from_array(*n).as_dvec3();
+            let z = space.to_light(p).z;
+            let texel = texel_world(space, grid, z);
+            let q = space.to_light(biased(space, p, n, texel, bias)) / unit;
+            (q.z > 0.0).then(|| LightPoint {
+                x: (q.x / q.z) as f32,
+                y: (q.y / q.z) as f32,
+                z: q.z as f32,
+            })
+        })
+        .collect()
+}
+
 /// Rasterizes the occluder layers on `grid` and shades `points` (world,
 /// with their camera-facing `normals`). Returns the visibility per point and
 /// the maps.
@@ -83,42 +131,8 @@ pub fn shade(
     normals: &[[f32; 3]],
     bias: &Bias,
 ) -> Result<(Vec<f32>, EyeMaps)> {
-    let far = tris.verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
-    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
-    let prepared = Prepared::new(&grid, &tris.verts, &tris.faces, near);
-    let o = prepared.nearest_farthest(passes >= 2);
-    let mut layers = vec![o.nearest];
-    for k in 0..passes.saturating_sub(2) as usize {
-        let next = prepared.peel(&layers[k]);
-        layers.push(next);
-    }
-    if let Some(b) = o.farthest {
-        layers.push(b);
-    }
-    let lp: Vec<LightPoint> = points
-        .par_iter()
-        .zip(normals)
-        .map(|(p, n)| {
-            let p = DVec3::from_array(*p);
-            let n = glam::Vec3::from_array(*n).as_dvec3();
-            let z = space.to_light(p).z;
-            let texel = texel_world(space, &grid, z);
-            let q = space.to_light(biased(space, p, n, texel, bias)) / unit;
-            if !(q.z > 0.0) {
-                // At or behind the light's plane: the caller gives these 0.
-                return LightPoint {
-                    x: 0.0,
-                    y: 0.0,
-                    z: f32::NAN,
-                };
-            }
-            LightPoint {
-                x: (q.x / q.z) as f32,
-                y: (q.y / q.z) as f32,
-                z: q.z as f32,
-            }
-        })
-        .collect();
+    let mut layers = occluder_layers(&grid, tris, passes);
+    let lp = biased_points(space, unit, &grid, points, normals, bias);
     let inputs = ShadowInputs {
         grid,
         occluder_grid: grid,
@@ -128,23 +142,16 @@ pub fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    let valid: Vec<LightPoint> = lp
-        .iter()
-        .map(|p| {
-            if p.z.is_nan() {
-                LightPoint {
-                    x: 0.0,
-                    y: 0.0,
-                    z: f32::INFINITY,
-                }
-            } else {
-                *p
-            }
-        })
-        .collect();
+    // Points the biases moved behind the light are shaded as empty, then 0.
+    let empty = LightPoint {
+        x: 0.0,
+        y: 0.0,
+        z: f32::INFINITY,
+    };
+    let valid: Vec<LightPoint> = lp.iter().map(|p| p.unwrap_or(empty)).collect();
     let mut v = crate::pipeline::shade_points(method, &inputs, &valid);
     for (v, p) in v.iter_mut().zip(&lp) {
-        if p.z.is_nan() {
+        if p.is_none() {
             *v = 0.0;
         }
     }

@@ -10,9 +10,10 @@ mod from_meshes;
 mod points;
 
 // The GPU pipelines start from the same framing and checks.
+pub(crate) use frame::Stopwatch;
 pub use frame::Timings;
 #[cfg(feature = "gpu")]
-pub(crate) use frame::{frame_scene, FramedScene, Stopwatch};
+pub(crate) use frame::{frame_scene, FramedScene};
 pub use from_depth::{check_depth, from_depth};
 #[cfg(feature = "gpu")]
 pub(crate) use from_depth::{check_depth_inputs, DepthInUnit};
