@@ -11,6 +11,7 @@ use crate::error::{Error, Result};
 use crate::geom::light::{check_light_size, is_point, MapGrid};
 use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::mesh::MeshRef;
+use crate::geom::sun::{DirectionalLight, SunSpace};
 use crate::methods::config::{check_resolution, CallContext};
 use crate::methods::MethodConfig;
 use crate::pipeline::{self, MapSettings, ShadowResult, Timings};
@@ -88,13 +89,14 @@ impl BackendChoice {
     }
 }
 
+/// Whether a real (non-software) GPU adapter opens: what "auto" needs.
 #[cfg(feature = "gpu")]
-fn real_gpu() -> bool {
+pub(crate) fn real_gpu() -> bool {
     crate::gpu::info().is_ok_and(|i| !i.software)
 }
 
 #[cfg(not(feature = "gpu"))]
-fn real_gpu() -> bool {
+pub(crate) fn real_gpu() -> bool {
     false
 }
 
@@ -192,7 +194,13 @@ pub struct DepthCall<'a> {
     pub grid: MapGrid,
     /// The occluder maps' grid (same extent, their own resolution).
     pub occluder_grid: MapGrid,
+    /// A rectangle's (width, height) in the depths' unit; ignored for
+    /// orthographic maps.
     pub light_size: [f64; 2],
+    /// `Some(angular_size)`: orthographic maps of a directional light of
+    /// that angular size (degrees): depths from the depth origin, extents
+    /// in world units (see `geom/sun.rs`).
+    pub sun: Option<[f64; 2]>,
     pub front: &'a [f32],
     pub back: Option<&'a [f32]>,
     pub receiver: &'a [f32],
@@ -201,28 +209,107 @@ pub struct DepthCall<'a> {
     pub threads: Option<i64>,
 }
 
+/// Orthographic depth maps as the kernels read them: the sun's space with
+/// the depth origin at depth 0 and the maps' farthest depth as its range,
+/// the maps in kernel depths, the grids in kernel tangents, the light's
+/// kernel size. Depths must be finite and >= 0, or +inf where empty.
+#[allow(clippy::type_complexity)]
+pub fn orthographic_maps(
+    call: &DepthCall,
+    angular_size: [f64; 2],
+) -> Result<(SunSpace, MapGrid, MapGrid, [f64; 2], Vec<Vec<f32>>)> {
+    let sun = DirectionalLight::new([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], angular_size)?;
+    let maps: Vec<(&str, &[f32])> = [
+        ("occluder_depth", call.front),
+        ("receiver_depth", call.receiver),
+    ]
+    .into_iter()
+    .chain(call.back.map(|b| ("occluder_depth_back", b)))
+    .collect();
+    let mut range = 0f64;
+    for (arg, m) in &maps {
+        if let Some(k) = m.iter().position(|z| !(*z >= 0.0)) {
+            return Err(Error::invalid(
+                *arg,
+                format!(
+                    "orthographic depths must be >= 0 (from the depth origin) or +inf where \
+                     empty; texel {k} holds {}",
+                    m[k]
+                ),
+            ));
+        }
+        range = range.max(pipeline::farthest_finite(m));
+    }
+    let space = SunSpace::new(sun, glam::DVec3::ZERO, range);
+    let kernel: Vec<Vec<f32>> = maps
+        .iter()
+        .map(|(_, m)| {
+            m.iter()
+                .map(|&z| space.kernel_depth(z as f64) as f32)
+                .collect()
+        })
+        .collect();
+    let s = LightSpace::Sun(space);
+    let grid = |g: &MapGrid| MapGrid::new(g.width, g.height, s.kernel_extent([g.tx, g.ty]));
+    Ok((
+        space,
+        grid(&call.grid)?,
+        grid(&call.occluder_grid)?,
+        sun.kernel_size(),
+        kernel,
+    ))
+}
+
+/// What shading depth maps returns.
+#[derive(Debug, Clone)]
+pub struct DepthOutput {
+    pub visibility: Vec<f32>,
+    pub timings: Timings,
+    /// For orthographic maps: the depth range their kernel space used
+    /// (`ShadowMap.sample` rebuilds the space from it).
+    pub depth_range: Option<f64>,
+}
+
 /// Depth maps -> visibility, on the chosen backend.
-pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<(Vec<f32>, Timings)>> {
+pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
     let cap = threads::resolve(call.threads)?;
-    let light_size = check_light_size("light_size", call.light_size)?;
-    let layers = 1 + call.back.is_some() as u32;
-    let og = &call.occluder_grid;
+    // Orthographic maps: the same shading on their kernel-space twins.
+    let ortho = call.sun.map(|a| orthographic_maps(call, a)).transpose()?;
+    let (grid, occluder_grid, light_size) = match &ortho {
+        Some((_, g, og, size, _)) => (*g, *og, *size),
+        None => (
+            call.grid,
+            call.occluder_grid,
+            check_light_size("light_size", call.light_size)?,
+        ),
+    };
+    let (front, receiver, back) = match &ortho {
+        Some((.., m)) => (&m[0][..], &m[1][..], m.get(2).map(|b| &b[..])),
+        None => (call.front, call.receiver, call.back),
+    };
+    let layers = 1 + back.is_some() as u32;
+    let og = &occluder_grid;
     let ctx = CallContext {
         backend: Backend::Cpu,
-        resolution: (call.grid.width, call.grid.height),
+        resolution: (grid.width, grid.height),
         depth_layers: Some((layers, (og.width, og.height))),
     };
     let backend = call.backend.pick(&call.method, ctx, light_size);
     let method = call.method.resolve(&CallContext { backend, ..ctx })?;
     let kernel = method.kernel();
-    let (g, f, b, r) = (&call.grid, call.front, call.back, call.receiver);
-    let (output, threads) = threads::run_capped(cap, || match backend {
+    let (g, f, b, r) = (&grid, front, back, receiver);
+    let ((visibility, timings), threads) = threads::run_capped(cap, || match backend {
         Backend::Cpu => pipeline::from_depth(g, og, light_size, f, b, r, kernel),
         #[cfg(feature = "gpu")]
         Backend::Gpu => crate::gpu::from_depth(g, og, light_size, f, b, r, kernel),
         #[cfg(not(feature = "gpu"))]
         Backend::Gpu => Err(not_built()),
     })?;
+    let output = DepthOutput {
+        visibility,
+        timings,
+        depth_range: ortho.map(|(space, ..)| space.depth_range),
+    };
     Ok(Run {
         output,
         method,

@@ -307,6 +307,8 @@ class DepthShadowResult:
     @property
     def visibility(self) -> npt.NDArray[np.float32]: ...
     @property
+    def depth_range(self) -> float | None: ...
+    @property
     def timings(self) -> dict[str, float]: ...
     @property
     def method(self) -> Ssm | Bitmask | Exact: ...
@@ -352,10 +354,11 @@ def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],
     occluder_depth_back: npt.NDArray[np.float32] | None,
     receiver_depth: npt.NDArray[np.float32],
-    light_size: tuple[float, float],
+    light_size: tuple[float, float] | None,
     extent: tuple[float, float],
     method: _MethodArg,
     *,
+    angular_size: tuple[float, float] | None = None,
     passes: int | None = None,
     samples: int | None = None,
     occluder_resolution: _Resolution | None = None,

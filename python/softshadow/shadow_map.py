@@ -308,8 +308,9 @@ def soft_shadow_map_from_depth(
     occluder_depth: np.ndarray,
     receiver_depth: np.ndarray,
     *,
-    light_size: Any,
+    light_size: Any = None,
     extent: Any,
+    angular_size: Any = None,
     occluder_depth_back: np.ndarray | None = None,
     method: str | MethodConfig = "ssm",
     backend: str = "cpu",
@@ -341,11 +342,22 @@ def soft_shadow_map_from_depth(
     and complex arrays raise TypeError. ``light_size`` must lie within
     about [1e-30, 1e30] times the receivers' depth, or be (0, 0) for a
     point light (hard shadows).
+
+    Orthographic maps of a directional light: pass ``angular_size`` (full
+    angles in degrees, see :class:`DirectionalLight`) instead of
+    ``light_size``; depths are then distances >= 0 from the depth origin
+    along the light's direction (+inf where empty) and ``extent`` the maps'
+    half-extents in world units. The result's ``light`` is the directional
+    light of that size travelling along +z (up +y), its depth origin at the
+    world origin, so ``sample`` takes points in that frame.
     """
     rec = check.depth_map("receiver_depth", receiver_depth)
     front = check.depth_map("occluder_depth", occluder_depth)
     back = None if occluder_depth_back is None else check.depth_map("occluder_depth_back", occluder_depth_back)
-    size = check.pair("light_size", light_size)
+    if (light_size is None) == (angular_size is None):
+        raise TypeError("light_size: pass either light_size (a rectangle's) or angular_size (a directional light's)")
+    size = None if light_size is None else check.pair("light_size", light_size)
+    angles = None if angular_size is None else check.pair("angular_size", angular_size)
     ext = check.pair("extent", extent)
     r = _core.shadow_map_from_depth(
         front,
@@ -354,6 +366,7 @@ def soft_shadow_map_from_depth(
         size,
         ext,
         method,
+        angular_size=angles,
         passes=passes,
         samples=samples,
         occluder_resolution=occluder_resolution,
@@ -367,11 +380,17 @@ def soft_shadow_map_from_depth(
         receiver_depth=rec,
         occluder_depth=front,
         occluder_depth_back=back,
-        light=RectLight.canonical(size),
+        light=(
+            RectLight.canonical(size)
+            if size is not None
+            else DirectionalLight(direction=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0), angular_size=angles)
+        ),
         extent=ext,
         method=r.method,
         extent_fitted=False,
         timings=dict(r.timings),
         backend=r.backend,
         threads=r.threads,
+        depth_origin=None if size is not None else (0.0, 0.0, 0.0),
+        depth_range=r.depth_range,
     )

@@ -15,7 +15,10 @@
 //!   d / focal world units; at the point, a texel covers its tangent width
 //!   times the point's light depth (a rectangle) or times the orthographic
 //!   scale (the sun). The map's texel is the median pixel footprint, so that
-//!   about one texel falls on a pixel, clamped to [MIN_SIDE, MAX_SIDE].
+//!   about one texel falls on a pixel, but no finer than the map's area
+//!   shared among TEXELS_PER_PIXEL texels per visible pixel (the map also
+//!   covers what can shadow the visible points, which no pixel shows), the
+//!   sides clamped to [MIN_SIDE, MAX_SIDE].
 
 use crate::error::Result;
 use crate::geom::extent::fit_extent;
@@ -56,6 +59,17 @@ pub fn focused_extent(
         e[1] = e[1].max((q.y / q.z).abs());
     }
     Ok(e.map(|t| (t * 1.01).min(MAX_EXTENT)))
+}
+
+/// At most TEXELS_PER_PIXEL texels per visible pixel: a footprint no
+/// finer than the map's area shared out among them.
+pub const TEXELS_PER_PIXEL: f64 = 2.0;
+
+/// `footprint` coarsened so that the map holds at most TEXELS_PER_PIXEL
+/// texels per visible pixel (`pixels` of them).
+pub fn capped_footprint(extent: [f64; 2], footprint: f64, pixels: usize) -> f64 {
+    let area = 4.0 * extent[0] * extent[1];
+    footprint.max((area / (TEXELS_PER_PIXEL * pixels.max(1) as f64)).sqrt())
 }
 
 /// Map sides (W, H) for `extent` whose texel matches `footprint` (the

@@ -10,9 +10,15 @@
 //! light depth, or times the orthographic scale for the sun):
 //! * normal offset: the point moves `normal_offset` texels along its
 //!   geometric normal (toward the camera), off its own micro-patches;
-//! * depth bias: then `depth_bias` texels toward the light (along its ray
-//!   to the light's centre, or against the sun's direction): a texel of the
-//!   surface itself sits at most about half a texel times the slope nearer.
+//! * depth bias: then `depth_bias (1 + tan θ)` texels toward the light
+//!   (along its ray to the light's centre, or against the sun's direction;
+//!   θ the angle between the normal and that ray, tan θ capped at 8): a
+//!   texel of the surface itself sits up to half a texel times the slope
+//!   nearer the light than the point.
+//!
+//! The light behind the point's tangent plane is hidden by the surface
+//! itself, which the biases remove from the maps: tangent_plane.rs bounds
+//! the visibility by the part of the light in front of it.
 //!
 //! Too little leaves acne on lit surfaces; too much lets light leak where
 //! an occluder touches a receiver (`docs/benchmarks/bias.md` measures both).
@@ -41,6 +47,9 @@ pub struct EyeMaps {
     pub layers: Vec<Vec<f32>>,
 }
 
+/// The largest slope the depth bias scales with (about 83 degrees).
+const MAX_SLOPE: f64 = 8.0;
+
 /// A texel's world size at a point of kernel depth `z` on `grid`.
 fn texel_world(space: &LightSpace, grid: &MapGrid, z_world: f64) -> f64 {
     // The coarser of the texel's two sides, in tangent units.
@@ -53,12 +62,16 @@ fn texel_world(space: &LightSpace, grid: &MapGrid, z_world: f64) -> f64 {
 
 /// The point moved by the biases, in world space.
 fn biased(space: &LightSpace, p: DVec3, n: DVec3, texel: f64, bias: &Bias) -> DVec3 {
-    let q = p + bias.normal_offset * texel * n;
     let toward = match space {
-        LightSpace::Rect(l) => (l.center - q).normalize_or_zero(),
+        LightSpace::Rect(l) => (l.center - p).normalize_or_zero(),
         LightSpace::Sun(s) => -s.light.n,
     };
-    q + bias.depth_bias * texel * toward
+    // Slope-scaled: a surface at angle θ to the light rises tan θ per
+    // texel across it (capped where it turns edge-on).
+    let c = n.dot(toward).abs().max(1e-3);
+    let tan = ((1.0 - c * c).max(0.0).sqrt() / c).min(MAX_SLOPE);
+    let q = p + bias.normal_offset * texel * n;
+    q + (1.0 + tan) * bias.depth_bias * texel * toward
 }
 
 /// What the map methods need of the scene: its triangles in kernel light
@@ -155,6 +168,7 @@ pub fn shade(
             *v = 0.0;
         }
     }
+    super::tangent_plane::bound(&mut v, space, unit, light_size, points, normals);
     // The maps back in the user's depth.
     for l in layers.iter_mut() {
         l.par_iter_mut()

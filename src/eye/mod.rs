@@ -8,11 +8,17 @@
 //! visible points (focus.rs) and shade each pixel at its own point and
 //! depth with the biases of maps.rs (`extent`, `raster_occluders`,
 //! `shadow`). Visibility is 1 where a pixel sees no surface.
+//!
+//! Both backends run the same stages: `render_cpu` here, and its GPU twin
+//! `crate::gpu::render_gpu` (src/gpu/eye.rs), which casts the first hits,
+//! the shadow rays, the occluder layers and the gather on the device and
+//! shares the framing below (`frame`, `map_grid`, ...) with the CPU.
 
 pub mod focus;
 pub mod gbuffer;
 pub mod maps;
 pub mod rays;
+pub mod tangent_plane;
 
 pub use gbuffer::GBuffer;
 pub use maps::{Bias, EyeMaps};
@@ -40,7 +46,7 @@ use rayon::prelude::*;
 /// further texel adds light leaking where occluders meet receivers.
 pub const DEFAULT_BIAS: Bias = Bias {
     normal_offset: 0.5,
-    depth_bias: 0.5,
+    depth_bias: 1.0,
 };
 /// The largest bias accepted, in texels.
 pub const MAX_BIAS: f64 = 64.0;
@@ -90,22 +96,41 @@ pub struct EyeImage {
     pub timings: Timings,
 }
 
-/// Renders the visibility image of `call` (the CPU: the eye view has no
-/// GPU pipeline yet).
+/// Renders the visibility image of `call` on the backend it asks for:
+/// "auto" takes the GPU where `crate::backend` would (a real, non-software
+/// adapter, a config that resolves there) and the light is not hard (the
+/// GPU has no hard shadow map kernel).
 pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
     let cap = threads::resolve(call.threads)?;
     if let Some(r) = call.map_resolution {
         check_resolution("map_resolution", r)?;
     }
-    let backend =
-        match call.backend {
-            BackendChoice::Cpu | BackendChoice::Auto => Backend::Cpu,
-            BackendChoice::Gpu => return Err(Error::invalid(
-                "backend",
-                "the eye view (render) runs on the CPU only in this version; use backend=\"cpu\"",
-            )),
-        };
-    let ((image, method), threads) = threads::run_capped(cap, || render_cpu(call))?;
+    let backend = match call.backend {
+        BackendChoice::Cpu => Backend::Cpu,
+        BackendChoice::Gpu => Backend::Gpu,
+        BackendChoice::Auto => {
+            let gpu = CallContext {
+                backend: Backend::Gpu,
+                resolution: (call.camera.width, call.camera.height),
+                depth_layers: None,
+            };
+            if crate::backend::real_gpu()
+                && !call.light.is_hard()
+                && call.method.resolve(&gpu).is_ok()
+            {
+                Backend::Gpu
+            } else {
+                Backend::Cpu
+            }
+        }
+    };
+    let ((image, method), threads) = threads::run_capped(cap, || match backend {
+        Backend::Cpu => render_cpu(call),
+        #[cfg(feature = "gpu")]
+        Backend::Gpu => crate::gpu::render_gpu(call),
+        #[cfg(not(feature = "gpu"))]
+        Backend::Gpu => Err(crate::backend::not_built()),
+    })?;
     Ok(Run {
         output: image,
         method,
@@ -114,11 +139,28 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
     })
 }
 
-fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
-    let mut sw = Stopwatch::new();
-    let scene = SceneTriangles::new(call.meshes)?;
-    let g = gbuffer::first_hits(call.camera, &scene);
-    sw.lap("first_hits");
+/// What both backends derive from the G-buffer before shading: the visible
+/// points, the light space fitted to them, the depth unit and every
+/// triangle's corners in kernel light space.
+pub(crate) struct Framed {
+    /// Flat indices of the pixels that see a surface, and their world points
+    /// and camera-facing normals.
+    pub hits: Vec<usize>,
+    pub points: Vec<[f64; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub space: LightSpace,
+    /// The visible points in light space (not unit-scaled).
+    pub pts_ls: Vec<DVec3>,
+    /// The kernels' depth unit, and the light's size in it.
+    pub unit: f64,
+    pub light_size: [f64; 2],
+    /// Every triangle's corners, kernel light space, unit-scaled (3 a triangle).
+    pub corners: Vec<DVec3>,
+}
+
+/// The light space, depth unit and light-space triangles of an image whose
+/// G-buffer is `g`.
+pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Framed> {
     let hits = g.hits();
     let points: Vec<[f64; 3]> = hits.iter().map(|&k| g.position[k]).collect();
     let normals: Vec<[f32; 3]> = hits.iter().map(|&k| g.normal[k]).collect();
@@ -151,114 +193,173 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         .par_iter()
         .flat_map_iter(|t| t.map(|c| space.to_light(c) / unit))
         .collect();
-    sw.lap("transform");
+    Ok(Framed {
+        hits,
+        points,
+        normals,
+        space,
+        pts_ls,
+        unit,
+        light_size,
+        corners,
+    })
+}
 
-    let mut visibility = vec![1f32; g.len()];
-    let mut maps = None;
-    let method;
-    // A hard light needs one ray: every sample would be the same.
-    if call.method.kernel().reads_input(Input::OccluderTriangles) {
-        method = call.method.resolve(&CallContext {
-            backend: Backend::Cpu,
-            resolution: (call.camera.width, call.camera.height),
-            depth_layers: None,
-        })?;
-        let samples = match method.kernel() {
-            crate::methods::Method::Exact { samples } if !call.light.is_hard() => samples,
-            _ => 1,
-        };
-        let tris: Vec<[Vec3; 3]> = corners
-            .par_chunks(3)
-            .map(|c| [c[0].as_vec3(), c[1].as_vec3(), c[2].as_vec3()])
-            .collect();
-        sw.lap("triangles");
-        let v = rays::visibility(&space, unit, light_size, tris, &points, &normals, samples);
-        for (&k, v) in hits.iter().zip(v) {
-            visibility[k] = v;
-        }
-        sw.lap("shadow");
-    } else if !points.is_empty() {
-        let in_front: Vec<DVec3> = pts_ls.iter().copied().filter(|q| q.z > 0.0).collect();
-        let pts_unit: Vec<DVec3> = in_front.iter().map(|q| *q / unit).collect();
-        let extent = if pts_unit.is_empty() {
-            [1.0, 1.0]
-        } else {
-            focus::focused_extent(&corners, &pts_unit, light_size)?
-        };
-        let footprint = focus::median(
-            hits.iter()
-                .zip(&pts_ls)
-                .filter(|(_, q)| q.z > 0.0)
-                .map(|(&k, q)| {
-                    let world = g.depth[k] as f64 / call.camera.focal;
-                    match space {
-                        LightSpace::Rect(_) => world / q.z,
-                        LightSpace::Sun(s) => world / s.lateral_scale(),
-                    }
-                })
-                .collect(),
-        )
-        .unwrap_or(1.0);
-        let fitted = focus::footprint_resolution(extent, footprint);
-        let resolution = match call.map_resolution {
-            Some((w, h)) => (w as usize, h as usize),
-            None => fitted,
-        };
-        method = call.method.resolve(&CallContext {
-            backend: Backend::Cpu,
-            resolution,
-            depth_layers: None,
-        })?;
-        // The eye view has occluder maps only: the resolved config's
-        // occluder resolution (the fitted one unless the config sets it;
-        // "auto"'s rule takes a quarter of it).
-        let (w, h) = method.occluder_resolution().unwrap_or(resolution);
-        let grid = MapGrid::new(w, h, extent)?;
-        sw.lap("extent");
-        let tris = maps::LightTriangles {
-            verts: corners,
-            faces: (0..scene.corners.len() as u32)
-                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-                .collect(),
-        };
-        let (v, m) = maps::shade(
-            &space,
-            unit,
-            light_size,
-            &tris,
-            grid,
-            method.passes(),
-            method.kernel(),
-            &points,
-            &normals,
-            &call.bias,
-        )?;
-        for (&k, v) in hits.iter().zip(v) {
-            visibility[k] = v;
-        }
-        maps = Some(m);
-        sw.lap("shadow");
-    } else {
-        method = call.method.resolve(&CallContext {
-            backend: Backend::Cpu,
-            resolution: (call.camera.width, call.camera.height),
-            depth_layers: None,
-        })?;
+/// The config of a call that reads no maps (`exact`, or no visible point),
+/// resolved for `backend` at the camera's resolution.
+pub(crate) fn resolve_at_camera(call: &EyeCall, backend: Backend) -> Result<MethodConfig> {
+    call.method.resolve(&CallContext {
+        backend,
+        resolution: (call.camera.width, call.camera.height),
+        depth_layers: None,
+    })
+}
+
+/// Light samples per pixel of `exact`: a hard light needs one ray (every
+/// sample would be the same).
+pub(crate) fn exact_samples(call: &EyeCall, method: &MethodConfig) -> u32 {
+    match method.kernel() {
+        crate::methods::Method::Exact { samples } if !call.light.is_hard() => samples,
+        _ => 1,
     }
-    // A rectangle lights its n side only.
-    if let LightSpace::Rect(l) = space {
-        for (&k, p) in hits.iter().zip(&points) {
+}
+
+/// The triangles `exact` traces: the corners in f32.
+pub(crate) fn traced_triangles(f: &Framed) -> Vec<[Vec3; 3]> {
+    f.corners
+        .par_chunks(3)
+        .map(|c| [c[0].as_vec3(), c[1].as_vec3(), c[2].as_vec3()])
+        .collect()
+}
+
+/// The map methods' occluder grid (focused on the visible points, sized
+/// from their footprint unless the call sets it) and the config resolved
+/// for `backend` at that resolution. `f` has visible points.
+pub(crate) fn map_grid(
+    call: &EyeCall,
+    g: &GBuffer,
+    f: &Framed,
+    backend: Backend,
+) -> Result<(MapGrid, MethodConfig)> {
+    let in_front: Vec<DVec3> = f.pts_ls.iter().copied().filter(|q| q.z > 0.0).collect();
+    let pts_unit: Vec<DVec3> = in_front.iter().map(|q| *q / f.unit).collect();
+    let extent = if pts_unit.is_empty() {
+        [1.0, 1.0]
+    } else {
+        focus::focused_extent(&f.corners, &pts_unit, f.light_size)?
+    };
+    let footprint = focus::median(
+        f.hits
+            .iter()
+            .zip(&f.pts_ls)
+            .filter(|(_, q)| q.z > 0.0)
+            .map(|(&k, q)| {
+                let world = g.depth[k] as f64 / call.camera.focal;
+                match f.space {
+                    LightSpace::Rect(_) => world / q.z,
+                    LightSpace::Sun(s) => world / s.lateral_scale(),
+                }
+            })
+            .collect(),
+    )
+    .unwrap_or(1.0);
+    let fitted = focus::footprint_resolution(
+        extent,
+        focus::capped_footprint(extent, footprint, f.hits.len()),
+    );
+    let resolution = match call.map_resolution {
+        Some((w, h)) => (w as usize, h as usize),
+        None => fitted,
+    };
+    let method = call.method.resolve(&CallContext {
+        backend,
+        resolution,
+        depth_layers: None,
+    })?;
+    // The eye view has occluder maps only: the resolved config's
+    // occluder resolution (the fitted one unless the config sets it;
+    // "auto"'s rule takes a quarter of it).
+    let (w, h) = method.occluder_resolution().unwrap_or(resolution);
+    Ok((MapGrid::new(w, h, extent)?, method))
+}
+
+/// Every triangle as one indexed mesh in kernel light space (the map
+/// methods' occluders), taking the corners out of `f`.
+pub(crate) fn light_triangles(f: &mut Framed) -> maps::LightTriangles {
+    let verts = std::mem::take(&mut f.corners);
+    let n = verts.len() as u32 / 3;
+    maps::LightTriangles {
+        verts,
+        faces: (0..n).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+    }
+}
+
+/// A rectangle lights its n side only: 0 at the pixels whose point is at
+/// or behind its plane.
+pub(crate) fn lit_side_only(f: &Framed, visibility: &mut [f32]) {
+    if let LightSpace::Rect(l) = f.space {
+        for (&k, p) in f.hits.iter().zip(&f.points) {
             if (DVec3::from_array(*p) - l.center).dot(l.n) <= 0.0 {
                 visibility[k] = 0.0;
             }
         }
     }
+}
+
+fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
+    let mut sw = Stopwatch::new();
+    let scene = SceneTriangles::new(call.meshes)?;
+    let g = gbuffer::first_hits(call.camera, &scene);
+    sw.lap("first_hits");
+    let mut f = frame(call, &scene, &g)?;
+    sw.lap("transform");
+
+    let mut visibility = vec![1f32; g.len()];
+    let mut maps = None;
+    let method;
+    if call.method.kernel().reads_input(Input::OccluderTriangles) {
+        method = resolve_at_camera(call, Backend::Cpu)?;
+        let samples = exact_samples(call, &method);
+        let tris = traced_triangles(&f);
+        sw.lap("triangles");
+        let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
+        let v = rays::visibility(f.light_size, tris, &starts, samples);
+        for (&k, v) in f.hits.iter().zip(v) {
+            visibility[k] = v;
+        }
+        sw.lap("shadow");
+    } else if !f.points.is_empty() {
+        let (grid, m) = map_grid(call, &g, &f, Backend::Cpu)?;
+        method = m;
+        sw.lap("extent");
+        let tris = light_triangles(&mut f);
+        let (v, m) = maps::shade(
+            &f.space,
+            f.unit,
+            f.light_size,
+            &tris,
+            grid,
+            method.passes(),
+            method.kernel(),
+            &f.points,
+            &f.normals,
+            &call.bias,
+        )?;
+        for (&k, v) in f.hits.iter().zip(v) {
+            visibility[k] = v;
+        }
+        maps = Some(m);
+        sw.lap("shadow");
+    } else {
+        method = resolve_at_camera(call, Backend::Cpu)?;
+    }
+    lit_side_only(&f, &mut visibility);
     Ok((
         EyeImage {
             gbuffer: g,
             visibility,
             maps,
-            light_space: space,
+            light_space: f.space,
             timings: sw.timings,
         },
         method,

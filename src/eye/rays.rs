@@ -19,54 +19,93 @@ use rayon::prelude::*;
 /// Mitsuba's `math::RayEpsilon<float>`: 1500 float32 epsilons.
 pub const RAY_EPSILON: f64 = 1500.0 / (1u64 << 24) as f64;
 
-/// Visibility at surface points `points` (world) with normals `normals`,
-/// every triangle of `triangles` (kernel light space, in the depth unit
-/// `unit`) blocking. A rectangle emits on its n side only: points at or
-/// behind its plane get 0.
-pub fn visibility(
+/// Which side of the tangent plane at `p` (normal `n`, world) each light
+/// point lies on, as `[a0, a1, a2]` with `a0 + a1 x + a2 y >= 0` in front
+/// for the light point (x, y) in kernel units (unit-scaled); `None` at or
+/// behind a rectangle's plane (it emits on its n side only).
+pub fn plane_side(space: &LightSpace, unit: f64, p: DVec3, n: DVec3) -> Option<[f64; 3]> {
+    match space {
+        LightSpace::Rect(l) => {
+            if (p - l.center).dot(l.n) <= 0.0 {
+                return None;
+            }
+            Some([n.dot(l.center - p) / unit, n.dot(l.u), n.dot(l.v)])
+        }
+        LightSpace::Sun(s) => Some([-n.dot(s.light.n), -n.dot(s.light.u), -n.dot(s.light.v)]),
+    }
+}
+
+/// A shadow ray's start for a surface point, in kernel light space: the
+/// origins above and below the surface, and the side of the surface a light
+/// point (x, y) lies on: `side[0] + x side[1] + y side[2] >= 0` is above.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayStart {
+    pub above: Vec3,
+    pub below: Vec3,
+    pub side: [f32; 3],
+}
+
+impl RayStart {
+    /// The origin of the ray toward the light point (x, y).
+    #[inline]
+    pub fn origin(&self, x: f32, y: f32) -> Vec3 {
+        if self.side[0] + x * self.side[1] + y * self.side[2] >= 0.0 {
+            self.above
+        } else {
+            self.below
+        }
+    }
+}
+
+/// The ray starts of surface points `points` (world) with normals
+/// `normals` (facing the camera), in kernel light space in the depth unit
+/// `unit`; `None` at or behind a rectangle's plane.
+pub fn ray_starts(
     space: &LightSpace,
     unit: f64,
-    light_size: [f64; 2],
-    triangles: Vec<[Vec3; 3]>,
     points: &[[f64; 3]],
     normals: &[[f32; 3]],
+) -> Vec<Option<RayStart>> {
+    let to_kernel = |p: DVec3| (space.to_light(p) / unit).as_vec3();
+    points
+        .par_iter()
+        .zip(normals)
+        .map(|(p, n)| {
+            let p = DVec3::from_array(*p);
+            let n = Vec3::from_array(*n).as_dvec3();
+            let side = plane_side(space, unit, p, n)?;
+            let mag = (1.0 + p.abs().max_element()) * RAY_EPSILON;
+            Some(RayStart {
+                above: to_kernel(p + mag * n),
+                below: to_kernel(p - mag * n),
+                side: side.map(|a| a as f32),
+            })
+        })
+        .collect()
+}
+
+/// Visibility at ray starts `starts` (a pixel's jitter key is its index in
+/// `starts`), every triangle of `triangles` (kernel light space,
+/// unit-scaled) blocking; 0 for `None`.
+pub fn visibility(
+    light_size: [f64; 2],
+    triangles: Vec<[Vec3; 3]>,
+    starts: &[Option<RayStart>],
     samples: u32,
 ) -> Vec<f32> {
     let bvh = Bvh::build(triangles);
     let grid = sample_grid(samples, light_size);
     let size = light_size.map(|s| s as f32);
-    let to_kernel = |p: DVec3| (space.to_light(p) / unit).as_vec3();
-    points
+    starts
         .par_iter()
-        .zip(normals)
         .enumerate()
         .with_min_len(64)
-        .map(|(k, (p, n))| {
-            let p = DVec3::from_array(*p);
-            let n = Vec3::from_array(*n).as_dvec3();
-            // side(x, y) = a0 + x au + y av: which side of the surface the
-            // light point (x, y) (kernel units) lies on.
-            let (a0, au, av) = match space {
-                LightSpace::Rect(l) => {
-                    if (p - l.center).dot(l.n) <= 0.0 {
-                        return 0.0;
-                    }
-                    (n.dot(l.center - p) / unit, n.dot(l.u), n.dot(l.v))
-                }
-                LightSpace::Sun(s) => (-n.dot(s.light.n), -n.dot(s.light.u), -n.dot(s.light.v)),
-            };
-            let mag = (1.0 + p.abs().max_element()) * RAY_EPSILON;
-            let above = to_kernel(p + mag * n);
-            let below = to_kernel(p - mag * n);
-            let (a0, au, av) = (a0 as f32, au as f32, av as f32);
-            stratified(&bvh, k as u64, grid, size, |x, y| {
-                let o = if a0 + x * au + y * av >= 0.0 {
-                    above
-                } else {
-                    below
-                };
+        .map(|(k, s)| match s {
+            None => 0.0,
+            Some(s) => stratified(&bvh, k as u64, grid, size, |x, y| {
+                let o = s.origin(x, y);
                 (o, Vec3::new(x, y, 0.0) - o, 0.0)
-            })
+            }),
         })
         .collect()
 }

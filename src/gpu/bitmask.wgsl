@@ -79,3 +79,49 @@ fn bitmask_resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     vis[idx] = 1.0 - f32(hidden) / f32(gp.samples);
 }
+
+// Points mode (gather.wgsl): masks need no per-row step.
+fn points_begin_row() {}
+
+fn points_end_row() {}
+
+// Ors this dispatch's chunk of its layer into every point's mask.
+@compute @workgroup_size(64)
+fn bitmask_points(@builtin(global_invocation_id) gid: vec3<u32>,
+                  @builtin(num_workgroups) groups: vec3<u32>) {
+    let rc = point_receiver(point_index(gid, groups));
+    if !rc.ok {
+        return;
+    }
+    var full = true;
+    for (var q = 0u; q < WORDS; q++) {
+        mask[q] = acc[rc.idx * WORDS + q];
+        full = full && mask[q] == x_ge(0u, q);
+    }
+    if full {
+        return;
+    }
+    gather_points_chunk(rc);
+    for (var q = 0u; q < WORDS; q++) {
+        acc[rc.idx * WORDS + q] = mask[q];
+    }
+}
+
+@compute @workgroup_size(64)
+fn bitmask_points_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
+                          @builtin(num_workgroups) groups: vec3<u32>) {
+    let idx = point_index(gid, groups);
+    if idx >= pp.n_points {
+        return;
+    }
+    let rc = point_receiver(idx);
+    if !rc.ok {
+        vis[idx] = 1.0;
+        return;
+    }
+    var hidden = 0u;
+    for (var q = 0u; q < WORDS; q++) {
+        hidden += countOneBits(acc[idx * WORDS + q]);
+    }
+    vis[idx] = 1.0 - f32(hidden) / f32(gp.samples);
+}

@@ -201,3 +201,348 @@ fn depth_maps_cannot_be_traced() {
     .to_string();
     assert!(e.starts_with("method:"), "{e}");
 }
+
+// ---------------------------------------------------------------------------
+// The eye view: `render(backend="gpu")` against the CPU.
+
+mod eye {
+    use super::{device_or_skip, floor, sphere};
+    use crate::backend::{Backend, BackendChoice};
+    use crate::eye::gbuffer::{self, SceneTriangles};
+    use crate::eye::{self, EyeCall, EyeImage, DEFAULT_BIAS};
+    use crate::geom::camera::Camera;
+    use crate::geom::light::RectLight;
+    use crate::geom::light_space::Light;
+    use crate::geom::mesh::MeshRef;
+    use crate::geom::sun::DirectionalLight;
+    use crate::methods::config::{BitmaskConfig, ExactConfig, SsmConfig};
+    use crate::methods::MethodConfig;
+    use glam::Vec3;
+
+    type Mesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+    /// An axis-aligned box (centre c, half-sizes h), outward-wound.
+    fn boxed(c: [f64; 3], h: [f64; 3]) -> Mesh {
+        let v = (0..8)
+            .map(|k| {
+                let s = |b: usize| if k >> b & 1 == 1 { 1.0 } else { -1.0 };
+                [c[0] + s(0) * h[0], c[1] + s(1) * h[1], c[2] + s(2) * h[2]]
+            })
+            .collect();
+        let f = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        (v, f)
+    }
+
+    /// A sphere on a floor, and a box.
+    fn scene() -> Vec<Mesh> {
+        vec![
+            sphere([0.1, 0.5, -0.2], 0.5, 24),
+            floor(),
+            boxed([-1.1, 0.35, 0.5], [0.35, 0.35, 0.3]),
+        ]
+    }
+
+    fn camera((w, h): (i64, i64)) -> Camera {
+        Camera::look_at([0.9, 2.4, 3.6], [-0.2, 0.3, 0.0], [0.0, 1.0, 0.0], 45.0, (w, h)).unwrap()
+    }
+
+    fn lights() -> [(&'static str, Light); 2] {
+        [
+            (
+                "rect",
+                RectLight::new(
+                    [0.3, 4.0, 0.2],
+                    [0.0, -1.0, 0.0],
+                    [0.0, 0.0, 1.0],
+                    [1.0, 0.6],
+                )
+                .unwrap()
+                .into(),
+            ),
+            (
+                "sun",
+                DirectionalLight::new([0.8, -0.7, -0.3], [0.0, 0.0, 1.0], [2.0, 2.0])
+                    .unwrap()
+                    .into(),
+            ),
+        ]
+    }
+
+    /// The configs as the GPU resolves them (no hierarchy, f32 sums), so
+    /// that the CPU runs the same kernels.
+    fn methods() -> [(&'static str, MethodConfig); 3] {
+        [
+            ("exact", MethodConfig::Exact(ExactConfig { samples: 64 })),
+            (
+                "ssm",
+                MethodConfig::Ssm(SsmConfig {
+                    hierarchy: Some(false),
+                    ..Default::default()
+                }),
+            ),
+            (
+                "bitmask",
+                MethodConfig::Bitmask(BitmaskConfig {
+                    hierarchy: Some(false),
+                    ..Default::default()
+                }),
+            ),
+        ]
+    }
+
+    fn render(
+        meshes: &[Mesh],
+        light: &Light,
+        camera: &Camera,
+        method: MethodConfig,
+        backend: BackendChoice,
+    ) -> crate::error::Result<crate::backend::Run<EyeImage>> {
+        let refs: Vec<MeshRef> = meshes
+            .iter()
+            .map(|(v, f)| MeshRef {
+                vertices: v,
+                faces: f,
+            })
+            .collect();
+        eye::render(&EyeCall {
+            meshes: &refs,
+            light,
+            camera,
+            method,
+            map_resolution: None,
+            bias: DEFAULT_BIAS,
+            backend,
+            threads: None,
+        })
+    }
+
+    /// The triangle each pixel sees, on the CPU (as gbuffer::first_hits
+    /// casts it) and on the GPU.
+    fn hit_ids(meshes: &[Mesh], camera: &Camera) -> (Vec<Option<u32>>, Vec<Option<u32>>) {
+        let refs: Vec<MeshRef> = meshes
+            .iter()
+            .map(|(v, f)| MeshRef {
+                vertices: v,
+                faces: f,
+            })
+            .collect();
+        let scene = SceneTriangles::new(&refs).unwrap();
+        let bvh = gbuffer::camera_bvh(camera, &scene);
+        let cpu = (0..camera.width * camera.height)
+            .map(|k| {
+                bvh.nearest(Vec3::ZERO, gbuffer::pixel_ray(camera, k), f32::INFINITY)
+                    .map(|(_, t)| t)
+            })
+            .collect();
+        let g = super::super::context::gpu().unwrap();
+        let (gpu, _) = super::super::eye::first_hits(g, camera, &scene).unwrap();
+        (cpu, gpu)
+    }
+
+    /// Pixels whose triangle differs between the two, and whether each of
+    /// them has a 4-neighbour seeing another triangle (or none) in either.
+    fn differing(a: &[Option<u32>], b: &[Option<u32>], w: usize) -> (usize, bool) {
+        let h = a.len() / w;
+        let mut n = 0;
+        let mut all_on_edges = true;
+        for k in 0..a.len() {
+            if a[k] == b[k] {
+                continue;
+            }
+            n += 1;
+            let (i, j) = (k % w, k / w);
+            let nbs = [
+                (i > 0).then(|| k - 1),
+                (i + 1 < w).then(|| k + 1),
+                (j > 0).then(|| k - w),
+                (j + 1 < h).then(|| k + w),
+            ];
+            let edge = nbs
+                .into_iter()
+                .flatten()
+                .any(|m| a[m] != a[k] || b[m] != b[k]);
+            all_on_edges &= edge;
+        }
+        (n, all_on_edges)
+    }
+
+    #[test]
+    fn first_hits_are_the_cpus_but_on_edges() {
+        if !device_or_skip() {
+            return;
+        }
+        for res in [(96, 72), (97, 61)] {
+            let cam = camera(res);
+            let (c, g) = hit_ids(&scene(), &cam);
+            assert!(c.iter().filter(|t| t.is_some()).count() > c.len() / 2);
+            let (n, on_edges) = differing(&c, &g, cam.width);
+            eprintln!("{res:?}: {n} of {} pixels see another triangle", c.len());
+            assert!(n * 200 <= c.len(), "{n} pixels differ");
+            assert!(on_edges, "a differing pixel is off the triangles' edges");
+        }
+    }
+
+    #[test]
+    fn gpu_renders_are_the_cpu_renders() {
+        if !device_or_skip() {
+            return;
+        }
+        let meshes = scene();
+        let cam = camera((96, 72));
+        let (ids_c, ids_g) = hit_ids(&meshes, &cam);
+        let same: Vec<bool> = ids_c.iter().zip(&ids_g).map(|(a, b)| a == b).collect();
+        for (lname, light) in lights() {
+            for (mname, method) in methods() {
+                let c = render(&meshes, &light, &cam, method, BackendChoice::Cpu).unwrap();
+                let g = render(&meshes, &light, &cam, method, BackendChoice::Gpu).unwrap();
+                assert_eq!((c.backend, g.backend), (Backend::Cpu, Backend::Gpu));
+                assert_eq!(c.method, g.method, "{lname} {mname}");
+                let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+                let ids_same = c
+                    .output
+                    .gbuffer
+                    .mesh_id
+                    .iter()
+                    .zip(&g.output.gbuffer.mesh_id)
+                    .filter(|(a, b)| a == b)
+                    .count();
+                assert!(ids_same * 200 >= 199 * cv.len(), "{lname} {mname}: mesh ids");
+                let dv: Vec<f64> = (0..cv.len())
+                    .filter(|&k| same[k] && ids_c[k].is_some())
+                    .map(|k| (cv[k] as f64 - gv[k] as f64).abs())
+                    .collect();
+                let mean = dv.iter().sum::<f64>() / dv.len() as f64;
+                let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+                let penumbra = cv.iter().filter(|&&v| v > 0.02 && v < 0.98).count();
+                let shadowed = cv.iter().filter(|&&v| v < 0.5).count();
+                eprintln!(
+                    "{lname} {mname}: mean |dV| {mean:.2e}, max {max:.2e}, \
+                     {} differ, penumbra {penumbra}, shadowed {shadowed}",
+                    dv.iter().filter(|&&x| x > 0.0).count()
+                );
+                // The scene exercises shadows and penumbrae (the sun's 2
+                // degrees make narrow ones).
+                assert!(penumbra > 20 && shadowed > 50, "{lname} {mname}");
+                assert!(mean <= 1e-4, "{lname} {mname}: mean |dV| {mean}");
+                match (&c.output.maps, &g.output.maps) {
+                    (Some(a), Some(b)) => {
+                        assert_eq!(a.grid, b.grid, "{lname} {mname}: grids");
+                        assert_eq!(a.layers.len(), b.layers.len());
+                        for (la, lb) in a.layers.iter().zip(&b.layers) {
+                            let diff = la
+                                .iter()
+                                .zip(lb)
+                                .filter(|(x, y)| x.to_bits() != y.to_bits())
+                                .count();
+                            assert_eq!(diff, 0, "{lname} {mname}: occluder layers");
+                        }
+                    }
+                    (None, None) => assert_eq!(mname, "exact"),
+                    _ => panic!("{lname} {mname}: maps differ in presence"),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn wide_penumbrae_on_fine_maps_take_many_chunks() {
+        // A large light over a fine map: each group's window spans hundreds
+        // of occluder texels, shaded in several dispatches per layer.
+        if !device_or_skip() {
+            return;
+        }
+        let meshes = scene();
+        let cam = camera((64, 48));
+        let light: Light = RectLight::new(
+            [0.3, 2.5, 0.2],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [3.0, 2.0],
+        )
+        .unwrap()
+        .into();
+        for (mname, method) in methods().into_iter().skip(1) {
+            let call = |backend| {
+                let refs: Vec<MeshRef> = meshes
+                    .iter()
+                    .map(|(v, f)| MeshRef {
+                        vertices: v,
+                        faces: f,
+                    })
+                    .collect();
+                eye::render(&EyeCall {
+                    meshes: &refs,
+                    light: &light,
+                    camera: &cam,
+                    method,
+                    map_resolution: Some((512, 512)),
+                    bias: DEFAULT_BIAS,
+                    backend,
+                    threads: None,
+                })
+                .unwrap()
+            };
+            let (c, g) = (call(BackendChoice::Cpu), call(BackendChoice::Gpu));
+            let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+            let dv: Vec<f64> = cv
+                .iter()
+                .zip(gv)
+                .map(|(a, b)| (*a as f64 - *b as f64).abs())
+                .collect();
+            let mean = dv.iter().sum::<f64>() / dv.len() as f64;
+            let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+            eprintln!("wide {mname}: mean |dV| {mean:.2e}, max {max:.2e}");
+            assert!(cv.iter().filter(|&&v| v > 0.02 && v < 0.98).count() > 300);
+            assert!(mean <= 1e-4 && max <= 2e-3, "{mname}: mean {mean}, max {max}");
+        }
+    }
+
+    #[test]
+    fn hard_lights_trace_on_the_gpu_and_refuse_the_map_methods() {
+        if !device_or_skip() {
+            return;
+        }
+        let meshes = scene();
+        let cam = camera((48, 36));
+        let point: Light = RectLight::new(
+            [0.3, 4.0, 0.2],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0],
+        )
+        .unwrap()
+        .into();
+        let exact = MethodConfig::Exact(ExactConfig { samples: 16 });
+        let c = render(&meshes, &point, &cam, exact, BackendChoice::Cpu).unwrap();
+        let g = render(&meshes, &point, &cam, exact, BackendChoice::Gpu).unwrap();
+        let differ = c
+            .output
+            .visibility
+            .iter()
+            .zip(&g.output.visibility)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(differ * 200 <= c.output.visibility.len(), "{differ}");
+        let ssm = MethodConfig::Ssm(SsmConfig::default());
+        let e = render(&meshes, &point, &cam, ssm, BackendChoice::Gpu)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("size:") && e.contains("CPU backend only"), "{e}");
+        // "auto" stays on the CPU: a hard light, or a software adapter.
+        let a = render(&meshes, &point, &cam, ssm, BackendChoice::Auto).unwrap();
+        assert_eq!(a.backend, Backend::Cpu);
+    }
+}

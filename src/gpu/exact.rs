@@ -17,9 +17,9 @@ pub const SOURCE: &str = concat!(include_str!("u64.wgsl"), "\n", include_str!("e
 
 /// Loop iterations (BVH nodes visited and triangles tested) one invocation
 /// may run per dispatch; lavapipe stops an invocation after 65535.
-const BUDGET: u32 = 50_000;
+pub(super) const BUDGET: u32 = 50_000;
 /// Samples per dispatch: BUDGET / SAMPLES_PER_CHUNK iterations a ray.
-const SAMPLES_PER_CHUNK: u32 = 4;
+pub(super) const SAMPLES_PER_CHUNK: u32 = 4;
 
 /// `ExactParams` of exact.wgsl.
 #[repr(C)]

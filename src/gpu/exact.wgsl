@@ -96,29 +96,41 @@ fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
-// exact.rs's hits: Möller-Trumbore, any hit with t in (t0, t1).
-fn hits(t: u32, o: vec3<f32>, d: vec3<f32>) -> bool {
+// exact.rs's hit_t: Möller-Trumbore, where the line o + t d crosses
+// triangle t (edges included): ok = false when it does not.
+struct Crossing {
+    ok: bool,
+    t: f32,
+}
+
+fn hit_t(t: u32, o: vec3<f32>, d: vec3<f32>) -> Crossing {
+    let none = Crossing(false, 0.0);
     let v0 = vertex(t, 0u);
     let e1 = vertex(t, 1u) - v0;
     let e2 = vertex(t, 2u) - v0;
     let p = cross3(d, e2);
     let det = dot3(e1, p);
     if det == 0.0 || !(abs(det) < bitcast<f32>(0x7f800000u)) {
-        return false;
+        return none;
     }
     let inv = 1.0 / det;
     let s = o - v0;
     let u = dot3(s, p) * inv;
     if !(u >= 0.0 && u <= 1.0) {
-        return false;
+        return none;
     }
     let q = cross3(s, e1);
     let v = dot3(d, q) * inv;
     if v < 0.0 || u + v > 1.0 {
-        return false;
+        return none;
     }
-    let tt = dot3(e2, q) * inv;
-    return tt > ep.t0 && tt < ep.t1;
+    return Crossing(true, dot3(e2, q) * inv);
+}
+
+// exact.rs's hits: any crossing with t in (t0, t1).
+fn hits(t: u32, o: vec3<f32>, d: vec3<f32>) -> bool {
+    let c = hit_t(t, o, d);
+    return c.ok && c.t > ep.t0 && c.t < ep.t1;
 }
 
 // f32::min / f32::max: the non-NaN operand wins.

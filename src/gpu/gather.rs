@@ -2,6 +2,8 @@
 //! layers (`row_stats`), then one invocation per receiver texel gathering the
 //! micro-patches in reach (`gather.wgsl` + the method's file). The CPU twins
 //! are `methods/gather.rs` with `methods/ssm.rs` and `methods/bitmask.rs`.
+//! Points mode (the eye view): one workgroup per group of 64 sorted points,
+//! twin of `visibility_points` (`record_shade_points`).
 
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
 use crate::error::{Error, Result};
@@ -61,6 +63,45 @@ pub struct ChunkParams {
     pub _pad1: u32,
 }
 
+/// Points per workgroup in points mode (gather.wgsl's POINTS_GROUP): the
+/// CPU's group of `visibility_points`.
+pub const POINT_GROUP: u32 = 64;
+const _: () = assert!(POINT_GROUP as usize == crate::methods::gather::POINTS_PER_GROUP);
+
+/// `PointsParams` of gather.wgsl (points mode).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct PointsParams {
+    pub n_points: u32,
+    pub steps_per_chunk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// `GatherPoint` of gather.wgsl: a lane's tangent (x, y) and 1/depth.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct GpuPoint {
+    pub x: f32,
+    pub y: f32,
+    pub wr: f32,
+    pub live: u32,
+}
+
+/// `GroupBounds` of gather.wgsl: a group's bounds over its active lanes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct GpuGroup {
+    pub x_lo: f32,
+    pub x_hi: f32,
+    pub y_lo: f32,
+    pub y_hi: f32,
+    pub wr_min: f32,
+    pub live: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
 /// Loop iterations we let one invocation run per dispatch: half of lavapipe's
 /// limit of 65535 (llvmpipe's loop limiter counts every iteration of every
 /// loop of an invocation), leaving room for the loops around the texel loop.
@@ -85,13 +126,30 @@ pub fn chunking(og: &MapGrid, light_size: [f64; 2], w_max: f64, method: Method) 
     };
     let cols = reach(hw, light_size[0], og.width);
     let rows = reach(hh, light_size[1], og.height);
-    // The bitmask's 8-word loop per texel, in case the compiler keeps it a loop.
-    let per_texel = match method {
-        Method::Bitmask { .. } => 9,
-        _ => 1,
-    };
+    let per_texel = texel_cost(method);
     let rows_per_chunk = (ITERATION_BUDGET / (cols * per_texel + 2)).max(1);
     (rows_per_chunk as u32, rows.div_ceil(rows_per_chunk) as u32)
+}
+
+/// Iterations one texel costs the method's loop (the bitmask's 8 words, in
+/// case the compiler keeps them a loop).
+pub fn texel_cost(method: Method) -> usize {
+    match method {
+        Method::Bitmask { .. } => 9,
+        _ => 1,
+    }
+}
+
+/// Points mode: outward steps (two occluder rows each) per chunk when a
+/// group's window is at most `cols` columns wide, and the chunks that cover
+/// `steps` steps.
+pub fn points_chunking(cols: usize, steps: usize, method: Method) -> (u32, u32) {
+    let per_step = 2 * (cols * texel_cost(method) + 2);
+    let steps_per_chunk = (ITERATION_BUDGET / per_step).max(1);
+    (
+        steps_per_chunk as u32,
+        steps.div_ceil(steps_per_chunk).max(1) as u32,
+    )
 }
 
 /// `RowSpan` of gather.wgsl (written by the GPU; 16 bytes a row).
@@ -170,6 +228,30 @@ fn pipelines(device: &wgpu::Device, method: Method) -> Result<&'static MethodPip
             row_stats: pipeline(device, &m, "row_stats"),
             chunk: pipeline(device, &m, name),
             resolve: pipeline(device, &m, &format!("{name}_resolve")),
+        }
+    }))
+}
+
+struct PointsPipelines {
+    /// Adds one chunk of one layer to the points' accumulators.
+    chunk: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static PointsPipelines> {
+    static SSM: OnceLock<PointsPipelines> = OnceLock::new();
+    static BITMASK: OnceLock<PointsPipelines> = OnceLock::new();
+    let (name, source) = method_source(method)?;
+    let cell = match method {
+        Method::Ssm { .. } => &SSM,
+        Method::Bitmask { .. } => &BITMASK,
+        Method::Exact { .. } => unreachable!("method_source refused it"),
+    };
+    Ok(cell.get_or_init(|| {
+        let m = module(device, name, &module_source(source));
+        PointsPipelines {
+            chunk: pipeline(device, &m, &format!("{name}_points")),
+            resolve: pipeline(device, &m, &format!("{name}_points_resolve")),
         }
     }))
 }
@@ -288,6 +370,90 @@ pub fn record_shade(
             Some(b.vis),
             None,
             Some(b.acc),
+        ],
+    );
+    pass.set_pipeline(&p.resolve);
+    pass.set_bind_group(0, &bg, &[]);
+    pass.dispatch_workgroups(groups.0, groups.1, 1);
+    Ok(())
+}
+
+/// The points-mode buffers beside `GatherBuffers`: the sorted points, their
+/// groups' bounds and the points' parameters.
+pub struct PointsBuffers<'a> {
+    pub points: &'a wgpu::Buffer,
+    pub groups: &'a wgpu::Buffer,
+    pub params: PointsParams,
+    /// Dispatches per layer (runs of `params.steps_per_chunk` steps).
+    pub chunks: u32,
+}
+
+/// Records the points-mode shading pass body: for every layer and chunk of
+/// outward steps, one dispatch (a workgroup per group of points) adding it
+/// to the accumulators, then the resolve into visibility (one value per
+/// sorted point in `b.vis`).
+pub fn record_shade_points(
+    device: &wgpu::Device,
+    pass: &mut wgpu::ComputePass,
+    method: Method,
+    b: &GatherBuffers,
+    params: &GatherParams,
+    pts: &PointsBuffers,
+) -> Result<()> {
+    let p = points_pipelines(device, method)?;
+    let u = uniform(device, "gather params", params);
+    let pu = uniform(device, "points params", &pts.params);
+    let groups = groups_1d(pts.params.n_points, POINT_GROUP);
+    pass.set_pipeline(&p.chunk);
+    for layer in 0..params.n_layers {
+        for chunk in 0..pts.chunks {
+            let c = uniform(
+                device,
+                "chunk params",
+                &ChunkParams {
+                    layer,
+                    chunk,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            );
+            let bg = bind(
+                device,
+                &p.chunk,
+                &[
+                    Some(b.maps),
+                    Some(b.rows),
+                    Some(b.layer_w_max),
+                    Some(&u),
+                    Some(b.axes),
+                    None,
+                    b.tables,
+                    Some(b.acc),
+                    Some(&c),
+                    Some(&pu),
+                    Some(pts.points),
+                    Some(pts.groups),
+                ],
+            );
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(groups.0, groups.1, 1);
+        }
+    }
+    let bg = bind(
+        device,
+        &p.resolve,
+        &[
+            None,
+            None,
+            None,
+            Some(&u),
+            None,
+            Some(b.vis),
+            None,
+            Some(b.acc),
+            None,
+            Some(&pu),
+            Some(pts.points),
         ],
     );
     pass.set_pipeline(&p.resolve);

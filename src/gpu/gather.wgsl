@@ -17,6 +17,22 @@
 // A method's file defines `add_texel(w, x0, x1, xr_s, r, rc)`, which adds one
 // micro-patch to its per-invocation state (a `var<private>`), and its entry
 // points, which load that state from `acc`, call `gather_chunk` and store it.
+//
+// Points mode (the eye view, src/gpu/eye.rs): the receivers are arbitrary
+// light-space points (x, y tangents, 1/depth), sorted and cut into groups of
+// 64 on the CPU as methods/gather/mod.rs's visibility_points does; one
+// workgroup shades one group, one invocation a point. As the CPU's
+// Kernel::shade_points (gather/traverse.rs's add_layer and add_row), every
+// lane of a group visits the group's window: the rows in reach of the group's
+// bounds, outward from the group's central row (j_c, j_c + 1, j_c - 1, ...),
+// in each the columns in reach of the group's bounds, the texels nearer than
+// the group's nearest receiver; each lane adds them to its own state, and
+// `points_begin_row` / `points_end_row` (the method's) close a row's sum as
+// the CPU's two-level sum does. The chunks here are runs of
+// `steps_per_chunk` outward steps (two rows a step), so the lanes add the
+// same terms in the same order as the CPU's one loop. Unlike the CPU, no
+// BLOCK-wide runs are trimmed at the row's ends: a trimmed texel cannot reach
+// any lane, and adds 0 (or at most a rounding error at the reach's edge).
 
 // Shared with Rust (`GatherParams` in gather.rs; a test compares layouts).
 struct GatherParams {
@@ -239,6 +255,184 @@ fn gather_chunk(rc: Receiver) {
             }
             let x0 = axes[gp.ax_col_x0s + i];
             add_texel(w, x0, x0 + gp.wx, xr_s, r, rc);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Points mode.
+
+// Shared with Rust (`PointsParams` in gather.rs).
+struct PointsParams {
+    // Points, a multiple of POINTS_GROUP (the last group padded with inactive lanes).
+    n_points: u32,
+    // Outward steps (two occluder rows each) of a group's window per chunk.
+    steps_per_chunk: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// One lane: tangent (x, y) and 1/depth; live = 0 where there is no receiver.
+// Shared with Rust (`GpuPoint` in gather.rs).
+struct GatherPoint {
+    x: f32,
+    y: f32,
+    wr: f32,
+    live: u32,
+}
+
+// A group's bounds over its live lanes (a receiver in front of the light) (gather/group.rs's Group).
+// Shared with Rust (`GpuGroup` in gather.rs).
+struct GroupBounds {
+    x_lo: f32,
+    x_hi: f32,
+    y_lo: f32,
+    y_hi: f32,
+    wr_min: f32,
+    live: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+const POINTS_GROUP: u32 = 64u;
+
+@group(0) @binding(9) var<uniform> pp: PointsParams;
+@group(0) @binding(10) var<storage, read> points: array<GatherPoint>;
+@group(0) @binding(11) var<storage, read> point_groups: array<GroupBounds>;
+
+fn point_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return gid.x + gid.y * groups.x * POINTS_GROUP;
+}
+
+fn point_receiver(idx: u32) -> Receiver {
+    var r = Receiver(false, idx, 0.0, 0.0, 0.0);
+    if idx >= pp.n_points {
+        return r;
+    }
+    let p = points[idx];
+    r.ok = p.live != 0u;
+    r.xr = p.x;
+    r.yr = p.y;
+    r.wr = p.wr;
+    return r;
+}
+
+// f32::round: half-way cases away from zero (WGSL's round goes to even).
+fn round_away(x: f32) -> f32 {
+    let t = trunc(x);
+    if abs(x - t) >= 0.5 {
+        return t + sign(x);
+    }
+    return t;
+}
+
+// A group's rows in this dispatch's layer (add_layer): [j_lo, j_hi] and
+// the central row j_c the visit starts from; ok = false when none reaches.
+struct GroupRows {
+    ok: bool,
+    j_lo: i32,
+    j_hi: i32,
+    j_c: i32,
+}
+
+fn group_rows(b: GroupBounds) -> GroupRows {
+    var r = GroupRows(false, 0, 0, 0);
+    let w_max = bitcast<f32>(atomicLoad(&layer_w_max[chunk.layer]));
+    if b.live == 0u || w_max <= b.wr_min {
+        return r;
+    }
+    let reach_y = gp.hh + gp.half_ly * (w_max - b.wr_min);
+    let last = i32(gp.occ_h) - 1;
+    r.ok = true;
+    r.j_lo = clamp_index(floor(row_coord(b.y_hi + reach_y)), 0, last);
+    r.j_hi = clamp_index(ceil(row_coord(b.y_lo - reach_y)), 0, last);
+    r.j_c = clamp_index(round_away(row_coord(0.5 * (b.y_lo + b.y_hi))), r.j_lo, r.j_hi);
+    return r;
+}
+
+// Occluder row j as the group sees it (add_row): the columns [i_lo, i_hi)
+// in reach of the group's bounds and the row's centre yc.
+struct GroupRow {
+    ok: bool,
+    i_lo: u32,
+    i_hi: u32,
+    yc: f32,
+}
+
+fn group_row(j: u32, b: GroupBounds) -> GroupRow {
+    var r = GroupRow(false, 0u, 0u, 0.0);
+    let span = rows[chunk.layer * gp.occ_h + j];
+    if span.first >= span.last || span.w_max <= b.wr_min {
+        return r;
+    }
+    let dw = span.w_max - b.wr_min;
+    let yc = axes[gp.ax_row_y + j];
+    let dy = max(max(b.y_lo - yc, yc - b.y_hi), 0.0);
+    if dy >= gp.hh + gp.half_ly * dw {
+        return r;
+    }
+    let reach_x = gp.hw + gp.half_lx * dw;
+    let w_i = i32(gp.occ_w);
+    let i_lo = max(clamp_index(floor(col_coord(b.x_lo - reach_x)), -1, w_i), i32(span.first));
+    let i_hi = min(clamp_index(ceil(col_coord(b.x_hi + reach_x)), -1, w_i) + 1, i32(span.last));
+    if i_lo >= i_hi {
+        return r;
+    }
+    r.ok = true;
+    r.i_lo = u32(i_lo);
+    r.i_hi = u32(i_hi);
+    r.yc = yc;
+    return r;
+}
+
+// Adds occluder row j of this dispatch's layer to lane `rc` of group `b`.
+fn points_row(j: i32, b: GroupBounds, rc: Receiver, xr_s: f32) {
+    let g = group_row(u32(j), b);
+    if !g.ok {
+        return;
+    }
+    // The lane's own y-interval of the row, in half-light units (RowLanes).
+    let r = RowReach(
+        true,
+        g.i_lo,
+        g.i_hi,
+        (rc.yr - (g.yc - gp.hh)) * gp.inv_half_ly,
+        (g.yc + gp.hh - rc.yr) * gp.inv_half_ly,
+    );
+    let row = layer_offset(chunk.layer) + u32(j) * gp.occ_w;
+    points_begin_row();
+    for (var i = g.i_lo; i < g.i_hi; i++) {
+        let w = inv_depth(maps[row + i]);
+        // Empty, or behind every lane's receiver.
+        if w <= b.wr_min {
+            continue;
+        }
+        let x0 = axes[gp.ax_col_x0s + i];
+        add_texel(w, x0, x0 + gp.wx, xr_s, r, rc);
+    }
+    points_end_row();
+}
+
+// Adds this dispatch's chunk of outward steps of the group's window to lane
+// `rc`: steps m of [chunk * steps_per_chunk, ...), rows j_c - m then j_c + 1 + m.
+fn gather_points_chunk(rc: Receiver) {
+    let b = point_groups[rc.idx / POINTS_GROUP];
+    let gr = group_rows(b);
+    if !gr.ok {
+        return;
+    }
+    let xr_s = rc.xr * gp.inv_half_lx;
+    let steps = max(gr.j_c - gr.j_lo + 1, gr.j_hi - gr.j_c);
+    let m0 = i32(chunk.chunk * pp.steps_per_chunk);
+    let m1 = min(m0 + i32(pp.steps_per_chunk), steps);
+    for (var m = m0; m < m1; m++) {
+        let up = gr.j_c - m;
+        if up >= gr.j_lo {
+            points_row(up, b, rc, xr_s);
+        }
+        let down = gr.j_c + 1 + m;
+        if down <= gr.j_hi {
+            points_row(down, b, rc, xr_s);
         }
     }
 }

@@ -10,11 +10,18 @@
 //!   `crate::methods::bitmask`.
 //! * `exact.wgsl` (`exact.rs`): ray casting through the CPU-built BVH; twin
 //!   `crate::methods::exact`.
+//! * `eye_hits.wgsl` (`eye.rs`): the eye view's first hits, closest hit
+//!   through the camera BVH; twin `Bvh::nearest` (`eye::gbuffer`).
+//! * `eye_rays.wgsl` (`eye.rs`): the eye view's `exact`, shadow rays from
+//!   the visible points; twin `crate::eye::rays`.
+//! * `gather.wgsl`'s points mode (`gather.rs`, `eye.rs`): the eye view's
+//!   map methods at arbitrary points; twin `methods::gather`'s
+//!   `visibility_points`.
 //! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl` and
-//!   `exact.wgsl`.
+//!   `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
-//! Entry points: `from_meshes` (the whole mesh pipeline) and `from_depth`
-//! (the user's depth maps, shaded). Device, queue and pipelines are made once
+//! Entry points: `from_meshes` (the whole mesh pipeline), `from_depth`
+//! (the user's depth maps, shaded) and `render_gpu` (the eye view). Device, queue and pipelines are made once
 //! per process (`context.rs`).
 
 mod context;
@@ -22,6 +29,7 @@ mod context;
 mod device_tests;
 mod dispatch;
 mod exact;
+mod eye;
 mod from_depth;
 mod from_meshes;
 mod gather;
@@ -33,6 +41,7 @@ mod shading;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};
+pub use eye::render_gpu;
 pub use from_depth::from_depth;
 pub use from_meshes::{from_meshes, MAX_SIDE};
 

@@ -230,7 +230,6 @@ impl RasterInput {
         let device = &g.device;
         let rp = RasterPipelines::get(device);
         let rec_len = grid.len() as u32;
-        let occ_len = og.len() as u32;
         {
             let mut pass = enc.begin_compute_pass(&timer.pass("raster_receivers"));
             rp.fill(device, &mut pass, maps, 0, rec_len, INF_BITS);
@@ -252,11 +251,32 @@ impl RasterInput {
                 },
             );
         }
+        self.record_occluders(g, enc, timer, maps, rec_len, og, passes);
+    }
+
+    /// Records the pass "raster_occluders": `passes` layers of the occluder
+    /// triangles on `og` at `offset` in `maps` (front, the peeled ones, back),
+    /// as `pipeline::from_meshes` and `eye::maps::occluder_layers` make them;
+    /// nothing with `passes` = 0.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_occluders(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+        offset: u32,
+        og: &MapGrid,
+        passes: u32,
+    ) {
         if passes == 0 {
             return;
         }
+        let device = &g.device;
+        let rp = RasterPipelines::get(device);
+        let occ_len = og.len() as u32;
         let mut pass = enc.begin_compute_pass(&timer.pass("raster_occluders"));
-        let layer = |k: u32| rec_len + k * occ_len;
+        let layer = |k: u32| offset + k * occ_len;
         // Nearest and peeled layers start at +inf (atomicMin), the farthest at 0 (atomicMax).
         let nearest_layers = if passes >= 2 { passes - 1 } else { 1 };
         rp.fill(

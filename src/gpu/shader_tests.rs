@@ -3,8 +3,10 @@
 //! WGSL has the same member offsets and sizes on both sides.
 
 use super::exact::{ExactParams, SOURCE as EXACT_SOURCE};
+use super::eye::{GpuRayStart, HitsParams, HITS_SOURCE, RAYS_SOURCE};
 use super::gather::{
-    module_source, ChunkParams, GatherParams, RowSpan, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
+    module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, PointsParams, RowSpan,
+    BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
 use std::mem::{offset_of, size_of};
@@ -16,6 +18,8 @@ fn modules() -> Vec<(&'static str, String)> {
         ("gather.wgsl + ssm.wgsl", module_source(SSM_SOURCE)),
         ("gather.wgsl + bitmask.wgsl", module_source(BITMASK_SOURCE)),
         ("exact.wgsl", EXACT_SOURCE.to_string()),
+        ("exact.wgsl + eye_hits.wgsl", HITS_SOURCE.to_string()),
+        ("exact.wgsl + eye_rays.wgsl", RAYS_SOURCE.to_string()),
     ]
 }
 
@@ -34,6 +38,8 @@ fn every_wgsl_file_is_used_by_a_module() {
         SSM_SOURCE,
         BITMASK_SOURCE,
         EXACT_SOURCE,
+        HITS_SOURCE,
+        RAYS_SOURCE,
     ];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -204,6 +210,63 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             first,
             last,
             _pad
+        }),
+    );
+    assert_same(
+        &gather,
+        "PointsParams",
+        rust_layout!(PointsParams {
+            n_points,
+            steps_per_chunk,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        &gather,
+        "GatherPoint",
+        rust_layout!(GpuPoint { x, y, wr, live }),
+    );
+    assert_same(
+        &gather,
+        "GroupBounds",
+        rust_layout!(GpuGroup {
+            x_lo,
+            x_hi,
+            y_lo,
+            y_hi,
+            wr_min,
+            live,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        HITS_SOURCE,
+        "HitsParams",
+        rust_layout!(HitsParams {
+            n,
+            budget,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        RAYS_SOURCE,
+        "RayStart",
+        rust_layout!(GpuRayStart {
+            ax,
+            ay,
+            az,
+            valid,
+            bx,
+            by,
+            bz,
+            a0,
+            au,
+            av,
+            _pad0,
+            _pad1
         }),
     );
     assert_same(

@@ -53,7 +53,7 @@ fn axes(grid: &MapGrid, og: &MapGrid, light_size: [f64; 2], p: &mut GatherParams
     data
 }
 
-fn gather_params(
+pub(super) fn gather_params(
     grid: &MapGrid,
     og: &MapGrid,
     light_size: [f64; 2],

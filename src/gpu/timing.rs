@@ -96,6 +96,7 @@ impl StageTimer {
 /// Timing names are static: the device stages get a "gpu_" prefix.
 fn gpu_stage_name(name: &'static str) -> &'static str {
     match name {
+        "first_hits" => "gpu_first_hits",
         "raster_receivers" => "gpu_raster_receivers",
         "raster_occluders" => "gpu_raster_occluders",
         "row_stats" => "gpu_row_stats",

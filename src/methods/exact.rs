@@ -93,6 +93,13 @@ impl Bvh {
             .collect()
     }
 
+    /// The input index of the triangle in each BVH slot (what `nearest`
+    /// reports), for the GPU twin's closest hits (`gpu/eye_hits.wgsl`).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn order(&self) -> &[u32] {
+        &self.order
+    }
+
     pub fn build(tris: Vec<[Vec3; 3]>) -> Bvh {
         let mut tris: Vec<([Vec3; 3], u32)> = tris
             .into_iter()

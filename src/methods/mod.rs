@@ -8,7 +8,7 @@ pub mod bitmask;
 pub mod capabilities;
 pub mod config;
 pub mod exact;
-mod gather;
+pub(crate) mod gather;
 pub mod point_light;
 pub mod ssm;
 

@@ -23,6 +23,14 @@ pub use points::{receiver_points, sample_points, OccluderSource};
 
 use crate::methods::{Method, MethodConfig};
 
+/// The farthest finite depth of a map (0 when none).
+pub fn farthest_finite(depth: &[f32]) -> f64 {
+    depth
+        .iter()
+        .filter(|z| z.is_finite())
+        .fold(0f64, |m, &z| m.max(z as f64))
+}
+
 /// Settings of the mesh pipeline.
 #[derive(Debug, Clone, Copy)]
 pub struct MapSettings {

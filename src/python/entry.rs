@@ -85,16 +85,17 @@ pub fn shadow_map_from_meshes<'py>(
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, *, angular_size=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn shadow_map_from_depth<'py>(
     py: Python<'py>,
     occluder_depth: PyReadonlyArray2<'py, f32>,
     occluder_depth_back: Option<PyReadonlyArray2<'py, f32>>,
     receiver_depth: PyReadonlyArray2<'py, f32>,
-    light_size: [f64; 2],
+    light_size: Option<[f64; 2]>,
     extent: (f64, f64),
     method: &Bound<'py, PyAny>,
+    angular_size: Option<[f64; 2]>,
     passes: Option<Bound<'py, PyAny>>,
     samples: Option<Bound<'py, PyAny>>,
     occluder_resolution: Option<Bound<'py, PyAny>>,
@@ -120,10 +121,21 @@ pub fn shadow_map_from_depth<'py>(
         }
         let grid = MapGrid::new(shape[1], shape[0], [extent.0, extent.1])?;
         let occluder_grid = MapGrid::new(oshape[1], oshape[0], [extent.0, extent.1])?;
+        let light_size = match (light_size, angular_size) {
+            (Some(s), None) => s,
+            (None, Some(_)) => [0.0, 0.0],
+            _ => {
+                return Err(PyValueError::new_err(
+                    "light_size: pass either light_size (a rectangle's) or angular_size \
+                     (a directional light's orthographic maps)",
+                ))
+            }
+        };
         let call = DepthCall {
             grid,
             occluder_grid,
             light_size,
+            sun: angular_size,
             front: slice("occluder_depth", &occluder_depth)?,
             back: match &occluder_depth_back {
                 Some(b) => Some(slice("occluder_depth_back", b)?),

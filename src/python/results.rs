@@ -2,6 +2,7 @@
 //! from the core's vectors without a copy.
 
 use super::configs;
+use crate::backend::DepthOutput;
 use crate::backend::Run;
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
@@ -115,6 +116,9 @@ pub struct DepthShadowResult {
     /// (H, W) float32 visibility, on the receiver map's grid.
     #[pyo3(get)]
     visibility: Py<PyAny>,
+    /// For orthographic maps: the depth range of their kernel space.
+    #[pyo3(get)]
+    depth_range: Option<f64>,
     timings: Timings,
     #[pyo3(get)]
     method: Py<PyAny>,
@@ -134,11 +138,12 @@ impl DepthShadowResult {
 }
 
 impl DepthShadowResult {
-    pub fn new(py: Python<'_>, grid: &MapGrid, run: Run<(Vec<f32>, Timings)>) -> PyResult<Self> {
-        let (v, timings) = run.output;
+    pub fn new(py: Python<'_>, grid: &MapGrid, run: Run<DepthOutput>) -> PyResult<Self> {
+        let out = run.output;
         Ok(DepthShadowResult {
-            visibility: map(py, grid, v)?,
-            timings,
+            visibility: map(py, grid, out.visibility)?,
+            depth_range: out.depth_range,
+            timings: out.timings,
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),
             threads: run.threads,

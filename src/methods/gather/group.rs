@@ -29,7 +29,7 @@ pub(in crate::methods) struct Group {
 impl Group {
     /// `None` when no lane has a receiver in front of the light. `tile`:
     /// the points are a whole tile of the output grid, row by row.
-    fn new(pts: impl Iterator<Item = (f32, f32, f32)>, tile: bool) -> Option<Group> {
+    pub(super) fn new(pts: impl Iterator<Item = (f32, f32, f32)>, tile: bool) -> Option<Group> {
         let mut g = Group {
             xr: [0.0; LANES],
             yr: [0.0; LANES],

@@ -29,6 +29,7 @@ pub use hierarchy::Hierarchy;
 use hierarchy::Level;
 
 use super::{LightPoint, ShadowInputs};
+use crate::geom::light::MapGrid;
 use rayon::prelude::*;
 
 /// What a gather method does with one (occluder texel, receiver lanes) pair,
@@ -162,6 +163,66 @@ pub(super) fn visibility_map<A: Accumulator>(
     out
 }
 
+/// The order `visibility_points` shades `points` in: sorted by the texel of
+/// the occluder grid `og` each falls in, tile-major, so that each run of
+/// LANES points (a group) forms a compact tile and its union of extents
+/// stays small. The GPU twin (`gpu/eye.rs`) groups points by it too.
+pub(crate) fn point_order(og: &MapGrid, points: &[LightPoint]) -> Vec<u32> {
+    // Kernel::row_coord and col_coord at level 0 (scale 1).
+    let (tx, ty) = (og.tx as f32, og.ty as f32);
+    let (width, height) = (og.width as f32, og.height as f32);
+    let key = |p: &LightPoint| {
+        let j = ((1.0 - p.y / ty) * 0.5 * height - 0.5)
+            .round()
+            .clamp(0.0, height - 1.0) as u64;
+        let i = ((p.x / tx + 1.0) * 0.5 * width - 0.5)
+            .round()
+            .clamp(0.0, width - 1.0) as u64;
+        // Tile-major order, so that runs of LANES points form compact tiles.
+        let (t, r) = (TILE_W as u64, ROWS_PER_GROUP as u64);
+        let tiles_x = (og.width as u64).div_ceil(t);
+        (((j / r) * tiles_x + i / t) * r + j % r) * t + i % t
+    };
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.par_sort_by_key(|&n| key(&points[n as usize]));
+    order
+}
+
+/// Points a group of `visibility_points` holds (the GPU twin's workgroup).
+#[cfg(feature = "gpu")]
+pub(crate) const POINTS_PER_GROUP: usize = LANES;
+
+/// A group of up to LANES points as `visibility_points` shades it, for the
+/// GPU twin: per lane x, y and 1/depth (+inf: no receiver), and the bounds
+/// over the lanes with a receiver.
+#[cfg(feature = "gpu")]
+pub(crate) struct PointGroup {
+    pub xr: Lanes,
+    pub yr: Lanes,
+    pub wr: Lanes,
+    pub x_lo: f32,
+    pub x_hi: f32,
+    pub y_lo: f32,
+    pub y_hi: f32,
+    pub wr_min: f32,
+}
+
+/// The group of `pts` (at most LANES, in `point_order`), or None when no
+/// point has a receiver in front of the light.
+#[cfg(feature = "gpu")]
+pub(crate) fn point_group(pts: &[LightPoint]) -> Option<PointGroup> {
+    Group::new(pts.iter().map(|p| (p.x, p.y, p.z)), false).map(|g| PointGroup {
+        xr: g.xr,
+        yr: g.yr,
+        wr: g.wr,
+        x_lo: g.x_lo,
+        x_hi: g.x_hi,
+        y_lo: g.y_lo,
+        y_hi: g.y_hi,
+        wr_min: g.wr_min,
+    })
+}
+
 /// Shades receiver points (light space) with accumulator `a`.
 pub(super) fn visibility_points<A: Accumulator>(
     a: &A,
@@ -172,17 +233,7 @@ pub(super) fn visibility_points<A: Accumulator>(
     let k = Kernel::new(inputs, hierarchy);
     // Shade neighbours together: sort the points by the texel they fall in,
     // so that each group's union of extents stays small.
-    let key = |p: &LightPoint| {
-        let lv = &k.levels[0];
-        let j = k.row_coord(lv, p.y).round().clamp(0.0, k.height - 1.0) as u64;
-        let i = k.col_coord(lv, p.x).round().clamp(0.0, k.width - 1.0) as u64;
-        // Tile-major order, so that runs of LANES points form compact tiles.
-        let (t, r) = (TILE_W as u64, ROWS_PER_GROUP as u64);
-        let tiles_x = (lv.width as u64).div_ceil(t);
-        (((j / r) * tiles_x + i / t) * r + j % r) * t + i % t
-    };
-    let mut order: Vec<u32> = (0..points.len() as u32).collect();
-    order.par_sort_by_key(|&n| key(&points[n as usize]));
+    let order = point_order(&inputs.occluder_grid, points);
     let sorted: Vec<LightPoint> = order.iter().map(|&n| points[n as usize]).collect();
     let mut shaded = vec![1f32; points.len()];
     shaded

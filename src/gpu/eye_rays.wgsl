@@ -1,0 +1,95 @@
+// `exact` in the eye view on the GPU: stratified shadow rays from every
+// visible surface point, through the BVH of every triangle in kernel light
+// space (built on the CPU). The CPU twin is src/eye/rays.rs (`visibility`,
+// through methods/exact.rs's `stratified`): for light sample (x, y, 0) of
+// point k (the jitter is exact.rs's hash of key k and the sample, as
+// exact.wgsl computes it for map texels), the segment starts at the origin
+// on the side of the surface the light point lies on,
+//     o = above  if a0 + x au + y av >= 0,  else below
+// (the point moved off its surface along the normal by Mitsuba's
+// spawn_ray_to offset, computed in f64 on the CPU: rays::ray_starts),
+// and runs o + t (light point - o), t in (0, 1 - RAY_EPS) (ExactParams t0 = 0,
+// t1). A chunk of samples per dispatch counts the clear ones into `seen`;
+// the resolve divides by the sample count, 0 for a start that is not valid
+// (a point at or behind a rectangle's plane).
+//
+// Appended to u64.wgsl + exact.wgsl (hash, unit, occluded and its bindings;
+// ExactParams' rec_w is the number of ray starts here).
+
+// Shared with Rust (`GpuRayStart` in eye.rs; a test compares layouts).
+struct RayStart {
+    // Origin above the surface (the normal's side), kernel light space.
+    ax: f32,
+    ay: f32,
+    az: f32,
+    // 1: shade this point; 0: visibility 0.
+    valid: u32,
+    // Origin below the surface.
+    bx: f32,
+    by: f32,
+    bz: f32,
+    // side(x, y) = a0 + x au + y av: which side light point (x, y) lies on.
+    a0: f32,
+    au: f32,
+    av: f32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+const RAYS_GROUP: u32 = 64u;
+
+@group(0) @binding(8) var<storage, read> starts: array<RayStart>;
+
+// Adds this dispatch's chunk of samples to each point's count.
+@compute @workgroup_size(64)
+fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
+             @builtin(num_workgroups) groups: vec3<u32>) {
+    let idx = gid.x + gid.y * groups.x * RAYS_GROUP;
+    if idx >= ep.rec_w || ep.has_tris == 0u {
+        return;
+    }
+    let s = starts[idx];
+    if s.valid == 0u {
+        return;
+    }
+    let above = vec3<f32>(s.ax, s.ay, s.az);
+    let below = vec3<f32>(s.bx, s.by, s.bz);
+    // exact.rs's key: the point's index as a u64.
+    let key = vec2<u32>(idx, 0u);
+    var count = 0u;
+    for (var k = ep.chunk_start; k < ep.chunk_start + ep.chunk_len; k++) {
+        let sa = k % ep.na;
+        let sb = k / ep.na;
+        // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
+        let h = hash(key ^ hash(vec2<u32>(k << 1u, 0u)));
+        let x = ((f32(sa) + unit(h)) / f32(ep.na) - 0.5) * ep.size_x;
+        let y = ((f32(sb) + unit(hash(h))) / f32(ep.nb) - 0.5) * ep.size_y;
+        var o = below;
+        if s.a0 + x * s.au + y * s.av >= 0.0 {
+            o = above;
+        }
+        let d = vec3<f32>(x, y, 0.0) - o;
+        if !occluded(o, d) {
+            count += 1u;
+        }
+    }
+    seen[idx] += count;
+}
+
+@compute @workgroup_size(64)
+fn eye_exact_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
+                     @builtin(num_workgroups) groups: vec3<u32>) {
+    let idx = gid.x + gid.y * groups.x * RAYS_GROUP;
+    if idx >= ep.rec_w {
+        return;
+    }
+    if starts[idx].valid == 0u {
+        vis[idx] = 0.0;
+        return;
+    }
+    if ep.has_tris == 0u {
+        vis[idx] = 1.0;
+        return;
+    }
+    vis[idx] = f32(seen[idx]) / f32(ep.na * ep.nb);
+}
