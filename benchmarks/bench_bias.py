@@ -67,16 +67,17 @@ def main() -> None:
                 errors.append(c.mean_abs)
                 acne.append(float((img.visibility[lit] < 0.98).mean()) if lit.any() else 0.0)
                 leak.append(float(np.maximum(d[dark], 0).mean()) if dark.any() else 0.0)
-            default = " (default)" if (no, db) == (0.5, 1.0) else ""
+            default = " (default)" if (no, db) == (0.25, 0.5) else ""
             per = ", ".join(f"{n} {e:.4f}" for (n, *_), e in zip(cases, errors, strict=True))
             report.line(f"| {no}{default} | {db} | {max(errors):.4f} | {max(acne):.4f} | {max(leak):.4f} | {per} |")
     if not args.no_write:
         report.write(
             args.out,
             intro=(
-                "Acne falls to almost nothing with half a texel of normal offset; every further texel "
-                "of either bias lets more light through in the shadows (leak). The defaults are the "
-                "row marked (default)."
+                "Without bias a third to a half of the lit pixels shadow themselves (acne); a quarter "
+                "texel of normal offset with half a texel of depth bias brings that to 0.3% (what is "
+                "left are the maps' penumbra edges), and every further texel of either bias lets more "
+                "light through in the shadows (leak). The defaults are the row marked (default)."
             ),
         )
 

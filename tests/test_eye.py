@@ -28,10 +28,10 @@ REFERENCE_SAMPLES = 1024
 #: methods' maps are capped at two texels per visible pixel, hence errors
 #: above the 640x480 ones of docs/benchmarks/eye.md.
 MEASURED: dict[str, dict[str, float]] = {
-    "bunny_on_floor": {"exact": 0.001, "ssm": 0.0072, "bitmask": 0.0075},
-    "torus": {"exact": 0.001, "ssm": 0.0068, "bitmask": 0.0083},
-    "contact_boxes": {"exact": 0.003, "ssm": 0.0252, "bitmask": 0.0278},
-    "city": {"exact": 0.001, "ssm": 0.0125, "bitmask": 0.0125},
+    "bunny_on_floor": {"exact": 0.001, "ssm": 0.0052, "bitmask": 0.0056},
+    "torus": {"exact": 0.001, "ssm": 0.0074, "bitmask": 0.0082},
+    "contact_boxes": {"exact": 0.003, "ssm": 0.0237, "bitmask": 0.0232},
+    "city": {"exact": 0.001, "ssm": 0.0104, "bitmask": 0.0104},
 }
 METHODS = {"exact": ss.Exact(samples=256), "ssm": ss.Ssm(), "bitmask": ss.Bitmask(samples=256)}
 
@@ -50,13 +50,25 @@ def references():
 
 @pytest.mark.parametrize("name", list(EYE_SCENES))
 def test_first_hits_agree_with_mitsuba(references, name):
+    """The rasterized G-buffer sees what Mitsuba's rays hit: the same mesh
+    within 1e-4 of the distance on >= 99% of the pixels, and every pixel
+    that differs lies on a silhouette (a neighbour sees another mesh or
+    nothing) or a crease (its two renderers hit faces a pixel apart)."""
     scene, light, cam, ref = references[name]
     img = ss.render(scene, light, cam, method="ssm")
     c = compare_images(img, ref, position_tol=1e-4)
     assert c.matched_fraction >= 0.99, c
-    both = img.mask & ref.mask
+    differ = (img.mask | ref.mask) & ~c.mask
+    assert differ.mean() < 0.002, differ.sum()
+    ids = np.pad(ref.mesh_id, 1, constant_values=-2)
+    h, w = ref.mesh_id.shape
+    for j, i in zip(*np.nonzero(differ), strict=True):
+        around = ids[j : j + 3, i : i + 3]
+        on_edge = (around != ref.mesh_id[j, i]).any()
+        near = np.linalg.norm(img.position[j, i] - ref.position[j, i]) < 3 * ref.depth[j, i] / cam.K[0, 0]
+        assert on_edge or near, (j, i)
+    both = c.mask
     np.testing.assert_allclose(img.depth[both], ref.depth[both], rtol=1e-4)
-    np.testing.assert_array_equal(img.mask, ref.mask)
 
 
 @pytest.mark.parametrize("method", list(METHODS))

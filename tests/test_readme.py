@@ -39,3 +39,15 @@ def test_usage_example_runs():
 def ss_one_pass(env):
     ss = env["ss"]
     return ss.soft_shadow_map(env["scene"], env["light"], resolution=256, passes=1).visibility
+
+
+def test_eye_view_example_runs():
+    text = README.read_text()
+    block = re.search(r"```python\n(import softshadow as ss\nfrom softshadow import eye_scenes.*?)```", text, re.S)
+    assert block, "the eye-view example is missing from the README"
+    env: dict = {}
+    exec(compile(block.group(1), "README.md", "exec"), env)
+    img = env["img"]
+    assert img.visibility.shape == (240, 320) and img.mask.mean() > 0.3
+    # The bunny shadows the floor and itself: some pixels it sees are dark.
+    assert (img.visibility[img.mask] < 0.05).mean() > 0.02

@@ -1,17 +1,25 @@
 //! The eye view's G-buffer: the first surface each pixel sees.
 //!
-//! Camera rays through pixel centres (`geom/camera.rs`) are cast against a
-//! BVH of every mesh's triangles (closest hit), as Mitsuba's first hits
-//! are: the same pixel-centre rule, so the two agree pixel for pixel except
-//! where a pixel centre grazes an edge. The BVH holds triangles relative to
-//! the eye in f32; the hit distance is then recomputed in f64 against the
-//! hit triangle's plane, so positions keep f64 precision however far the
-//! scene is from the world origin.
+//! On the CPU every mesh is rasterized from the camera (`raster/`, the
+//! light-view maps' rasterizer: exact edge functions at pixel centres, a tie
+//! rule on shared edges, 1/Z interpolated) keeping the nearest face per
+//! pixel. The camera's frame is a light frame at the eye, (r, u', f); a
+//! principal point off the centre is a shear, `X' = X - dx Z`,
+//! `Y' = Y - dy Z` with `dx = ((W-1)/2 - cx)/f_px`, `dy = (cy - (H-1)/2)/f_px`,
+//! which puts pixel [j, i]'s centre on the centred grid's texel [j, i]
+//! (tangent half-extents W/(2 f_px), H/(2 f_px)). The GPU casts the same
+//! pixel-centre rays through a BVH (`camera_bvh`, `pixel_ray`). Either way
+//! the hit is then recomputed in f64 on the face's plane along the pixel's
+//! ray (`from_hits`), so positions keep f64 precision however far the scene
+//! is from the origin, and agree with Mitsuba's first hits (the same
+//! pixel-centre rays) except where a pixel centre grazes an edge.
 
 use crate::error::{Error, Result};
 use crate::geom::camera::Camera;
+use crate::geom::light::MapGrid;
 use crate::geom::mesh::MeshRef;
 use crate::methods::exact::Bvh;
+use crate::raster::Prepared;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -102,19 +110,38 @@ pub fn pixel_ray(camera: &Camera, k: usize) -> Vec3 {
         .as_vec3()
 }
 
-/// Casts the camera's pixel-centre rays into the scene.
-pub fn first_hits(camera: &Camera, scene: &SceneTriangles) -> GBuffer {
-    let bvh = camera_bvh(camera, scene);
-    let n = camera.width * camera.height;
-    let hit: Vec<Option<u32>> = (0..n)
-        .into_par_iter()
-        .with_min_len(256)
-        .map(|k| {
-            bvh.nearest(Vec3::ZERO, pixel_ray(camera, k), f32::INFINITY)
-                .map(|(_, tri)| tri)
+/// The nearest face at every pixel centre, rasterized from the camera.
+pub fn rasterized_hits(camera: &Camera, scene: &SceneTriangles) -> Vec<Option<u32>> {
+    let (w, h, f) = (camera.width as f64, camera.height as f64, camera.focal);
+    let dx = ((w - 1.0) / 2.0 - camera.cx) / f;
+    let dy = (camera.cy - (h - 1.0) / 2.0) / f;
+    let verts: Vec<DVec3> = scene
+        .corners
+        .par_iter()
+        .flat_map_iter(|t| {
+            t.map(|p| {
+                let d = p - camera.eye;
+                let z = d.dot(camera.forward);
+                DVec3::new(d.dot(camera.right) - dx * z, d.dot(camera.up) - dy * z, z)
+            })
         })
         .collect();
-    from_hits(camera, scene, &hit)
+    let faces: Vec<[u32; 3]> = (0..scene.corners.len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    // The camera's validated grid: its tangents are within MAX_TANGENT.
+    let grid = match MapGrid::new(camera.width, camera.height, [w / (2.0 * f), h / (2.0 * f)]) {
+        Ok(g) => g,
+        Err(_) => return vec![None; camera.width * camera.height],
+    };
+    let far = verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
+    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
+    Prepared::with_faces(&grid, &verts, &faces, near).nearest_faces()
+}
+
+/// What each pixel of `camera` sees of the scene.
+pub fn first_hits(camera: &Camera, scene: &SceneTriangles) -> GBuffer {
+    from_hits(camera, scene, &rasterized_hits(camera, scene))
 }
 
 /// The G-buffer from the triangle each pixel's ray hit first (`None`: no

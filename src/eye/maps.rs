@@ -27,6 +27,7 @@ use crate::error::Result;
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
 use crate::methods::{Input, LightPoint, Method, ShadowInputs};
+pub(crate) use crate::pipeline::Stopwatch;
 use crate::raster::Prepared;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -132,7 +133,7 @@ pub fn biased_points(
 /// with their camera-facing `normals`). Returns the visibility per point and
 /// the maps.
 #[allow(clippy::too_many_arguments)]
-pub fn shade(
+pub(crate) fn shade(
     space: &LightSpace,
     unit: f64,
     light_size: [f64; 2],
@@ -143,9 +144,12 @@ pub fn shade(
     points: &[[f64; 3]],
     normals: &[[f32; 3]],
     bias: &Bias,
+    sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps)> {
     let mut layers = occluder_layers(&grid, tris, passes);
+    sw.lap("raster_occluders");
     let lp = biased_points(space, unit, &grid, points, normals, bias);
+    sw.lap("bias");
     let inputs = ShadowInputs {
         grid,
         occluder_grid: grid,
@@ -163,12 +167,14 @@ pub fn shade(
     };
     let valid: Vec<LightPoint> = lp.iter().map(|p| p.unwrap_or(empty)).collect();
     let mut v = crate::pipeline::shade_points(method, &inputs, &valid);
+    sw.lap("shadow");
     for (v, p) in v.iter_mut().zip(&lp) {
         if p.is_none() {
             *v = 0.0;
         }
     }
     super::tangent_plane::bound(&mut v, space, unit, light_size, points, normals);
+    sw.lap("tangent_plane");
     // The maps back in the user's depth.
     for l in layers.iter_mut() {
         l.par_iter_mut()

@@ -41,7 +41,8 @@ pub fn bound(
             let p = DVec3::from_array(*p);
             let n = Vec3::from_array(*n).as_dvec3();
             let front = plane_side(space, unit, p, n).map_or(0.0, |s| front_fraction(s, half));
-            *v = v.min(front as f32);
+            // (+ 0.0 turns a -0.0 from the clamp into 0.)
+            *v = v.min(front as f32) + 0.0;
         });
 }
 

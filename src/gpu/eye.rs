@@ -7,8 +7,11 @@
 //!   (`gbuffer::camera_bvh`, built on the CPU) for its nearest triangle,
 //!   t in (0, best), as `Bvh::nearest` does; the slot comes back, is mapped to
 //!   the input triangle (`Bvh::order`) and the G-buffer is built on the CPU
-//!   in f64 (`gbuffer::from_hits`, shared). Pixels may differ only where a
-//!   centre grazes an edge and the device contracts a product differently.
+//!   in f64 (`gbuffer::from_hits`, shared). The cast's CPU twin is the
+//!   camera BVH's `nearest` (the device tests find the same triangle at
+//!   every pixel on lavapipe); the CPU's own G-buffer rasterizes the same
+//!   pixel centres (`gbuffer::rasterized_hits`), so the two backends'
+//!   G-buffers may differ where a pixel centre grazes an edge.
 //! * Framing (CPU, shared with the CPU path: `eye::frame`, `eye::map_grid`):
 //!   the light space, the depth unit, the triangles in kernel light space,
 //!   the focused grid and its resolution.
@@ -218,7 +221,7 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
             vis[k] = v;
         }
         maps = Some(m);
-        sw.lap("shadow");
+        sw.lap("maps_out");
     } else {
         method = eye::resolve_at_camera(call, Backend::Gpu)?;
     }
@@ -627,9 +630,6 @@ fn shade_maps(
     fits(g, "resolution", (acc_words * 4).max(n_points as u64 * 16))?;
     let (cols, steps) = window_bounds(&grid, f.light_size, w_bound, &groups);
     let (steps_per_chunk, chunks) = gather::points_chunking(cols, steps, method);
-    if std::env::var("SOFTSHADOW_DEBUG_CHUNKS").is_ok() {
-        eprintln!("DEBUG grid {}x{} cols {cols} steps {steps} -> {steps_per_chunk} steps x {chunks} chunks", grid.width, grid.height);
-    }
     let mut params = gather_params(&grid, &grid, f.light_size, passes, method);
     params.rec_w = 0;
     params.rec_h = 0;
@@ -670,6 +670,12 @@ fn shade_maps(
         );
         let points_buf = upload(device, "points", &lanes);
         let groups_buf = upload(device, "point groups", &groups);
+        let status = storage(
+            device,
+            "status",
+            4,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
         sw.lap("upload");
         let timer = StageTimer::new(g, 3);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -677,6 +683,7 @@ fn shade_maps(
         });
         enc.clear_buffer(&layer_w_max, 0, None);
         enc.clear_buffer(&acc, 0, None);
+        enc.clear_buffer(&status, 0, None);
         raster.record_occluders(g, &mut enc, &timer, &maps_buf, 0, &grid, passes);
         let b = GatherBuffers {
             maps: &maps_buf,
@@ -696,12 +703,13 @@ fn shade_maps(
             let pts = PointsBuffers {
                 points: &points_buf,
                 groups: &groups_buf,
+                status: &status,
                 params: PointsParams {
                     n_points: n_points as u32,
                     steps_per_chunk,
-                    ..Default::default()
+                    chunks,
+                    _pad: 0,
                 },
-                chunks,
             };
             gather::record_shade_points(device, &mut pass, method, &b, &params, &pts)?;
         }
@@ -709,10 +717,16 @@ fn shade_maps(
             g,
             enc,
             &timer,
-            &[(&maps_buf, maps_bytes), (&vis, vis_bytes)],
+            &[(&maps_buf, maps_bytes), (&vis, vis_bytes), (&status, 4)],
             sw,
         )
     })?;
+    if words(&out.buffers[2])[0] != 0 {
+        return Err(Error::gpu(
+            "an occluder window outgrew its bound on the GPU (a bug: please report it); \
+             use backend=\"cpu\"",
+        ));
+    }
     let shaded = visibility(&out.buffers[1])?;
     let mut v = vec![1f32; valid.len()];
     for (&n, &s) in order.iter().zip(&shaded) {
@@ -733,6 +747,7 @@ fn shade_maps(
         &f.points,
         &f.normals,
     );
+    sw.lap("tangent_plane");
     // The layers back in the user's depth; the farthest starts at 0 bits
     // (before its atomicMax): 0 means empty.
     let m = words(&out.buffers[0]);

@@ -74,8 +74,8 @@ const _: () = assert!(POINT_GROUP as usize == crate::methods::gather::POINTS_PER
 pub struct PointsParams {
     pub n_points: u32,
     pub steps_per_chunk: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    pub chunks: u32,
+    pub _pad: u32,
 }
 
 /// `GatherPoint` of gather.wgsl: a lane's tangent (x, y) and 1/depth.
@@ -379,13 +379,13 @@ pub fn record_shade(
 }
 
 /// The points-mode buffers beside `GatherBuffers`: the sorted points, their
-/// groups' bounds and the points' parameters.
+/// groups' bounds, the status word (zeroed) and the points' parameters
+/// (`params.chunks` dispatches per layer).
 pub struct PointsBuffers<'a> {
     pub points: &'a wgpu::Buffer,
     pub groups: &'a wgpu::Buffer,
+    pub status: &'a wgpu::Buffer,
     pub params: PointsParams,
-    /// Dispatches per layer (runs of `params.steps_per_chunk` steps).
-    pub chunks: u32,
 }
 
 /// Records the points-mode shading pass body: for every layer and chunk of
@@ -406,7 +406,7 @@ pub fn record_shade_points(
     let groups = groups_1d(pts.params.n_points, POINT_GROUP);
     pass.set_pipeline(&p.chunk);
     for layer in 0..params.n_layers {
-        for chunk in 0..pts.chunks {
+        for chunk in 0..pts.params.chunks {
             let c = uniform(
                 device,
                 "chunk params",
@@ -433,6 +433,7 @@ pub fn record_shade_points(
                     Some(&pu),
                     Some(pts.points),
                     Some(pts.groups),
+                    Some(pts.status),
                 ],
             );
             pass.set_bind_group(0, &bg, &[]);

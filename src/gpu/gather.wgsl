@@ -266,10 +266,11 @@ fn gather_chunk(rc: Receiver) {
 struct PointsParams {
     // Points, a multiple of POINTS_GROUP (the last group padded with inactive lanes).
     n_points: u32,
-    // Outward steps (two occluder rows each) of a group's window per chunk.
+    // Outward steps (two occluder rows each) of a group's window per chunk,
+    // and the chunks per layer (sized on the CPU from a bound on the windows).
     steps_per_chunk: u32,
-    _pad0: u32,
-    _pad1: u32,
+    chunks: u32,
+    _pad: u32,
 }
 
 // One lane: tangent (x, y) and 1/depth; live = 0 where there is no receiver.
@@ -299,6 +300,9 @@ const POINTS_GROUP: u32 = 64u;
 @group(0) @binding(9) var<uniform> pp: PointsParams;
 @group(0) @binding(10) var<storage, read> points: array<GatherPoint>;
 @group(0) @binding(11) var<storage, read> point_groups: array<GroupBounds>;
+// Raised when a group's window outlasts the last chunk (the CPU's bound was
+// too small): an error, never a silently partial sum.
+@group(0) @binding(12) var<storage, read_write> points_status: array<atomic<u32>>;
 
 fn point_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
     return gid.x + gid.y * groups.x * POINTS_GROUP;
@@ -425,6 +429,9 @@ fn gather_points_chunk(rc: Receiver) {
     let steps = max(gr.j_c - gr.j_lo + 1, gr.j_hi - gr.j_c);
     let m0 = i32(chunk.chunk * pp.steps_per_chunk);
     let m1 = min(m0 + i32(pp.steps_per_chunk), steps);
+    if chunk.chunk + 1u == pp.chunks && m1 < steps {
+        atomicOr(&points_status[0], 1u);
+    }
     for (var m = m0; m < m1; m++) {
         let up = gr.j_c - m;
         if up >= gr.j_lo {

@@ -218,8 +218,8 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
         rust_layout!(PointsParams {
             n_points,
             steps_per_chunk,
-            _pad0,
-            _pad1
+            chunks,
+            _pad
         }),
     );
     assert_same(

@@ -4,7 +4,7 @@
 //! or, by depth peeling, the next layer beyond a previous one.
 
 use super::scan::{band_rows, raster_tri};
-use super::setup::{setup_triangles, SetupTri};
+use super::setup::{setup_triangles, setup_triangles_with_faces, SetupTri};
 use crate::geom::light::MapGrid;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -26,6 +26,8 @@ pub struct Prepared<'g> {
     binned: Vec<u32>,
     counts: Vec<u32>,
     rows_per_band: usize,
+    /// The face of each set-up triangle (`with_faces` only).
+    faces: Vec<u32>,
 }
 
 /// Relative depth gap under which a surface counts as the layer already peeled
@@ -37,8 +39,22 @@ impl<'g> Prepared<'g> {
     /// the clip distance from the light's plane: geometry closer than it (or
     /// behind the light) is cut away.
     pub fn new(grid: &'g MapGrid, verts: &[DVec3], faces: &[[u32; 3]], near: f64) -> Prepared<'g> {
-        let tris = setup_triangles(grid, verts, faces, near);
+        Self::binned(grid, setup_triangles(grid, verts, faces, near), vec![])
+    }
 
+    /// `new`, remembering which face each texel's nearest surface is (see
+    /// `nearest_faces`).
+    pub fn with_faces(
+        grid: &'g MapGrid,
+        verts: &[DVec3],
+        faces: &[[u32; 3]],
+        near: f64,
+    ) -> Prepared<'g> {
+        let (tris, ids) = setup_triangles_with_faces(grid, verts, faces, near);
+        Self::binned(grid, tris, ids)
+    }
+
+    fn binned(grid: &'g MapGrid, tris: Vec<SetupTri>, faces: Vec<u32>) -> Prepared<'g> {
         // Bin triangle indices by band (counting sort).
         let rows_per_band = band_rows(grid.height);
         let n_bands = grid.height.div_ceil(rows_per_band);
@@ -65,15 +81,42 @@ impl<'g> Prepared<'g> {
             binned,
             counts,
             rows_per_band,
+            faces,
         }
     }
 
-    /// Runs `visit(band's rows, band's slice of each output, triangle)` for every
+    /// The face whose surface is nearest at each texel centre (`None`:
+    /// nothing), for a `Prepared::with_faces`. Equal depths keep the face
+    /// rasterized first (the lower index within a band).
+    pub fn nearest_faces(&self) -> Vec<Option<u32>> {
+        // The face ids ride in a second f32 map as bit patterns (moved, never
+        // computed with), so the bands' one output type serves both.
+        let none = f32::from_bits(u32::MAX);
+        let mut outs = vec![
+            vec![f32::INFINITY; self.grid.len()],
+            vec![none; self.grid.len()],
+        ];
+        self.bands(&mut outs, |k, rows, o| {
+            let id = f32::from_bits(self.faces[k]);
+            raster_tri(&self.tris[k], self.grid, rows, |idx, z| {
+                if z < o[0][idx] {
+                    o[0][idx] = z;
+                    o[1][idx] = id;
+                }
+            })
+        });
+        outs[1]
+            .iter()
+            .map(|f| (f.to_bits() != u32::MAX).then_some(f.to_bits()))
+            .collect()
+    }
+
+    /// Runs `visit(triangle index, band's rows, band's slice of each output)` for every
     /// band in parallel, each band owning its rows of the outputs.
     fn bands(
         &self,
         outputs: &mut [Vec<f32>],
-        visit: impl Fn(&SetupTri, std::ops::Range<usize>, &mut [&mut [f32]]) + Sync,
+        visit: impl Fn(usize, std::ops::Range<usize>, &mut [&mut [f32]]) + Sync,
     ) {
         let band_len = self.rows_per_band * self.grid.width;
         let mut per_band: Vec<Vec<&mut [f32]>> =
@@ -90,7 +133,7 @@ impl<'g> Prepared<'g> {
                 let rows =
                     b * self.rows_per_band..((b + 1) * self.rows_per_band).min(self.grid.height);
                 for &k in &self.binned[self.counts[b] as usize..self.counts[b + 1] as usize] {
-                    visit(&self.tris[k as usize], rows.clone(), &mut slices);
+                    visit(k as usize, rows.clone(), &mut slices);
                 }
             });
     }
@@ -101,8 +144,8 @@ impl<'g> Prepared<'g> {
         if want_farthest {
             outs.push(vec![f32::INFINITY; self.grid.len()]);
         }
-        self.bands(&mut outs, |t, rows, o| {
-            raster_tri(t, self.grid, rows, |idx, z| {
+        self.bands(&mut outs, |k, rows, o| {
+            raster_tri(&self.tris[k], self.grid, rows, |idx, z| {
                 if z < o[0][idx] {
                     o[0][idx] = z;
                 }
@@ -125,9 +168,9 @@ impl<'g> Prepared<'g> {
     pub fn peel(&self, previous: &[f32]) -> Vec<f32> {
         let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
         let band_len = self.rows_per_band * self.grid.width;
-        self.bands(&mut outs, |t, rows, o| {
+        self.bands(&mut outs, |k, rows, o| {
             let base = rows.start / self.rows_per_band * band_len;
-            raster_tri(t, self.grid, rows, |idx, z| {
+            raster_tri(&self.tris[k], self.grid, rows, |idx, z| {
                 let floor = previous[base + idx];
                 if z > floor * (1.0 + PEEL_GAP) && z < o[0][idx] {
                     o[0][idx] = z;

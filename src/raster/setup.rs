@@ -209,6 +209,33 @@ impl Projector {
     }
 }
 
+/// `setup_triangles`, with the face each set-up triangle came from (a face
+/// clipped into several pieces gives each piece its index).
+pub(crate) fn setup_triangles_with_faces(
+    grid: &MapGrid,
+    verts: &[DVec3],
+    faces: &[[u32; 3]],
+    near: f64,
+) -> (Vec<SetupTri>, Vec<u32>) {
+    let proj = Projector::new(grid, near);
+    let snapped: Vec<Snapped> = verts.par_iter().map(|&q| proj.snap(q)).collect();
+    faces
+        .par_chunks(4096)
+        .enumerate()
+        .flat_map_iter(|(c, chunk)| {
+            let mut out = Vec::with_capacity(chunk.len());
+            let mut ids = Vec::with_capacity(chunk.len());
+            for (k, f) in chunk.iter().enumerate() {
+                let tri = f.map(|i| verts[i as usize]);
+                let sn = f.map(|i| snapped[i as usize]);
+                proj.setup(tri, sn, &mut out);
+                ids.resize(out.len(), (c * 4096 + k) as u32);
+            }
+            out.into_iter().zip(ids)
+        })
+        .unzip()
+}
+
 /// Projects, clips and snaps a mesh whose vertices are already in light space
 /// (f64) into triangles ready to rasterize; the GPU backend uploads these.
 pub(crate) fn setup_triangles(
