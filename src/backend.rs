@@ -171,6 +171,54 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
     })
 }
 
+/// A shadow map of a scene where every mesh casts and receives shadows.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneCall<'a> {
+    /// Every mesh, as one.
+    pub scene: MeshRef<'a>,
+    pub light: &'a Light,
+    pub resolution: (i64, i64),
+    pub extent: Option<[f64; 2]>,
+    pub method: MethodConfig,
+    /// The map methods' self-shadowing biases (see `eye/maps.rs`).
+    pub bias: crate::eye::Bias,
+    pub backend: BackendChoice,
+    pub threads: Option<i64>,
+}
+
+/// A self-shadowing scene -> light-view maps -> visibility (the CPU: its
+/// receiver texels are shaded as points, which the GPU twin of the eye view
+/// does not cover yet).
+pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
+    let (w, h) = check_resolution("resolution", call.resolution)?;
+    let cap = threads::resolve(call.threads)?;
+    if call.backend == BackendChoice::Gpu {
+        return Err(Error::invalid(
+            "backend",
+            "the light-view maps of a scene shadowing itself run on the CPU only in this version; \
+             use backend=\"cpu\"",
+        ));
+    }
+    let ctx = CallContext {
+        backend: Backend::Cpu,
+        resolution: (w, h),
+        depth_layers: None,
+    };
+    let method = call.method.resolve(&ctx)?;
+    let (output, threads) = threads::run_capped(cap, || {
+        let space = mesh_space(call.light, &[call.scene])?;
+        let extent = call.extent.map(|e| space.kernel_extent(e));
+        let settings = MapSettings::new(w, h, extent, &method);
+        pipeline::from_scene(call.scene, &space, &settings, &call.bias)
+    })?;
+    Ok(Run {
+        output,
+        method,
+        backend: Backend::Cpu,
+        threads,
+    })
+}
+
 /// The light space of a scene made of `meshes`: a sun's depth origin and
 /// range are fitted to their vertices (checked first: a non-finite vertex
 /// is named, not folded into the bounds).

@@ -31,6 +31,7 @@ __all__ = [
     "check_mesh",
     "shadow_map_from_meshes",
     "shadow_map_from_depth",
+    "shadow_map_from_scene",
     "sample_points",
     "receiver_points",
     "gpu_available",
@@ -349,6 +350,27 @@ def shadow_map_from_meshes(
 ) -> MeshShadowResult:
     """Meshes -> light-view maps -> visibility, on ``backend`` ("cpu", "gpu"
     or "auto"). ``method`` is a config, or a name with the loose options."""
+
+def shadow_map_from_scene(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.uint32],
+    light: _Light,
+    resolution: _Resolution,
+    extent: tuple[float, float] | None,
+    method: _MethodArg,
+    *,
+    normal_offset: float | None = None,
+    depth_bias: float | None = None,
+    passes: int | None = None,
+    samples: int | None = None,
+    occluder_resolution: _Resolution | None = None,
+    hierarchy: bool | None = None,
+    precision: str | None = None,
+    backend: str = "cpu",
+    threads: int | None = None,
+) -> MeshShadowResult:
+    """A scene shadowing itself (every mesh as one) -> light-view maps ->
+    visibility, each receiver texel shaded at its own surface point."""
 
 def shadow_map_from_depth(
     occluder_depth: npt.NDArray[np.float32],

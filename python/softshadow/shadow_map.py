@@ -65,6 +65,8 @@ class ShadowMap:
     plane across the light's direction touching the scene on its side)."""
     depth_range: float | None = None
     """For a DirectionalLight: the scene's depth range along the light."""
+    self_shadowing: bool = False
+    """True for the map of a ``Scene(meshes=...)``: every mesh casts and receives."""
 
     def _light_args(self) -> tuple[Any, ...]:
         if isinstance(self.light, DirectionalLight):
@@ -116,6 +118,11 @@ class ShadowMap:
         when the extent was fitted (no shadow can fall there) and a
         ValueError otherwise. ``threads`` as for :func:`soft_shadow_map`.
         """
+        if self.self_shadowing:
+            raise ValueError(
+                "points: a scene shadowing itself needs each point's normal to shade it without acne; "
+                "use softshadow.render, or the map's own texels (sm.visibility)"
+            )
         pts = np.asarray(points)
         if pts.dtype.kind not in "fiu":
             raise TypeError(f"points: must be real numbers, got dtype {pts.dtype}")
@@ -174,16 +181,27 @@ def soft_shadow_map(
     occluder_resolution: int | tuple[int, int] | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
+    normal_offset: float | None = None,
+    depth_bias: float | None = None,
 ) -> ShadowMap:
-    """Soft shadow map of ``scene``'s occluders on its receivers.
+    """Soft shadow map of ``scene``'s occluders on its receivers, or of a
+    scene shadowing itself.
 
     Parameters
     ----------
     scene, light
-        The geometry (the split scene: occluders and receivers) and the
-        light: a rectangle, or a :class:`DirectionalLight`, whose maps are
-        orthographic (world half-extents; depth from the plane across the
-        light touching the scene, ``sm.depth_origin``).
+        The geometry and the light: a rectangle, or a
+        :class:`DirectionalLight`, whose maps are orthographic (world
+        half-extents; depth from the plane across the light touching the
+        scene, ``sm.depth_origin``). With the split scene
+        (``Scene(occluders=..., receivers=...)``) occluders shadow receivers
+        and nothing shadows itself (the paper's setting). With
+        ``Scene(meshes=...)`` every mesh casts and receives: the receiver map
+        is the nearest surface seen from the light, and each of its texels is
+        shaded at its own surface point as :func:`softshadow.render` shades a
+        pixel's (``exact`` with offset shadow rays, the map methods with the
+        biases ``normal_offset`` and ``depth_bias``, in texels, and the
+        tangent-plane bound; CPU only); ``sample`` is then not available.
     resolution
         ``int`` for a square map or ``(W, H)``. The receiver map shares it, and
         the occluder maps unless the method's ``occluder_resolution`` says
@@ -261,22 +279,9 @@ def soft_shadow_map(
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
     if not isinstance(light, (RectLight, DirectionalLight)):
         raise TypeError(f"light: must be a softshadow.RectLight or DirectionalLight, got {type(light).__name__}")
-    if not scene.split:
-        raise ValueError(
-            "scene: soft_shadow_map maps the paper's split (Scene(occluders=..., receivers=...)); "
-            "for a scene where every mesh casts and receives, use softshadow.render"
-        )
     ext = None if extent is None else check.pair("extent", extent)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
-    r = _core.shadow_map_from_meshes(
-        ov,
-        of,
-        rv,
-        rf,
-        light._core_args(),
-        resolution,
-        ext,
-        method,
+    loose: dict[str, Any] = dict(
         passes=passes,
         samples=samples,
         occluder_resolution=occluder_resolution,
@@ -285,6 +290,22 @@ def soft_shadow_map(
         backend=backend,
         threads=threads,
     )
+    if scene.split:
+        if normal_offset is not None or depth_bias is not None:
+            raise TypeError("normal_offset: the biases are for scenes shadowing themselves (Scene(meshes=...))")
+        r = _core.shadow_map_from_meshes(ov, of, rv, rf, light._core_args(), resolution, ext, method, **loose)
+    else:
+        r = _core.shadow_map_from_scene(
+            ov,
+            of,
+            light._core_args(),
+            resolution,
+            ext,
+            method,
+            normal_offset=normal_offset,
+            depth_bias=depth_bias,
+            **loose,
+        )
     return ShadowMap(
         visibility=r.visibility,
         receiver_depth=r.receiver_depth,
@@ -299,6 +320,7 @@ def soft_shadow_map(
         backend=r.backend,
         threads=r.threads,
         _occluder_mesh=(ov, of) if r.occluder_depth is None else None,
+        self_shadowing=not scene.split,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
     )

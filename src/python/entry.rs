@@ -5,7 +5,7 @@ use super::configs::{method_arg, Loose};
 use super::convert::{light_of, mesh, opt_int, same_shape, slice, space_of, triples, Light};
 use super::errors;
 use super::results::{DepthShadowResult, MeshShadowResult};
-use crate::backend::{self, BackendChoice, DepthCall, MeshCall};
+use crate::backend::{self, BackendChoice, DepthCall, MeshCall, SceneCall};
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::Light as CoreLight;
 use crate::methods::MethodConfig;
@@ -79,6 +79,53 @@ pub fn shadow_map_from_meshes<'py>(
             threads: opt_int("threads", threads.as_ref())?,
         };
         let run = py.detach(|| backend::shadow_map(&call))?;
+        MeshShadowResult::new(py, run)
+    })
+}
+
+/// A scene shadowing itself (one mesh of every mesh) -> light-view maps ->
+/// visibility.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, light, resolution, extent, method, *, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn shadow_map_from_scene<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    light: Light,
+    resolution: &Bound<'py, PyAny>,
+    extent: Option<(f64, f64)>,
+    method: &Bound<'py, PyAny>,
+    normal_offset: Option<f64>,
+    depth_bias: Option<f64>,
+    passes: Option<Bound<'py, PyAny>>,
+    samples: Option<Bound<'py, PyAny>>,
+    occluder_resolution: Option<Bound<'py, PyAny>>,
+    hierarchy: Option<Bound<'py, PyAny>>,
+    precision: Option<Bound<'py, PyAny>>,
+    backend: &str,
+    threads: Option<Bound<'py, PyAny>>,
+) -> PyResult<MeshShadowResult> {
+    errors::guard(|| {
+        let light = light_of(light)?;
+        let loose = Loose {
+            passes,
+            samples,
+            occluder_resolution,
+            hierarchy,
+            precision,
+        };
+        let call = SceneCall {
+            scene: mesh("meshes", &vertices, &faces)?,
+            light: &light,
+            resolution: super::convert::resolution("resolution", resolution)?,
+            extent: extent.map(|e| [e.0, e.1]),
+            method: method_arg(method, &loose)?,
+            bias: crate::eye::Bias::new(normal_offset, depth_bias)?,
+            backend: BackendChoice::parse(backend)?,
+            threads: opt_int("threads", threads.as_ref())?,
+        };
+        let run = py.detach(|| backend::scene_shadow_map(&call))?;
         MeshShadowResult::new(py, run)
     })
 }

@@ -41,6 +41,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entry::check_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(entry::shadow_map_from_meshes, m)?)?;
     m.add_function(wrap_pyfunction!(entry::shadow_map_from_depth, m)?)?;
+    m.add_function(wrap_pyfunction!(entry::shadow_map_from_scene, m)?)?;
     m.add_function(wrap_pyfunction!(entry::sample_points, m)?)?;
     m.add_function(wrap_pyfunction!(entry::receiver_points, m)?)?;
     m.add_function(wrap_pyfunction!(gpu::gpu_available, m)?)?;

@@ -1,0 +1,135 @@
+//! Light-view maps of a scene where every mesh casts and receives shadows
+//! (`soft_shadow_map` of `Scene(meshes=...)`): the receiver map is the
+//! nearest surface seen from the light, and every receiver texel is shaded
+//! at its own surface point as the eye view shades a pixel's (`crate::eye`):
+//! `exact` with offset shadow rays, the map methods with the biases and the
+//! tangent-plane bound, every mesh an occluder, the texel's own included.
+//!
+//! A texel's point is the light's ray through the texel centre at the
+//! receiver map's depth; its normal the face's there (the face rasterized
+//! nearest), turned toward the light.
+
+use crate::error::Result;
+use crate::eye::{maps, rays, Bias};
+use crate::geom::light_space::LightSpace;
+use crate::geom::mesh::MeshRef;
+use crate::methods::Input;
+use crate::raster::Prepared;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::frame::{frame_scene, FramedScene, Stopwatch};
+use super::from_meshes::light_space_triangles;
+use super::{MapSettings, ShadowResult};
+
+/// Soft shadow map of a scene shadowing itself.
+pub fn from_scene(
+    scene: MeshRef,
+    light: &LightSpace,
+    s: &MapSettings,
+    bias: &Bias,
+) -> Result<ShadowResult> {
+    let mut sw = Stopwatch::new();
+    let FramedScene {
+        occ_ls,
+        rec_ls: _,
+        grid,
+        occluder_grid,
+        near,
+        unit,
+        light_size,
+    } = frame_scene(&scene, &scene, light, s, &mut sw)?;
+    let prepared = Prepared::with_faces(&grid, &occ_ls, scene.faces, near);
+    let faces = prepared.nearest_faces();
+    let receiver = prepared.nearest_farthest(false).nearest;
+    sw.lap("raster_receivers");
+    // The receiver texels' world points and light-facing normals.
+    let texels: Vec<usize> = (0..grid.len()).filter(|&k| faces[k].is_some()).collect();
+    let (points, normals): (Vec<[f64; 3]>, Vec<[f32; 3]>) = texels
+        .par_iter()
+        .map(|&k| {
+            let z = receiver[k] as f64 * unit;
+            let p = light.point_at(grid.x_of(k % grid.width), grid.y_of(k / grid.width), z);
+            let f = scene.faces[faces[k].unwrap_or(0) as usize];
+            let [a, b, c] = f.map(|i| DVec3::from_array(scene.vertices[i as usize]));
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            let toward = match light {
+                LightSpace::Rect(l) => l.center - p,
+                LightSpace::Sun(s) => -s.light.n,
+            };
+            let n = if n.dot(toward) < 0.0 { -n } else { n };
+            (p.to_array(), n.as_vec3().to_array())
+        })
+        .unzip();
+    sw.lap("receiver_points");
+    let mut visibility = vec![1f32; grid.len()];
+    let (front, back, middle) = if s.method.reads_input(Input::OccluderTriangles) {
+        let tris: Vec<[Vec3; 3]> = light_space_triangles(&occ_ls, scene.faces);
+        sw.lap("triangles");
+        let starts = rays::ray_starts(light, unit, &points, &normals);
+        let samples = match s.method {
+            crate::methods::Method::Exact { samples }
+                if !crate::geom::light::is_point(light_size) =>
+            {
+                samples
+            }
+            _ => 1,
+        };
+        // Keys are texel indices, as the light-view exact's.
+        let keyed: Vec<Option<rays::RayStart>> = {
+            let mut all = vec![None; grid.len()];
+            for (&k, st) in texels.iter().zip(starts) {
+                all[k] = st;
+            }
+            all
+        };
+        let v = rays::visibility(light_size, tris, &keyed, samples);
+        for &k in &texels {
+            visibility[k] = v[k];
+        }
+        sw.lap("shadow");
+        (None, None, vec![])
+    } else {
+        let tris = maps::LightTriangles {
+            verts: occ_ls,
+            faces: scene.faces.to_vec(),
+        };
+        let (v, m) = maps::shade(
+            light,
+            unit,
+            light_size,
+            &tris,
+            occluder_grid,
+            s.passes,
+            s.method,
+            &points,
+            &normals,
+            bias,
+            &mut sw,
+        )?;
+        for (&k, v) in texels.iter().zip(v) {
+            visibility[k] = v;
+        }
+        // The layers come back in the user's depth already.
+        let mut layers = m.layers;
+        let back = (s.passes >= 2).then(|| layers.pop()).flatten();
+        let front = Some(layers.remove(0));
+        (front, back, layers)
+    };
+    let mut out = ShadowResult {
+        grid,
+        occluder_grid,
+        visibility,
+        receiver,
+        occluder_front: None,
+        occluder_middle: vec![],
+        occluder_back: None,
+        timings: sw.timings,
+        light_space: *light,
+    }
+    .in_user_units(unit);
+    out.occluder_front = front;
+    out.occluder_middle = middle;
+    out.occluder_back = back;
+    Ok(out)
+}
