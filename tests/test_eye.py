@@ -318,3 +318,45 @@ def test_light_view_maps_of_a_scene_shadowing_itself(light):
         sm.sample([[0.0, 0.0, 0.0]])
     with pytest.raises(ValueError, match="backend"):
         ss.soft_shadow_map(scene, light, resolution=32, backend="gpu")
+
+
+def test_image_plot_draws_the_visibility():
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    img = ss.render(sphere_on_floor(), LIGHT, LOW, method="ssm")
+    ax = img.plot(title="sphere")
+    shown = ax.images[0].get_array()
+    np.testing.assert_array_equal(np.asarray(shown)[img.mask], img.visibility[img.mask])
+    assert ax.get_title() == "sphere"
+    plt.close("all")
+
+
+def test_orthographic_maps_from_depth_shade_as_from_meshes():
+    """The sun's orthographic maps handed back through
+    soft_shadow_map_from_depth (angular_size=, world extent) give the
+    visibility the mesh pipeline computed from them."""
+    plate = box((0.2, 1.0, -0.1), (0.8, 0.05, 0.6))
+    floor = box((0.0, -0.01, 0.0), (4.0, 0.02, 4.0))
+    sun = ss.DirectionalLight(direction=(0.3, -1.0, 0.2), up=(0, 0, 1), angular_size=(6, 4))
+    sm = ss.soft_shadow_map(ss.Scene(occluders=[plate], receivers=[floor]), sun, resolution=128, method="bitmask")
+    again = ss.soft_shadow_map_from_depth(
+        sm.occluder_depth,
+        sm.receiver_depth,
+        occluder_depth_back=sm.occluder_depth_back,
+        angular_size=sun.angular_size,
+        extent=sm.extent,
+        method=sm.method,
+    )
+    assert (sm.visibility < 0.5).mean() > 0.05
+    assert np.abs(again.visibility - sm.visibility).mean() < 1e-3
+    assert again.depth_range == pytest.approx(
+        float(np.nanmax(np.where(np.isfinite(sm.receiver_depth), sm.receiver_depth, np.nan)))
+    )
+    with pytest.raises(TypeError, match="light_size"):
+        ss.soft_shadow_map_from_depth(
+            sm.occluder_depth, sm.receiver_depth, light_size=1.0, angular_size=1.0, extent=sm.extent
+        )
+    with pytest.raises(ValueError, match="receiver_depth"):
+        ss.soft_shadow_map_from_depth(sm.occluder_depth, -sm.receiver_depth, angular_size=1.0, extent=sm.extent)

@@ -155,8 +155,10 @@ def render(
         ``normal_offset`` texels along its normal, then ``depth_bias``
         texels toward the light.
     backend
-        ``"cpu"`` or ``"auto"`` (the eye view runs on the CPU in this
-        version; ``"gpu"`` raises ValueError).
+        ``"cpu"`` (default), ``"gpu"`` or ``"auto"``: on the GPU the first
+        hits, the shadow rays, the occluder layers and the gather at the
+        pixels' points run on the device, with the same answers (see
+        docs/gpu.md; hard lights on the map methods stay on the CPU).
 
     Bad values raise ValueError or TypeError naming the argument.
     """

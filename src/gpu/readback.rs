@@ -38,6 +38,10 @@ pub struct ReadBack {
 /// Copies `sources` (buffer, bytes) and the timestamps into one staging
 /// buffer, submits `enc`, waits and reads it all back (stages "encode",
 /// "device" and "readback" of `sw`).
+/// How long a finished submission's results may take to be mapped once the
+/// device is idle (another thread may be delivering the callback).
+const MAP_WAIT: std::time::Duration = std::time::Duration::from_secs(10);
+
 pub fn submit_and_read(
     g: &Gpu,
     mut enc: wgpu::CommandEncoder,
@@ -68,13 +72,22 @@ pub fn submit_and_read(
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::gpu(format!("waiting for the device: {e}")))?;
-    match rx.try_recv() {
-        Ok(Ok(())) => {}
-        Ok(Err(e)) => return Err(Error::gpu(format!("mapping the results: {e}"))),
-        Err(_) => return Err(Error::gpu("the results were not mapped after the wait")),
+    // The map callback runs in whichever thread's poll processes it: with
+    // several calls sharing the device, another thread's poll may be running
+    // it just as ours returns, so wait on the channel, polling again, until
+    // it arrives (bounded: a lost mapping is an error, not a hang).
+    let deadline = std::time::Instant::now() + MAP_WAIT;
+    loop {
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::gpu(format!("waiting for the device: {e}")))?;
+        match rx.recv_timeout(std::time::Duration::from_millis(1)) {
+            Ok(Ok(())) => break,
+            Ok(Err(e)) => return Err(Error::gpu(format!("mapping the results: {e}"))),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout)
+                if std::time::Instant::now() < deadline => {}
+            Err(_) => return Err(Error::gpu("the results were not mapped after the wait")),
+        }
     }
     let device_wall = submitted.elapsed().as_secs_f64();
     sw.lap("device");
