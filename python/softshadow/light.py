@@ -11,8 +11,29 @@ from . import _core
 from . import _validate as check
 
 
+class _Frame:
+    """The light frame (u, v, n) the core computed, as fresh arrays."""
+
+    _frame: tuple[Any, Any, Any]
+
+    @property
+    def u(self) -> np.ndarray:
+        """Unit vector along the light's width or first angle (map columns grow along it)."""
+        return self._frame[0].copy()
+
+    @property
+    def v(self) -> np.ndarray:
+        """Unit vector along the light's height or second angle (map rows grow against it)."""
+        return self._frame[1].copy()
+
+    @property
+    def n(self) -> np.ndarray:
+        """Unit normal from a rectangle into the scene; the direction a sun's light travels."""
+        return self._frame[2].copy()
+
+
 @dataclass(frozen=True, init=False)
-class RectLight:
+class RectLight(_Frame):
     """A rectangular area light that emits uniformly over its whole rectangle.
 
     Frame: ``n = normalize(normal)`` points from the light into the scene,
@@ -56,20 +77,6 @@ class RectLight:
         ``n = +z``, ``v = +y`` (so ``u = -x``)."""
         return cls(center=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0), size=size)
 
-    @property
-    def u(self) -> np.ndarray:
-        """Unit vector along the light's width (map columns grow along it)."""
-        return self._frame[0].copy()
-
-    @property
-    def v(self) -> np.ndarray:
-        """Unit vector along the light's height (map rows grow against it)."""
-        return self._frame[1].copy()
-
-    @property
-    def n(self) -> np.ndarray:
-        """Unit normal, from the light into the scene."""
-        return self._frame[2].copy()
 
     @property
     def area(self) -> float:
@@ -87,7 +94,7 @@ class RectLight:
 
 
 @dataclass(frozen=True, init=False)
-class DirectionalLight:
+class DirectionalLight(_Frame):
     """A directional light (the sun): a rectangle of directions at infinity.
 
     Frame: ``n = normalize(direction)`` is the direction the light travels,
@@ -118,20 +125,6 @@ class DirectionalLight:
         object.__setattr__(self, "angular_size", a)
         object.__setattr__(self, "_frame", tuple(np.array(x) for x in frame))
 
-    @property
-    def u(self) -> np.ndarray:
-        """Unit vector along the first angle (map columns grow along it)."""
-        return self._frame[0].copy()
-
-    @property
-    def v(self) -> np.ndarray:
-        """Unit vector along the second angle (map rows grow against it)."""
-        return self._frame[1].copy()
-
-    @property
-    def n(self) -> np.ndarray:
-        """Unit direction the light travels."""
-        return self._frame[2].copy()
 
     def _core_args(self) -> tuple[Any, ...]:
         return (self.direction, self.up, self.angular_size)

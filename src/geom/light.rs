@@ -58,32 +58,44 @@ pub fn is_point(size: [f64; 2]) -> bool {
     size == [0.0, 0.0]
 }
 
+/// A light's frame (u, v, n) from its axis `axis` (named `axis_arg`: the
+/// rectangle's "normal", the sun's "direction") and `up`:
+/// `n = normalize(axis)`, `v = normalize(up - (up.n) n)`, `u = n x v`,
+/// refusing non-finite or zero vectors and an `up` along the axis.
+pub(crate) fn light_frame(
+    axis_arg: &str,
+    axis: [f64; 3],
+    up: [f64; 3],
+) -> Result<(DVec3, DVec3, DVec3)> {
+    let nrm = finite3(axis_arg, axis)?;
+    let up = finite3("up", up)?;
+    let nlen = nrm.length();
+    if !(nlen > 1e-300) || !nlen.is_finite() {
+        return Err(Error::invalid(axis_arg, "has zero length"));
+    }
+    let n = nrm / nlen;
+    let ulen = up.length();
+    if !(ulen > 1e-300) || !ulen.is_finite() {
+        return Err(Error::invalid("up", "has zero length"));
+    }
+    let ortho = up - up.dot(n) * n;
+    // Relative test: `up` within ~1e-6 rad of the axis gives no usable v axis.
+    if ortho.length() <= 1e-6 * ulen {
+        return Err(Error::invalid(
+            "up",
+            format!("is parallel to {axis_arg}: it must have a component across the light's {axis_arg}"),
+        ));
+    }
+    let v = ortho.normalize();
+    Ok((n.cross(v), v, n))
+}
+
 impl RectLight {
     /// Builds the light frame, refusing degenerate input.
     pub fn new(center: [f64; 3], normal: [f64; 3], up: [f64; 3], size: [f64; 2]) -> Result<Self> {
         let c = finite3("center", center)?;
-        let nrm = finite3("normal", normal)?;
-        let up = finite3("up", up)?;
+        let (u, v, n) = light_frame("normal", normal, up)?;
         let size = check_light_size("size", size)?;
-        let nlen = nrm.length();
-        if !(nlen > 1e-300) || !nlen.is_finite() {
-            return Err(Error::invalid("normal", "has zero length"));
-        }
-        let n = nrm / nlen;
-        let ulen = up.length();
-        if !(ulen > 1e-300) || !ulen.is_finite() {
-            return Err(Error::invalid("up", "has zero length"));
-        }
-        let ortho = up - up.dot(n) * n;
-        // Relative test: `up` within ~1e-6 rad of `normal` gives no usable v axis.
-        if ortho.length() <= 1e-6 * ulen {
-            return Err(Error::invalid(
-                "up",
-                "is parallel to normal: it must have a component across the light's normal",
-            ));
-        }
-        let v = ortho.normalize();
-        let u = n.cross(v);
         Ok(RectLight {
             center: c,
             u,

@@ -29,7 +29,7 @@
 //! on both backends, runs unchanged; the maps go back to Z for the user.
 
 use crate::error::{Error, Result};
-use crate::geom::light::finite3;
+use crate::geom::light::light_frame;
 use glam::DVec3;
 
 /// A directional light with its orthonormal frame.
@@ -48,24 +48,7 @@ pub const MAX_ANGLE: f64 = 179.0;
 
 impl DirectionalLight {
     pub fn new(direction: [f64; 3], up: [f64; 3], angular_size: [f64; 2]) -> Result<Self> {
-        let d = finite3("direction", direction)?;
-        let up = finite3("up", up)?;
-        let len = d.length();
-        if !(len > 1e-300) || !len.is_finite() {
-            return Err(Error::invalid("direction", "has zero length"));
-        }
-        let n = d / len;
-        let ulen = up.length();
-        if !(ulen > 1e-300) || !ulen.is_finite() {
-            return Err(Error::invalid("up", "has zero length"));
-        }
-        let ortho = up - up.dot(n) * n;
-        if ortho.length() <= 1e-6 * ulen {
-            return Err(Error::invalid(
-                "up",
-                "is parallel to direction: it must have a component across the light's direction",
-            ));
-        }
+        let (u, v, n) = light_frame("direction", direction, up)?;
         let ok = |a: f64| a.is_finite() && a > 0.0 && a <= MAX_ANGLE;
         if !(angular_size.iter().all(|&a| ok(a)) || angular_size == [0.0, 0.0]) {
             return Err(Error::invalid(
@@ -76,9 +59,8 @@ impl DirectionalLight {
                 ),
             ));
         }
-        let v = ortho.normalize();
         Ok(DirectionalLight {
-            u: n.cross(v),
+            u,
             v,
             n,
             angular_size,
