@@ -77,7 +77,6 @@ class RectLight(_Frame):
         ``n = +z``, ``v = +y`` (so ``u = -x``)."""
         return cls(center=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0), size=size)
 
-
     @property
     def area(self) -> float:
         return self.size[0] * self.size[1]
@@ -124,7 +123,6 @@ class DirectionalLight(_Frame):
         object.__setattr__(self, "up", u)
         object.__setattr__(self, "angular_size", a)
         object.__setattr__(self, "_frame", tuple(np.array(x) for x in frame))
-
 
     def _core_args(self) -> tuple[Any, ...]:
         return (self.direction, self.up, self.angular_size)

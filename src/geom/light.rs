@@ -83,7 +83,9 @@ pub(crate) fn light_frame(
     if ortho.length() <= 1e-6 * ulen {
         return Err(Error::invalid(
             "up",
-            format!("is parallel to {axis_arg}: it must have a component across the light's {axis_arg}"),
+            format!(
+                "is parallel to {axis_arg}: it must have a component across the light's {axis_arg}"
+            ),
         ));
     }
     let v = ortho.normalize();
