@@ -183,9 +183,16 @@ pub(crate) fn point_order(og: &MapGrid, points: &[LightPoint]) -> Vec<u32> {
         let tiles_x = (og.width as u64).div_ceil(t);
         (((j / r) * tiles_x + i / t) * r + j % r) * t + i % t
     };
-    let mut order: Vec<u32> = (0..points.len() as u32).collect();
-    order.par_sort_by_key(|&n| key(&points[n as usize]));
-    order
+    // Each key computed once, then (key, index) pairs sorted: the order of
+    // a stable sort by key (ties keep the input order), without evaluating
+    // the key in every comparison (which cost more than the shading).
+    let mut keyed: Vec<(u64, u32)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(n, p)| (key(p), n as u32))
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, n)| n).collect()
 }
 
 /// Points a group of `visibility_points` holds (the GPU twin's workgroup).
