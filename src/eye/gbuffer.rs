@@ -154,11 +154,11 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
         .enumerate()
         .with_min_len(256)
         .map(|(k, tri)| {
-            let d = camera.pixel_direction(k % w, k / w);
             let none = (f32::INFINITY, [f64::NAN; 3], [0.0; 3], -1);
             let Some(tri) = *tri else {
                 return none;
             };
+            let d = camera.pixel_direction(k % w, k / w);
             let [a, b, c] = scene.corners[tri as usize];
             let n = (b - a).cross(c - a);
             let den = n.dot(d);
@@ -179,19 +179,16 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
             )
         })
         .collect();
-    let mut g = GBuffer {
+    let ((depth, position), (normal, mesh_id)) = per_pixel
+        .into_par_iter()
+        .map(|(z, p, n, m)| ((z, p), (n, m)))
+        .unzip();
+    GBuffer {
         width: w,
         height: h,
-        depth: Vec::with_capacity(w * h),
-        position: Vec::with_capacity(w * h),
-        normal: Vec::with_capacity(w * h),
-        mesh_id: Vec::with_capacity(w * h),
-    };
-    for (z, p, n, m) in per_pixel {
-        g.depth.push(z);
-        g.position.push(p);
-        g.normal.push(n);
-        g.mesh_id.push(m);
+        depth,
+        position,
+        normal,
+        mesh_id,
     }
-    g
 }
