@@ -183,14 +183,28 @@ pub(crate) fn point_order(og: &MapGrid, points: &[LightPoint]) -> Vec<u32> {
         let tiles_x = (og.width as u64).div_ceil(t);
         (((j / r) * tiles_x + i / t) * r + j % r) * t + i % t
     };
-    // Each key computed once, then (key, index) pairs sorted: the order of
-    // a stable sort by key (ties keep the input order), without evaluating
-    // the key in every comparison (which cost more than the shading).
-    let mut keyed: Vec<(u64, u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(n, p)| (key(p), n as u32))
-        .collect();
+    // Each key computed once (evaluating it in every comparison cost more
+    // than the shading), then the order of a stable sort by key: ties keep
+    // the input order.
+    let keys: Vec<u64> = points.par_iter().map(key).collect();
+    let top = keys.iter().copied().max().unwrap_or(0);
+    if top < 4 * points.len() as u64 + 1024 {
+        // Keys are texel indices: a counting sort when they are few.
+        let mut start = vec![0u32; top as usize + 2];
+        for &k in &keys {
+            start[k as usize + 1] += 1;
+        }
+        for b in 1..start.len() {
+            start[b] += start[b - 1];
+        }
+        let mut order = vec![0u32; points.len()];
+        for (n, &k) in keys.iter().enumerate() {
+            order[start[k as usize] as usize] = n as u32;
+            start[k as usize] += 1;
+        }
+        return order;
+    }
+    let mut keyed: Vec<(u64, u32)> = keys.into_iter().zip(0u32..).collect();
     keyed.par_sort_unstable();
     keyed.into_iter().map(|(_, n)| n).collect()
 }
@@ -252,4 +266,48 @@ pub(super) fn visibility_points<A: Accumulator>(
         out[n as usize] = v;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `point_order` is the stable sort by texel key, on both of its paths
+    /// (the counting sort of few keys, the sort of many).
+    #[test]
+    fn point_order_is_the_stable_sort_by_texel() {
+        let mut seed = 7u64;
+        let mut r = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let points: Vec<LightPoint> = (0..3000)
+            .map(|_| LightPoint {
+                // Some beyond the map (clamped), many sharing a texel.
+                x: (r() * 2.4 - 1.2) * 0.5,
+                y: (r() * 2.4 - 1.2) * 0.5,
+                z: 1.0,
+            })
+            .collect();
+        for side in [16usize, 4096] {
+            let og = MapGrid::new(side, side, [0.5, 0.5]).unwrap();
+            let (w, h) = (side as f32, side as f32);
+            let key = |p: &LightPoint| {
+                let j = ((1.0 - p.y / 0.5) * 0.5 * h - 0.5)
+                    .round()
+                    .clamp(0.0, h - 1.0) as u64;
+                let i = ((p.x / 0.5 + 1.0) * 0.5 * w - 0.5)
+                    .round()
+                    .clamp(0.0, w - 1.0) as u64;
+                let (t, rr) = (TILE_W as u64, ROWS_PER_GROUP as u64);
+                let tiles_x = (side as u64).div_ceil(t);
+                (((j / rr) * tiles_x + i / t) * rr + j % rr) * t + i % t
+            };
+            let mut want: Vec<u32> = (0..points.len() as u32).collect();
+            want.sort_by_key(|&n| key(&points[n as usize]));
+            assert_eq!(point_order(&og, &points), want, "side {side}");
+        }
+    }
 }
