@@ -22,7 +22,8 @@ For each scene of ``softshadow.eye_scenes.EYE_SCENES`` at the resolution:
 The error is the mean |V - V_ref| over the pixels where both renderers see
 the same mesh at the same place (``softshadow.metrics.compare_images``).
 Each round times every call and every Mitsuba sample count once, so both
-sides of a ratio see the same load. Prints the tables, writes them to
+sides of a ratio see the same load, in an order reversed every other round
+so that neither always runs right after the other. Prints the tables, writes them to
 ``docs/benchmarks/eye.md`` and one row per scene (the fastest call within
 ``BAR_ERROR`` and its ratio to Mitsuba at that error) into the README
 between ``<!-- eye-table:start -->`` and ``<!-- eye-table:end -->``.
@@ -196,15 +197,18 @@ def main() -> None:
             ss.render(scene, light, cam, method=m)
         times: dict[str, list[float]] = {}
         outs: dict[str, Any] = {}
-        for _ in range(args.repeats):
-            for k in MITSUBA_SAMPLES:
-                t, v = timed(lambda k=k, job=job: job.run(k))
-                times.setdefault(f"mitsuba {k}", []).append(t)
-                outs[f"mitsuba {k}"] = v
-            for label, m in CALLS:
-                t, img = timed(lambda m=m, s=scene, li=light, c=cam: ss.render(s, li, c, method=m))
+        # One job of each renderer after the other, alternating which goes
+        # first, so that neither always runs in the other's wake (Dr.Jit's
+        # and rayon's worker threads wind down after a call).
+        jobs: list[tuple[str, Any]] = [(f"mitsuba {k}", lambda k=k, job=job: job.run(k)) for k in MITSUBA_SAMPLES] + [
+            (label, lambda m=m, s=scene, li=light, c=cam: ss.render(s, li, c, method=m)) for label, m in CALLS
+        ]
+        for r in range(args.repeats):
+            ordered = jobs if r % 2 == 0 else jobs[::-1]
+            for label, fn in ordered:
+                t, out = timed(fn)
                 times.setdefault(label, []).append(t)
-                outs[label] = img
+                outs[label] = out
         points: list[Point] = []
         for k in MITSUBA_SAMPLES:
             c = compare_images(Ref(ref, outs[f"mitsuba {k}"]), ref)
