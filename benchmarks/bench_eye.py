@@ -1,7 +1,7 @@
 """The eye view against Mitsuba: every method's time and error on the eye-view
 scenes, and Mitsuba's time at equal error.
 
-    python benchmarks/bench_eye.py [--resolution 640 480] [--repeats 3] [--scenes ...] [--no-write]
+    python benchmarks/bench_eye.py [--resolution 640 480] [--repeats 7] [--scenes ...] [--no-write]
 
 For each scene of ``softshadow.eye_scenes.EYE_SCENES`` at the resolution:
 
@@ -179,7 +179,7 @@ def describe(img: Any) -> str:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--resolution", type=int, nargs=2, default=(640, 480), metavar=("W", "H"))
-    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--repeats", type=int, default=7)
     p.add_argument("--reference-samples", type=int, default=4096)
     p.add_argument("--scenes", nargs="*", default=list(EYE_SCENES))
     add_output_arguments(p, DOCS / "eye.md")
