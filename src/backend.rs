@@ -286,7 +286,7 @@ pub fn orthographic_maps(
                 ),
             ));
         }
-        range = range.max(pipeline::farthest_finite(m));
+        range = range.max(crate::geom::units::farthest(m));
     }
     let space = SunSpace::new(sun, glam::DVec3::ZERO, range);
     let kernel: Vec<Vec<f32>> = maps

@@ -134,9 +134,10 @@ pub fn rasterized_hits(camera: &Camera, scene: &SceneTriangles) -> Vec<Option<u3
         Ok(g) => g,
         Err(_) => return vec![None; camera.width * camera.height],
     };
-    let far = verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
-    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
-    Prepared::with_faces(&grid, &verts, &faces, near).nearest_faces()
+    let near = crate::pipeline::near_plane(&verts);
+    Prepared::with_faces(&grid, &verts, &faces, near)
+        .nearest_faces()
+        .1
 }
 
 /// What each pixel of `camera` sees of the scene.

@@ -85,8 +85,7 @@ pub struct LightTriangles {
 /// The occluder layers of every mesh on `grid` (kernel depths, unit-scaled),
 /// front first, the peeled ones, back last.
 pub fn occluder_layers(grid: &MapGrid, tris: &LightTriangles, passes: u32) -> Vec<Vec<f32>> {
-    let far = tris.verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
-    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
+    let near = crate::pipeline::near_plane(&tris.verts);
     let prepared = Prepared::new(grid, &tris.verts, &tris.faces, near);
     let o = prepared.nearest_farthest(passes >= 2);
     let mut layers = vec![o.nearest];
@@ -159,26 +158,51 @@ pub(crate) fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    // Points the biases moved behind the light are shaded as empty, then 0.
+    let mut v = crate::pipeline::shade_points(method, &inputs, &shaded_points(&lp));
+    sw.lap("shadow");
+    finish(&mut v, &lp, space, unit, light_size, points, normals);
+    sw.lap("tangent_plane");
+    for l in layers.iter_mut() {
+        l.par_iter_mut()
+            .for_each(|z| *z = user_depth(space, unit, *z));
+    }
+    Ok((v, EyeMaps { grid, layers }))
+}
+
+/// The points the kernels shade: one the biases moved behind the light
+/// (`None`) as no receiver (`finish` then gives it 0). Both backends.
+pub(crate) fn shaded_points(lp: &[Option<LightPoint>]) -> Vec<LightPoint> {
     let empty = LightPoint {
         x: 0.0,
         y: 0.0,
         z: f32::INFINITY,
     };
-    let valid: Vec<LightPoint> = lp.iter().map(|p| p.unwrap_or(empty)).collect();
-    let mut v = crate::pipeline::shade_points(method, &inputs, &valid);
-    sw.lap("shadow");
-    for (v, p) in v.iter_mut().zip(&lp) {
+    lp.iter().map(|p| p.unwrap_or(empty)).collect()
+}
+
+/// What both backends do with the kernel's visibility `v` of `lp`: 0 where
+/// the biases left no point, then the tangent-plane bound.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn finish(
+    v: &mut [f32],
+    lp: &[Option<LightPoint>],
+    space: &LightSpace,
+    unit: f64,
+    light_size: [f64; 2],
+    points: &[[f64; 3]],
+    normals: &[[f32; 3]],
+) {
+    for (v, p) in v.iter_mut().zip(lp) {
         if p.is_none() {
             *v = 0.0;
         }
     }
-    super::tangent_plane::bound(&mut v, space, unit, light_size, points, normals);
-    sw.lap("tangent_plane");
-    // The maps back in the user's depth.
-    for l in layers.iter_mut() {
-        l.par_iter_mut()
-            .for_each(|z| *z = space.user_depth(*z * unit as f32));
-    }
-    Ok((v, EyeMaps { grid, layers }))
+    super::tangent_plane::bound(v, space, unit, light_size, points, normals);
+}
+
+/// A layer depth of the kernels (in the depth unit `unit`) as the user's
+/// maps hold it.
+#[inline]
+pub(crate) fn user_depth(space: &LightSpace, unit: f64, z: f32) -> f32 {
+    space.user_depth(z * unit as f32)
 }

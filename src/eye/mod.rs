@@ -7,7 +7,10 @@
 //! (rays.rs); the map methods rasterize occluder layers focused on the
 //! visible points (focus.rs) and shade each pixel at its own point and
 //! depth with the biases of maps.rs (`extent`, `raster_occluders`,
-//! `shadow`). Visibility is 1 where a pixel sees no surface.
+//! `shadow`). Visibility is 1 where a pixel sees no surface. A rectangle
+//! lights its n side only: `rays::plane_side` has no side for a point at
+//! or behind its plane, which exact (no ray start) and the map methods (the
+//! tangent-plane bound) both turn into 0.
 //!
 //! Both backends run the same stages: `render_cpu` here, and its GPU twin
 //! `crate::gpu::render_gpu` (src/gpu/eye.rs), which casts the first hits,
@@ -41,10 +44,10 @@ use rayon::prelude::*;
 
 /// The default biases of the map methods (texels), measured by
 /// `benchmarks/bench_bias.py` (docs/benchmarks/bias.md) on the four
-/// eye-view scenes: without either bias a third to a half of the lit pixels
-/// shadow themselves; a quarter texel of normal offset and half a texel of
-/// depth bias bring that to 0.3% (the map's penumbra edges), and every
-/// further texel of either lets more light leak into the shadows.
+/// eye-view scenes: without either bias up to 55% of the lit pixels shadow
+/// themselves; a quarter texel of normal offset and half a texel of depth
+/// bias bring that to 0.3% (the map's penumbra edges), and every further
+/// texel of either lets more light leak into the shadows.
 pub const DEFAULT_BIAS: Bias = Bias {
     normal_offset: 0.25,
     depth_bias: 0.5,
@@ -295,18 +298,6 @@ pub(crate) fn light_triangles(f: &mut Framed) -> maps::LightTriangles {
     }
 }
 
-/// A rectangle lights its n side only: 0 at the pixels whose point is at
-/// or behind its plane.
-pub(crate) fn lit_side_only(f: &Framed, visibility: &mut [f32]) {
-    if let LightSpace::Rect(l) = f.space {
-        for (&k, p) in f.hits.iter().zip(&f.points) {
-            if (DVec3::from_array(*p) - l.center).dot(l.n) <= 0.0 {
-                visibility[k] = 0.0;
-            }
-        }
-    }
-}
-
 fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     let mut sw = Stopwatch::new();
     let scene = SceneTriangles::new(call.meshes)?;
@@ -355,7 +346,6 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     } else {
         method = resolve_at_camera(call, Backend::Cpu)?;
     }
-    lit_side_only(&f, &mut visibility);
     Ok((
         EyeImage {
             gbuffer: g,

@@ -52,7 +52,6 @@ use crate::error::{Error, Result};
 use crate::eye::gbuffer::{self, SceneTriangles};
 use crate::eye::maps::{self, LightTriangles};
 use crate::eye::rays::{self, RayStart};
-use crate::eye::tangent_plane;
 use crate::eye::{self, Bias, EyeCall, EyeImage, EyeMaps, Framed};
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
@@ -225,7 +224,6 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     } else {
         method = eye::resolve_at_camera(call, Backend::Gpu)?;
     }
-    eye::lit_side_only(&f, &mut vis);
     let mut timings = sw.timings;
     timings.extend(device_timings);
     Ok((
@@ -602,8 +600,7 @@ fn shade_maps(
     }
     fits(g, "map_resolution", texels * 4)?;
     // maps::occluder_layers' near plane.
-    let far = tris.verts.iter().fold(0f64, |m, q| m.max(q.z.abs()));
-    let near = (far * 1e-9).max(f64::MIN_POSITIVE);
+    let near = crate::pipeline::near_plane(&tris.verts);
     let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, &tris.faces, near)
         .iter()
         .map(GpuTri::from_setup)
@@ -616,12 +613,7 @@ fn shade_maps(
         .fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
     // maps::shade's points: biased, `None` shaded as empty then 0.
     let lp = maps::biased_points(&f.space, f.unit, &grid, &f.points, &f.normals, bias);
-    let empty = LightPoint {
-        x: 0.0,
-        y: 0.0,
-        z: f32::INFINITY,
-    };
-    let valid: Vec<LightPoint> = lp.iter().map(|p| p.unwrap_or(empty)).collect();
+    let valid = maps::shaded_points(&lp);
     let order = point_order(&grid, &valid);
     let sorted: Vec<LightPoint> = order.iter().map(|&n| valid[n as usize]).collect();
     let (lanes, groups) = point_lanes(&sorted);
@@ -732,15 +724,10 @@ fn shade_maps(
     for (&n, &s) in order.iter().zip(&shaded) {
         v[n as usize] = s;
     }
-    // As maps::shade: points the biases moved behind the light get 0, and
-    // every point is bounded by the light in front of its tangent plane.
-    for (v, p) in v.iter_mut().zip(&lp) {
-        if p.is_none() {
-            *v = 0.0;
-        }
-    }
-    tangent_plane::bound(
+    // As maps::shade.
+    maps::finish(
         &mut v,
+        &lp,
         &f.space,
         f.unit,
         f.light_size,
@@ -751,7 +738,6 @@ fn shade_maps(
     // The layers back in the user's depth; the farthest starts at 0 bits
     // (before its atomicMax): 0 means empty.
     let m = words(&out.buffers[0]);
-    let unit = f.unit as f32;
     let layers = (0..passes as usize)
         .map(|k| {
             let far_layer = passes >= 2 && k == passes as usize - 1;
@@ -763,7 +749,7 @@ fn shade_maps(
                     } else {
                         f32::from_bits(b)
                     };
-                    f.space.user_depth(z * unit)
+                    maps::user_depth(&f.space, f.unit, z)
                 })
                 .collect()
         })

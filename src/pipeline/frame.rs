@@ -40,8 +40,8 @@ impl Stopwatch {
 
 /// Clip distance for rasterization: a tiny fraction of the scene's depth range,
 /// so that geometry touching the light's plane keeps finite 1/Z.
-fn near_plane(occ: &[DVec3], rec: &[DVec3]) -> f64 {
-    let far = occ.iter().chain(rec).fold(0f64, |m, q| m.max(q.z.abs()));
+pub(crate) fn near_plane<'a>(verts: impl IntoIterator<Item = &'a DVec3>) -> f64 {
+    let far = verts.into_iter().fold(0f64, |m, q| m.max(q.z.abs()));
     (far * 1e-9).max(f64::MIN_POSITIVE)
 }
 
@@ -128,7 +128,7 @@ pub(crate) fn frame_scene(
     let grid = MapGrid::new(s.width, s.height, extent)?;
     let occluder_grid = MapGrid::new(ow, oh, extent)?;
     sw.lap("extent");
-    let near = near_plane(&occ_ls, &rec_ls);
+    let near = near_plane(occ_ls.iter().chain(&rec_ls));
     Ok(FramedScene {
         occ_ls,
         rec_ls,

@@ -40,8 +40,7 @@ pub fn from_scene(
         light_size,
     } = frame_scene(&scene, &scene, light, s, &mut sw)?;
     let prepared = Prepared::with_faces(&grid, &occ_ls, scene.faces, near);
-    let faces = prepared.nearest_faces();
-    let receiver = prepared.nearest_farthest(false).nearest;
+    let (receiver, faces) = prepared.nearest_faces();
     sw.lap("raster_receivers");
     // The receiver texels' world points and light-facing normals.
     let texels: Vec<usize> = (0..grid.len()).filter(|&k| faces[k].is_some()).collect();

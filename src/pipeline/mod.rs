@@ -11,10 +11,10 @@ mod from_scene;
 mod points;
 
 // The GPU pipelines start from the same framing and checks.
-pub(crate) use frame::Stopwatch;
 pub use frame::Timings;
 #[cfg(feature = "gpu")]
 pub(crate) use frame::{frame_scene, FramedScene};
+pub(crate) use frame::{near_plane, Stopwatch};
 pub use from_depth::{check_depth, from_depth};
 #[cfg(feature = "gpu")]
 pub(crate) use from_depth::{check_depth_inputs, DepthInUnit};
@@ -24,14 +24,6 @@ pub(crate) use points::shade_points;
 pub use points::{receiver_points, sample_points, OccluderSource};
 
 use crate::methods::{Method, MethodConfig};
-
-/// The farthest finite depth of a map (0 when none).
-pub fn farthest_finite(depth: &[f32]) -> f64 {
-    depth
-        .iter()
-        .filter(|z| z.is_finite())
-        .fold(0f64, |m, &z| m.max(z as f64))
-}
 
 /// Settings of the mesh pipeline.
 #[derive(Debug, Clone, Copy)]

@@ -5,10 +5,9 @@ use super::camera::PyCamera;
 use super::configs::{self, method_arg, Loose};
 use super::convert::{light_of, mesh, opt_int, opt_resolution, Light};
 use super::errors;
-use super::results::map;
+use super::results::{map, sun_depth};
 use crate::backend::{BackendChoice, Run};
 use crate::eye::{self, Bias, EyeCall, EyeImage};
-use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::pipeline::Timings;
 use numpy::ndarray::{Array2, Array3};
@@ -147,10 +146,7 @@ impl EyeResult {
             }
             None => (None, vec![]),
         };
-        let (depth_origin, depth_range) = match img.light_space {
-            LightSpace::Sun(s) => (Some(s.origin.into()), Some(s.depth_range)),
-            LightSpace::Rect(_) => (None, None),
-        };
+        let (depth_origin, depth_range) = sun_depth(&img.light_space);
         Ok(EyeResult {
             visibility: image2(py, h, w, img.visibility)?,
             depth: image2(py, h, w, g.depth)?,

@@ -20,6 +20,14 @@ pub fn map(py: Python<'_>, grid: &MapGrid, v: Vec<f32>) -> PyResult<Py<PyAny>> {
     Ok(a.into_pyarray(py).into_any().unbind())
 }
 
+/// A sun's orthographic maps' depth origin and range (None for a rectangle).
+pub fn sun_depth(space: &LightSpace) -> (Option<(f64, f64, f64)>, Option<f64>) {
+    match space {
+        LightSpace::Sun(s) => (Some(s.origin.into()), Some(s.depth_range)),
+        LightSpace::Rect(_) => (None, None),
+    }
+}
+
 fn timings_dict<'py>(py: Python<'py>, t: &Timings) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     for (k, v) in t {
@@ -93,14 +101,8 @@ impl MeshShadowResult {
                 .map(|m| map(py, &og, m))
                 .collect::<PyResult<_>>()?,
             extent: (ex, ey),
-            depth_origin: match r.light_space {
-                LightSpace::Sun(s) => Some(s.origin.into()),
-                LightSpace::Rect(_) => None,
-            },
-            depth_range: match r.light_space {
-                LightSpace::Sun(s) => Some(s.depth_range),
-                LightSpace::Rect(_) => None,
-            },
+            depth_origin: sun_depth(&r.light_space).0,
+            depth_range: sun_depth(&r.light_space).1,
             timings: r.timings,
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),

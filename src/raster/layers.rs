@@ -85,10 +85,10 @@ impl<'g> Prepared<'g> {
         }
     }
 
-    /// The face whose surface is nearest at each texel centre (`None`:
-    /// nothing), for a `Prepared::with_faces`. Equal depths keep the face
-    /// rasterized first (the lower index within a band).
-    pub fn nearest_faces(&self) -> Vec<Option<u32>> {
+    /// The nearest depth at each texel centre (`inf`: nothing) and the face
+    /// it belongs to (`None`: nothing), for a `Prepared::with_faces`. Equal
+    /// depths keep the face rasterized first (the lower index within a band).
+    pub fn nearest_faces(&self) -> (Vec<f32>, Vec<Option<u32>>) {
         // The face ids ride in a second f32 map as bit patterns (moved, never
         // computed with), so the bands' one output type serves both.
         let none = f32::from_bits(u32::MAX);
@@ -105,10 +105,13 @@ impl<'g> Prepared<'g> {
                 }
             })
         });
-        outs[1]
+        let faces = outs
+            .pop()
+            .unwrap_or_default()
             .iter()
             .map(|f| (f.to_bits() != u32::MAX).then_some(f.to_bits()))
-            .collect()
+            .collect();
+        (outs.pop().unwrap_or_default(), faces)
     }
 
     /// Runs `visit(triangle index, band's rows, band's slice of each output)` for every
