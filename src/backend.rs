@@ -147,7 +147,10 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         .pick(&call.method, ctx, call.light.kernel_size());
     let method = call.method.resolve(&CallContext { backend, ..ctx })?;
     let (output, threads) = threads::run_capped(cap, || {
-        let space = mesh_space(call.light, &[call.occluders, call.receivers])?;
+        let space = mesh_space(
+            call.light,
+            &[("occluders", call.occluders), ("receivers", call.receivers)],
+        )?;
         // A sun's map extent is given in world units; the kernels' in tangents.
         let extent = call.extent.map(|e| space.kernel_extent(e));
         let settings = MapSettings::new(w, h, extent, &method);
@@ -206,7 +209,7 @@ pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
     };
     let method = call.method.resolve(&ctx)?;
     let (output, threads) = threads::run_capped(cap, || {
-        let space = mesh_space(call.light, &[call.scene])?;
+        let space = mesh_space(call.light, &[("meshes", call.scene)])?;
         let extent = call.extent.map(|e| space.kernel_extent(e));
         let settings = MapSettings::new(w, h, extent, &method);
         pipeline::from_scene(call.scene, &space, &settings, &call.bias)
@@ -219,18 +222,18 @@ pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
     })
 }
 
-/// The light space of a scene made of `meshes`: a sun's depth origin and
-/// range are fitted to their vertices (checked first: a non-finite vertex
-/// is named, not folded into the bounds).
-pub fn mesh_space(light: &Light, meshes: &[MeshRef]) -> Result<LightSpace> {
+/// The light space of a scene made of `meshes` (each with the name errors
+/// give it): a sun's depth origin and range are fitted to their vertices
+/// (checked first: a non-finite vertex is named, not folded into the bounds).
+pub fn mesh_space(light: &Light, meshes: &[(&str, MeshRef)]) -> Result<LightSpace> {
     if let Light::Sun(_) = light {
-        for (m, arg) in meshes.iter().zip(["occluders", "receivers"]) {
+        for (arg, m) in meshes {
             m.validate(arg)?;
         }
     }
     let verts = meshes
         .iter()
-        .flat_map(|m| m.vertices.iter())
+        .flat_map(|(_, m)| m.vertices.iter())
         .map(|p| glam::DVec3::from_array(*p));
     light.space_for(verts)
 }

@@ -87,7 +87,8 @@ class Scene:
             self.occluders = self.meshes
             self.receivers = self.meshes
         self._occ = _concat(self.occluders)
-        self._rec = _concat(self.receivers)
+        # Every mesh casts and receives: one mesh serves as both.
+        self._rec = _concat(self.receivers) if self.split else self._occ
 
     @classmethod
     def from_trimesh(cls, obj: Any) -> Scene:
