@@ -41,6 +41,7 @@
 // rasterized light-view maps, the shadow methods that read them, and the
 // pipelines that chain them; `gpu` mirrors raster and methods on the device.
 pub mod backend;
+pub mod block_cache;
 pub mod error;
 pub mod eye;
 pub mod geom;

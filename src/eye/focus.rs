@@ -14,16 +14,18 @@
 //! * Resolution. A pixel at distance d along the optical axis covers
 //!   d / focal world units; at the point, a texel covers its tangent width
 //!   times the point's light depth (a rectangle) or times the orthographic
-//!   scale (the sun). The map's texel is the median pixel footprint, so that
+//!   scale (the sun). The map's texel is the median pixel footprint (over a
+//!   regular subsample of at most 16384 pixels, mod.rs), so that
 //!   about one texel falls on a pixel, but no finer than the map's area
 //!   shared among TEXELS_PER_PIXEL texels per visible pixel (the map also
 //!   covers what can shadow the visible points, which no pixel shows), the
 //!   sides clamped to [MIN_SIDE, MAX_SIDE].
 
 use crate::error::Result;
-use crate::geom::extent::fit_extent;
+use crate::geom::extent::{fit_extent_within, ReceiverBounds};
 use crate::geom::light::MAX_EXTENT;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// The nearest occluder depth the extent makes room for, as a fraction of
 /// the nearest visible point's depth.
@@ -32,15 +34,39 @@ pub const NEAREST_OCCLUDER: f64 = 1.0 / 16.0;
 pub const MIN_SIDE: usize = 64;
 pub const MAX_SIDE: usize = 4096;
 
-/// Tangent half-extents holding every occluder texel that can shadow
-/// `points` (kernel light space, all in front of the light).
+/// What the extent reads of the visible points (kernel light space, those
+/// in front of the light): their bounds and their nearest depth.
+#[derive(Debug, Clone, Copy)]
+pub struct VisibleBounds {
+    pub bounds: ReceiverBounds,
+    pub z_min: f64,
+}
+
+impl VisibleBounds {
+    /// The bounds of the points of `points` in front of the light, each
+    /// divided by `unit`; `None` when none is.
+    pub fn of(points: &[DVec3], unit: f64) -> Option<VisibleBounds> {
+        let empty = || (ReceiverBounds::EMPTY, f64::INFINITY);
+        let (bounds, z_min) = points
+            .par_iter()
+            .with_min_len(4096)
+            .filter(|q| q.z > 0.0)
+            .fold(empty, |(b, z), q| (b.with(*q / unit), z.min(q.z / unit)))
+            .reduce(empty, |(a, za), (b, zb)| {
+                (ReceiverBounds::union(a, b), za.min(zb))
+            });
+        z_min.is_finite().then_some(VisibleBounds { bounds, z_min })
+    }
+}
+
+/// Tangent half-extents holding every occluder texel that can shadow the
+/// visible points `points` (kernel light space).
 pub fn focused_extent(
     occluders: &[DVec3],
-    points: &[DVec3],
+    points: &VisibleBounds,
     light_size: [f64; 2],
 ) -> Result<[f64; 2]> {
-    let z_min = points.iter().fold(f64::INFINITY, |m, q| m.min(q.z));
-    let cut = z_min * NEAREST_OCCLUDER;
+    let cut = points.z_min * NEAREST_OCCLUDER;
     let occ: Vec<DVec3> = occluders
         .iter()
         .filter(|q| q.z > 0.0)
@@ -52,11 +78,10 @@ pub fn focused_extent(
             }
         })
         .collect();
-    let mut e = fit_extent(&occ, points, light_size)?;
+    let mut e = fit_extent_within(&occ, &points.bounds, light_size)?;
     // The points themselves, with a texel's margin for the bias (mod.rs).
-    for q in points {
-        e[0] = e[0].max((q.x / q.z).abs());
-        e[1] = e[1].max((q.y / q.z).abs());
+    for (e, t) in e.iter_mut().zip(points.bounds.tangent) {
+        *e = e.max(t);
     }
     Ok(e.map(|t| (t * 1.01).min(MAX_EXTENT)))
 }
@@ -133,7 +158,8 @@ mod tests {
         let pts = [DVec3::new(0.1, 0.0, 1.0), DVec3::new(-0.2, 0.1, 2.0)];
         // An occluder touching the light's plane would need an unbounded map.
         let occ = [DVec3::new(0.0, 0.0, 1e-12), DVec3::new(0.05, 0.05, 0.5)];
-        let e = focused_extent(&occ, &pts, [0.5, 0.5]).unwrap();
+        let vis = VisibleBounds::of(&pts, 1.0).unwrap();
+        let e = focused_extent(&occ, &vis, [0.5, 0.5]).unwrap();
         assert!(e[0] >= 0.1 && e[1] >= 0.05, "{e:?}");
         assert!(e[0] < 0.25 * 16.0 + 0.2, "{e:?}");
     }

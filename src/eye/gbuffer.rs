@@ -49,7 +49,10 @@ impl GBuffer {
 
     /// Flat indices of the pixels that see a surface.
     pub fn hits(&self) -> Vec<usize> {
-        (0..self.len()).filter(|&k| self.mesh_id[k] >= 0).collect()
+        (0..self.len())
+            .into_par_iter()
+            .filter(|&k| self.mesh_id[k] >= 0)
+            .collect()
     }
 }
 
@@ -150,46 +153,44 @@ pub fn first_hits(camera: &Camera, scene: &SceneTriangles) -> GBuffer {
 pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -> GBuffer {
     let eye = camera.eye;
     let (w, h) = (camera.width, camera.height);
-    let per_pixel: Vec<(f32, [f64; 3], [f32; 3], i32)> = hit
-        .par_iter()
-        .enumerate()
-        .with_min_len(256)
-        .map(|(k, tri)| {
-            let none = (f32::INFINITY, [f64::NAN; 3], [0.0; 3], -1);
-            let Some(tri) = *tri else {
-                return none;
-            };
-            let d = camera.pixel_direction(k % w, k / w);
-            let [a, b, c] = scene.corners[tri as usize];
-            let n = (b - a).cross(c - a);
-            let den = n.dot(d);
-            // The f32 hit refined in f64 on the triangle's plane.
-            let t = n.dot(a - eye) / den;
-            if !(t.is_finite() && t > 0.0) {
-                return none;
-            }
-            let p = eye + t * d;
-            let n = n.normalize();
-            let n = if den > 0.0 { -n } else { n };
-            let depth = (t * d.dot(camera.forward)) as f32;
-            (
-                depth,
-                p.to_array(),
-                n.as_vec3().to_array(),
-                scene.mesh_of[tri as usize],
-            )
-        })
-        .collect();
-    let ((depth, position), (normal, mesh_id)) = per_pixel
-        .into_par_iter()
-        .map(|(z, p, n, m)| ((z, p), (n, m)))
-        .unzip();
-    GBuffer {
+    let n = w * h;
+    let mut g = GBuffer {
         width: w,
         height: h,
-        depth,
-        position,
-        normal,
-        mesh_id,
-    }
+        depth: vec![f32::INFINITY; n],
+        position: vec![[f64::NAN; 3]; n],
+        normal: vec![[0.0; 3]; n],
+        mesh_id: vec![-1; n],
+    };
+    // Each row written in place (no per-pixel tuples to unzip).
+    g.depth
+        .par_chunks_mut(w)
+        .zip(g.position.par_chunks_mut(w))
+        .zip(g.normal.par_chunks_mut(w))
+        .zip(g.mesh_id.par_chunks_mut(w))
+        .zip(hit.par_chunks(w))
+        .enumerate()
+        .for_each(|(j, ((((depth, position), normal), mesh_id), hit))| {
+            for (i, tri) in hit.iter().enumerate() {
+                let Some(tri) = *tri else {
+                    continue;
+                };
+                let d = camera.pixel_direction(i, j);
+                let [a, b, c] = scene.corners[tri as usize];
+                let nrm = (b - a).cross(c - a);
+                let den = nrm.dot(d);
+                // The f32 hit refined in f64 on the triangle's plane.
+                let t = nrm.dot(a - eye) / den;
+                if !(t.is_finite() && t > 0.0) {
+                    continue;
+                }
+                let nrm = nrm.normalize();
+                let nrm = if den > 0.0 { -nrm } else { nrm };
+                depth[i] = (t * d.dot(camera.forward)) as f32;
+                position[i] = (eye + t * d).to_array();
+                normal[i] = nrm.as_vec3().to_array();
+                mesh_id[i] = scene.mesh_of[tri as usize];
+            }
+        });
+    g
 }

@@ -23,6 +23,7 @@
 //! Too little leaves acne on lit surfaces; too much lets light leak where
 //! an occluder touches a receiver (`docs/benchmarks/bias.md` measures both).
 
+use super::tangent_plane;
 use crate::error::Result;
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
@@ -99,33 +100,72 @@ pub fn occluder_layers(grid: &MapGrid, tris: &LightTriangles, passes: u32) -> Ve
     layers
 }
 
-/// The points (world, with their camera-facing `normals`) moved by the
-/// biases, in kernel light space (unit-scaled); `None` for a point the
-/// biases move to or behind the light's plane.
-pub fn biased_points(
+/// The points the kernels shade, and the bound their visibility is cut to.
+pub struct ShadingPoints {
+    /// The points moved by the biases, kernel light space (unit-scaled);
+    /// an empty point (z = inf, which no kernel shades) where there is
+    /// nothing to shade: a bound of 0.
+    pub points: Vec<LightPoint>,
+    /// The fraction of the light in front of each point's tangent plane
+    /// (tangent_plane.rs); 0 where the biases move the point to or behind
+    /// the light's plane, or it lies at or behind a rectangle's plane.
+    pub bound: Vec<f32>,
+}
+
+/// The point no kernel shades (it has no depth in front of the light).
+pub(crate) const EMPTY_POINT: LightPoint = LightPoint {
+    x: 0.0,
+    y: 0.0,
+    z: f32::INFINITY,
+};
+
+/// The points (world, with their camera-facing `normals`, and `pts_ls`
+/// their kernel light-space images before unit scaling) moved by the
+/// biases, and their tangent-plane bounds, in one pass. A point whose bound
+/// is 0 (the far side of a closed mesh, facing away from the whole light)
+/// is not shaded: its visibility is 0 whatever the maps say. Both backends.
+#[allow(clippy::too_many_arguments)]
+pub fn shading_points(
     space: &LightSpace,
     unit: f64,
+    light_size: [f64; 2],
     grid: &MapGrid,
     points: &[[f64; 3]],
+    pts_ls: &[DVec3],
     normals: &[[f32; 3]],
     bias: &Bias,
-) -> Vec<Option<LightPoint>> {
-    points
-        .par_iter()
-        .zip(normals)
-        .map(|(p, n)| {
+) -> ShadingPoints {
+    let half = light_size.map(|s| 0.5 * s);
+    let inv_unit = 1.0 / unit;
+    let mut out = ShadingPoints {
+        points: vec![EMPTY_POINT; points.len()],
+        bound: vec![0.0; points.len()],
+    };
+    out.points
+        .par_iter_mut()
+        .zip(out.bound.par_iter_mut())
+        .zip(points.par_iter().zip(pts_ls).zip(normals))
+        .with_min_len(1024)
+        .for_each(|((lp, b), ((p, q), n))| {
             let p = DVec3::from_array(*p);
             let n = glam::Vec3::from_array(*n).as_dvec3();
-            let z = space.to_light(p).z;
-            let texel = texel_world(space, grid, z);
-            let q = space.to_light(biased(space, p, n, texel, bias)) / unit;
-            (q.z > 0.0).then(|| LightPoint {
-                x: (q.x / q.z) as f32,
-                y: (q.y / q.z) as f32,
-                z: q.z as f32,
-            })
-        })
-        .collect()
+            let front = tangent_plane::front_of(space, unit, half, p, n);
+            if front <= 0.0 {
+                return;
+            }
+            let texel = texel_world(space, grid, q.z);
+            let q = space.to_light(biased(space, p, n, texel, bias)) * inv_unit;
+            if q.z > 0.0 {
+                let inv_z = 1.0 / q.z;
+                *lp = LightPoint {
+                    x: (q.x * inv_z) as f32,
+                    y: (q.y * inv_z) as f32,
+                    z: q.z as f32,
+                };
+                *b = front as f32;
+            }
+        });
+    out
 }
 
 /// Rasterizes the occluder layers on `grid` and shades `points` (world,
@@ -141,13 +181,16 @@ pub(crate) fn shade(
     passes: u32,
     method: Method,
     points: &[[f64; 3]],
+    pts_ls: &[DVec3],
     normals: &[[f32; 3]],
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps)> {
     let mut layers = occluder_layers(&grid, tris, passes);
     sw.lap("raster_occluders");
-    let lp = biased_points(space, unit, &grid, points, normals, bias);
+    let sp = shading_points(
+        space, unit, light_size, &grid, points, pts_ls, normals, bias,
+    );
     sw.lap("bias");
     let inputs = ShadowInputs {
         grid,
@@ -158,10 +201,9 @@ pub(crate) fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    let mut v = crate::pipeline::shade_points(method, &inputs, &shaded_points(&lp));
+    let mut v = crate::pipeline::shade_points(method, &inputs, &sp.points);
     sw.lap("shadow");
-    finish(&mut v, &lp, space, unit, light_size, points, normals);
-    sw.lap("tangent_plane");
+    finish(&mut v, &sp.bound);
     for l in layers.iter_mut() {
         l.par_iter_mut()
             .for_each(|z| *z = user_depth(space, unit, *z));
@@ -169,35 +211,13 @@ pub(crate) fn shade(
     Ok((v, EyeMaps { grid, layers }))
 }
 
-/// The points the kernels shade: one the biases moved behind the light
-/// (`None`) as no receiver (`finish` then gives it 0). Both backends.
-pub(crate) fn shaded_points(lp: &[Option<LightPoint>]) -> Vec<LightPoint> {
-    let empty = LightPoint {
-        x: 0.0,
-        y: 0.0,
-        z: f32::INFINITY,
-    };
-    lp.iter().map(|p| p.unwrap_or(empty)).collect()
-}
-
-/// What both backends do with the kernel's visibility `v` of `lp`: 0 where
-/// the biases left no point, then the tangent-plane bound.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn finish(
-    v: &mut [f32],
-    lp: &[Option<LightPoint>],
-    space: &LightSpace,
-    unit: f64,
-    light_size: [f64; 2],
-    points: &[[f64; 3]],
-    normals: &[[f32; 3]],
-) {
-    for (v, p) in v.iter_mut().zip(lp) {
-        if p.is_none() {
-            *v = 0.0;
-        }
-    }
-    super::tangent_plane::bound(v, space, unit, light_size, points, normals);
+/// What both backends do with the kernel's visibility `v`: each point's
+/// cut to its bound (`ShadingPoints::bound`).
+pub(crate) fn finish(v: &mut [f32], bound: &[f32]) {
+    v.par_iter_mut().zip(bound).for_each(|(v, b)| {
+        // (+ 0.0 turns a -0.0 from the min into 0.)
+        *v = v.min(*b) + 0.0;
+    });
 }
 
 /// A layer depth of the kernels (in the depth unit `unit`) as the user's

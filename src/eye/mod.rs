@@ -166,8 +166,8 @@ pub(crate) struct Framed {
 /// G-buffer is `g`.
 pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Framed> {
     let hits = g.hits();
-    let points: Vec<[f64; 3]> = hits.iter().map(|&k| g.position[k]).collect();
-    let normals: Vec<[f32; 3]> = hits.iter().map(|&k| g.normal[k]).collect();
+    let points: Vec<[f64; 3]> = hits.par_iter().map(|&k| g.position[k]).collect();
+    let normals: Vec<[f32; 3]> = hits.par_iter().map(|&k| g.normal[k]).collect();
     let space = match call.light {
         Light::Rect(l) => LightSpace::Rect(*l),
         Light::Sun(s) => {
@@ -189,7 +189,7 @@ pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Resu
         .par_iter()
         .map(|p| space.to_light(DVec3::from_array(*p)))
         .collect();
-    let unit = depth_unit(pts_ls.iter().fold(0f64, |m, q| m.max(q.z)));
+    let unit = depth_unit(pts_ls.par_iter().map(|q| q.z).reduce(|| 0.0, f64::max));
     check_unit("meshes", unit)?;
     let light_size = light_size_in("size", space.size(), unit)?;
     let corners: Vec<DVec3> = scene
@@ -208,6 +208,9 @@ pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Resu
         corners,
     })
 }
+
+/// The most points the median pixel footprint is taken over (focus.rs).
+const FOOTPRINT_SAMPLES: usize = 1 << 14;
 
 /// The config of a call that reads no maps (`exact`, or no visible point),
 /// resolved for `backend` at the camera's resolution.
@@ -245,17 +248,19 @@ pub(crate) fn map_grid(
     f: &Framed,
     backend: Backend,
 ) -> Result<(MapGrid, MethodConfig)> {
-    let in_front: Vec<DVec3> = f.pts_ls.iter().copied().filter(|q| q.z > 0.0).collect();
-    let pts_unit: Vec<DVec3> = in_front.iter().map(|q| *q / f.unit).collect();
-    let extent = if pts_unit.is_empty() {
-        [1.0, 1.0]
-    } else {
-        focus::focused_extent(&f.corners, &pts_unit, f.light_size)?
+    let visible = focus::VisibleBounds::of(&f.pts_ls, f.unit);
+    let extent = match &visible {
+        None => [1.0, 1.0],
+        Some(v) => focus::focused_extent(&f.corners, v, f.light_size)?,
     };
+    // The median over a regular subsample of at most FOOTPRINT_SAMPLES
+    // points: the resolution is a rule of thumb, not worth a full select.
+    let stride = f.hits.len().div_ceil(FOOTPRINT_SAMPLES).max(1);
     let footprint = focus::median(
         f.hits
             .iter()
             .zip(&f.pts_ls)
+            .step_by(stride)
             .filter(|(_, q)| q.z > 0.0)
             .map(|(&k, q)| {
                 let world = g.depth[k] as f64 / call.camera.focal;
@@ -334,6 +339,7 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
             method.passes(),
             method.kernel(),
             &f.points,
+            &f.pts_ls,
             &f.normals,
             &call.bias,
             &mut sw,

@@ -19,31 +19,14 @@
 
 use super::rays::plane_side;
 use crate::geom::light_space::LightSpace;
-use glam::{DVec3, Vec3};
-use rayon::prelude::*;
+use glam::DVec3;
 
-/// Each point's visibility bounded by the light in front of its tangent
-/// plane (`points` world, `normals` facing the camera; `light_size` in
-/// kernel units, unit-scaled). Points at or behind a rectangle's plane get 0.
-pub fn bound(
-    visibility: &mut [f32],
-    space: &LightSpace,
-    unit: f64,
-    light_size: [f64; 2],
-    points: &[[f64; 3]],
-    normals: &[[f32; 3]],
-) {
-    let half = light_size.map(|s| 0.5 * s);
-    visibility
-        .par_iter_mut()
-        .zip(points.par_iter().zip(normals))
-        .for_each(|(v, (p, n))| {
-            let p = DVec3::from_array(*p);
-            let n = Vec3::from_array(*n).as_dvec3();
-            let front = plane_side(space, unit, p, n).map_or(0.0, |s| front_fraction(s, half));
-            // (+ 0.0 turns a -0.0 from the clamp into 0.)
-            *v = v.min(front as f32) + 0.0;
-        });
+/// The fraction of the light in front of the tangent plane at `p` (normal
+/// `n`, world; `half` the light's half-size in kernel units, unit-scaled):
+/// 0 at or behind a rectangle's plane.
+#[inline]
+pub fn front_of(space: &LightSpace, unit: f64, half: [f64; 2], p: DVec3, n: DVec3) -> f64 {
+    plane_side(space, unit, p, n).map_or(0.0, |s| front_fraction(s, half))
 }
 
 /// ∫_0^t clamp(s, 0, h) ds for any t (the antiderivative of the clamp).
@@ -62,6 +45,14 @@ fn clamp_integral(t: f64, h: f64) -> f64 {
 pub fn front_fraction(side: [f64; 3], half: [f64; 2]) -> f64 {
     let [a0, a1, a2] = side;
     let [hx, hy] = half;
+    // Every corner on one side (most points): the whole light or none.
+    let reach = a1.abs() * hx + a2.abs() * hy;
+    if a0 >= reach {
+        return 1.0;
+    }
+    if a0 < -reach {
+        return 0.0;
+    }
     if !(hx > 0.0 && hy > 0.0) {
         return if a0 >= 0.0 { 1.0 } else { 0.0 };
     }

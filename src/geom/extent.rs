@@ -17,15 +17,84 @@
 
 use crate::error::{Error, Result};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// The smallest extent we return (a scene whose shadow shrinks to the axis).
 const MIN_EXTENT: f64 = 1e-9;
+
+/// What the extent reads of the receivers: over those in front of the
+/// light, the farthest depth and the largest tangents, and whether all are
+/// in front.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReceiverBounds {
+    /// -inf when none is in front.
+    pub z_far: f64,
+    pub tangent: [f64; 2],
+    pub all_in_front: bool,
+}
+
+impl ReceiverBounds {
+    pub const EMPTY: ReceiverBounds = ReceiverBounds {
+        z_far: f64::NEG_INFINITY,
+        tangent: [0.0; 2],
+        all_in_front: true,
+    };
+
+    /// The bounds of `receivers`, in one parallel pass.
+    pub fn of(receivers: &[DVec3]) -> ReceiverBounds {
+        receivers
+            .par_iter()
+            .with_min_len(4096)
+            .fold(|| Self::EMPTY, |b, q| b.with(*q))
+            .reduce(|| Self::EMPTY, Self::union)
+    }
+
+    /// These bounds with the receiver `q` added.
+    #[inline]
+    pub fn with(self, q: DVec3) -> ReceiverBounds {
+        if q.z > 0.0 {
+            ReceiverBounds {
+                z_far: self.z_far.max(q.z),
+                tangent: [
+                    self.tangent[0].max((q.x / q.z).abs()),
+                    self.tangent[1].max((q.y / q.z).abs()),
+                ],
+                all_in_front: self.all_in_front,
+            }
+        } else {
+            ReceiverBounds {
+                all_in_front: false,
+                ..self
+            }
+        }
+    }
+
+    pub fn union(a: ReceiverBounds, b: ReceiverBounds) -> ReceiverBounds {
+        ReceiverBounds {
+            z_far: a.z_far.max(b.z_far),
+            tangent: [
+                a.tangent[0].max(b.tangent[0]),
+                a.tangent[1].max(b.tangent[1]),
+            ],
+            all_in_front: a.all_in_front && b.all_in_front,
+        }
+    }
+}
 
 /// Tangent half-extents (tx, ty) that contain every umbra and penumbra the
 /// occluders can cast on the receivers.
 pub fn fit_extent(
     occluders: &[DVec3],
     receivers: &[DVec3],
+    light_size: [f64; 2],
+) -> Result<[f64; 2]> {
+    fit_extent_within(occluders, &ReceiverBounds::of(receivers), light_size)
+}
+
+/// `fit_extent` for receivers known by their bounds.
+pub fn fit_extent_within(
+    occluders: &[DVec3],
+    receivers: &ReceiverBounds,
     light_size: [f64; 2],
 ) -> Result<[f64; 2]> {
     if let Some(q) = occluders.iter().find(|q| !(q.z > 0.0)) {
@@ -38,8 +107,7 @@ pub fn fit_extent(
             ),
         ));
     }
-    let in_front = receivers.iter().filter(|q| q.z > 0.0);
-    let z_far = in_front.clone().fold(f64::NEG_INFINITY, |m, q| m.max(q.z));
+    let z_far = receivers.z_far;
     if !z_far.is_finite() {
         return Err(Error::invalid(
             "receivers",
@@ -61,10 +129,8 @@ pub fn fit_extent(
             reach[a] = reach[a].max(r[a]);
         }
     }
-    if receivers.iter().all(|q| q.z > 0.0) {
-        let rx = in_front.clone().fold(0f64, |m, q| m.max((q.x / q.z).abs()));
-        let ry = in_front.fold(0f64, |m, q| m.max((q.y / q.z).abs()));
-        for (a, r) in [rx, ry].into_iter().enumerate() {
+    if receivers.all_in_front {
+        for (a, r) in receivers.tangent.into_iter().enumerate() {
             ext[a] = ext[a].min(r.max(own[a]).min(r + reach[a]));
         }
     }

@@ -612,9 +612,18 @@ fn shade_maps(
         .iter()
         .fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
     // maps::shade's points: biased, `None` shaded as empty then 0.
-    let lp = maps::biased_points(&f.space, f.unit, &grid, &f.points, &f.normals, bias);
-    let valid = maps::shaded_points(&lp);
-    let order = point_order(&grid, &valid);
+    let sp = maps::shading_points(
+        &f.space,
+        f.unit,
+        f.light_size,
+        &grid,
+        &f.points,
+        &f.pts_ls,
+        &f.normals,
+        bias,
+    );
+    let valid = &sp.points;
+    let order = point_order(&grid, valid);
     let sorted: Vec<LightPoint> = order.iter().map(|&n| valid[n as usize]).collect();
     let (lanes, groups) = point_lanes(&sorted);
     let n_points = lanes.len();
@@ -725,16 +734,7 @@ fn shade_maps(
         v[n as usize] = s;
     }
     // As maps::shade.
-    maps::finish(
-        &mut v,
-        &lp,
-        &f.space,
-        f.unit,
-        f.light_size,
-        &f.points,
-        &f.normals,
-    );
-    sw.lap("tangent_plane");
+    maps::finish(&mut v, &sp.bound);
     // The layers back in the user's depth; the farthest starts at 0 bits
     // (before its atomicMax): 0 means empty.
     let m = words(&out.buffers[0]);

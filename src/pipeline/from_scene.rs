@@ -93,6 +93,10 @@ pub fn from_scene(
             verts: occ_ls,
             faces: scene.faces.to_vec(),
         };
+        let pts_ls: Vec<DVec3> = points
+            .par_iter()
+            .map(|p| light.to_light(DVec3::from_array(*p)))
+            .collect();
         let (v, m) = maps::shade(
             light,
             unit,
@@ -102,6 +106,7 @@ pub fn from_scene(
             s.passes,
             s.method,
             &points,
+            &pts_ls,
             &normals,
             bias,
             &mut sw,

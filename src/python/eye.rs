@@ -150,8 +150,8 @@ impl EyeResult {
         Ok(EyeResult {
             visibility: image2(py, h, w, img.visibility)?,
             depth: image2(py, h, w, g.depth)?,
-            position: image3(py, h, w, g.position.into_iter().flatten().collect())?,
-            normal: image3(py, h, w, g.normal.into_iter().flatten().collect())?,
+            position: image3(py, h, w, g.position.into_flattened())?,
+            normal: image3(py, h, w, g.normal.into_flattened())?,
             mesh_id: image2(py, h, w, g.mesh_id)?,
             shadow_maps,
             map_extent,

@@ -25,8 +25,14 @@ mod results;
 
 use pyo3::prelude::*;
 
+/// The extension's allocations keep their large blocks between calls
+/// (crate::block_cache: page faults were half an eye-view render's time).
+#[global_allocator]
+static ALLOCATOR: crate::block_cache::BlockCache = crate::block_cache::BlockCache::new();
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    ALLOCATOR.configure_from_env();
     configs::register(m)?;
     m.add_class::<camera::PyCamera>()?;
     m.add_class::<results::MeshShadowResult>()?;
