@@ -61,6 +61,10 @@ pub struct SceneTriangles {
     /// World-space corners (f64).
     pub corners: Vec<[DVec3; 3]>,
     pub mesh_of: Vec<i32>,
+    /// The same triangles indexed: every mesh's vertices in one list, and
+    /// the faces into it (the rasterizers set up each vertex once).
+    pub vertices: Vec<DVec3>,
+    pub faces: Vec<[u32; 3]>,
 }
 
 impl SceneTriangles {
@@ -72,8 +76,11 @@ impl SceneTriangles {
         if meshes.len() > i32::MAX as usize {
             return Err(Error::invalid("meshes", "too many meshes"));
         }
-        let mut corners = vec![];
-        let mut mesh_of = vec![];
+        if meshes.iter().map(|m| m.vertices.len()).sum::<usize>() > u32::MAX as usize {
+            return Err(Error::invalid("meshes", "more than 2^32 vertices in all"));
+        }
+        let (mut corners, mut mesh_of) = (vec![], vec![]);
+        let (mut vertices, mut faces) = (vec![], vec![]);
         for (k, m) in meshes.iter().enumerate() {
             m.validate(&format!("meshes[{k}]"))?;
             corners.extend(
@@ -82,13 +89,21 @@ impl SceneTriangles {
                     .map(|f| f.map(|i| DVec3::from_array(m.vertices[i as usize]))),
             );
             mesh_of.extend(std::iter::repeat_n(k as i32, m.faces.len()));
+            let first = vertices.len() as u32;
+            faces.extend(m.faces.iter().map(|f| f.map(|i| first + i)));
+            vertices.extend(m.vertices.iter().map(|v| DVec3::from_array(*v)));
         }
-        Ok(SceneTriangles { corners, mesh_of })
+        Ok(SceneTriangles {
+            corners,
+            mesh_of,
+            vertices,
+            faces,
+        })
     }
 
-    /// Every corner, for bounds.
+    /// Every vertex, for bounds.
     pub fn points(&self) -> impl Iterator<Item = DVec3> + Clone + '_ {
-        self.corners.iter().flat_map(|t| t.iter().copied())
+        self.vertices.iter().copied()
     }
 }
 
@@ -119,26 +134,22 @@ pub fn rasterized_hits(camera: &Camera, scene: &SceneTriangles) -> Vec<Option<u3
     let dx = ((w - 1.0) / 2.0 - camera.cx) / f;
     let dy = (camera.cy - (h - 1.0) / 2.0) / f;
     let verts: Vec<DVec3> = scene
-        .corners
+        .vertices
         .par_iter()
-        .flat_map_iter(|t| {
-            t.map(|p| {
-                let d = p - camera.eye;
-                let z = d.dot(camera.forward);
-                DVec3::new(d.dot(camera.right) - dx * z, d.dot(camera.up) - dy * z, z)
-            })
+        .map(|&p| {
+            let d = p - camera.eye;
+            let z = d.dot(camera.forward);
+            DVec3::new(d.dot(camera.right) - dx * z, d.dot(camera.up) - dy * z, z)
         })
         .collect();
-    let faces: Vec<[u32; 3]> = (0..scene.corners.len() as u32)
-        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-        .collect();
+    let faces = &scene.faces;
     // The camera's validated grid: its tangents are within MAX_TANGENT.
     let grid = match MapGrid::new(camera.width, camera.height, [w / (2.0 * f), h / (2.0 * f)]) {
         Ok(g) => g,
         Err(_) => return vec![None; camera.width * camera.height],
     };
     let near = crate::pipeline::near_plane(&verts);
-    Prepared::with_faces(&grid, &verts, &faces, near)
+    Prepared::with_faces(&grid, &verts, faces, near)
         .nearest_faces()
         .1
 }

@@ -158,8 +158,10 @@ pub(crate) struct Framed {
     /// The kernels' depth unit, and the light's size in it.
     pub unit: f64,
     pub light_size: [f64; 2],
-    /// Every triangle's corners, kernel light space, unit-scaled (3 a triangle).
-    pub corners: Vec<DVec3>,
+    /// Every vertex in kernel light space, unit-scaled, and the faces
+    /// into them (`SceneTriangles::faces`).
+    pub verts: Vec<DVec3>,
+    pub faces: Vec<[u32; 3]>,
 }
 
 /// The light space, depth unit and light-space triangles of an image whose
@@ -192,10 +194,10 @@ pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Resu
     let unit = depth_unit(pts_ls.par_iter().map(|q| q.z).reduce(|| 0.0, f64::max));
     check_unit("meshes", unit)?;
     let light_size = light_size_in("size", space.size(), unit)?;
-    let corners: Vec<DVec3> = scene
-        .corners
+    let verts: Vec<DVec3> = scene
+        .vertices
         .par_iter()
-        .flat_map_iter(|t| t.map(|c| space.to_light(c) / unit))
+        .map(|&c| space.to_light(c) / unit)
         .collect();
     Ok(Framed {
         hits,
@@ -205,7 +207,8 @@ pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Resu
         pts_ls,
         unit,
         light_size,
-        corners,
+        verts,
+        faces: scene.faces.clone(),
     })
 }
 
@@ -233,9 +236,9 @@ pub(crate) fn exact_samples(call: &EyeCall, method: &MethodConfig) -> u32 {
 
 /// The triangles `exact` traces: the corners in f32.
 pub(crate) fn traced_triangles(f: &Framed) -> Vec<[Vec3; 3]> {
-    f.corners
-        .par_chunks(3)
-        .map(|c| [c[0].as_vec3(), c[1].as_vec3(), c[2].as_vec3()])
+    f.faces
+        .par_iter()
+        .map(|t| t.map(|i| f.verts[i as usize].as_vec3()))
         .collect()
 }
 
@@ -251,7 +254,7 @@ pub(crate) fn map_grid(
     let visible = focus::VisibleBounds::of(&f.pts_ls, f.unit);
     let extent = match &visible {
         None => [1.0, 1.0],
-        Some(v) => focus::focused_extent(&f.corners, v, f.light_size)?,
+        Some(v) => focus::focused_extent(&f.verts, v, f.light_size)?,
     };
     // The median over a regular subsample of at most FOOTPRINT_SAMPLES
     // points: the resolution is a rule of thumb, not worth a full select.
@@ -293,13 +296,11 @@ pub(crate) fn map_grid(
 }
 
 /// Every triangle as one indexed mesh in kernel light space (the map
-/// methods' occluders), taking the corners out of `f`.
+/// methods' occluders), taken out of `f`.
 pub(crate) fn light_triangles(f: &mut Framed) -> maps::LightTriangles {
-    let verts = std::mem::take(&mut f.corners);
-    let n = verts.len() as u32 / 3;
     maps::LightTriangles {
-        verts,
-        faces: (0..n).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+        verts: std::mem::take(&mut f.verts),
+        faces: std::mem::take(&mut f.faces),
     }
 }
 
