@@ -122,8 +122,9 @@ impl BlockCache {
     /// The layout a cached `layout` is allocated at.
     #[inline]
     fn class_layout(layout: Layout) -> Layout {
-        // A class size of a valid layout stays below isize::MAX / 2^3 of
-        // slack, far from overflow; should it not fit, the system refuses.
+        // Only a request within an eighth of isize::MAX has no class that
+        // fits; it keeps its own layout (alloc and dealloc both come here,
+        // so they agree).
         Layout::from_size_align(class_size(layout.size()), layout.align()).unwrap_or(layout)
     }
 

@@ -78,16 +78,16 @@ fn biased(space: &LightSpace, p: DVec3, n: DVec3, texel: f64, bias: &Bias) -> DV
 
 /// What the map methods need of the scene: its triangles in kernel light
 /// space (unit-scaled) as one indexed mesh.
-pub struct LightTriangles {
+pub struct LightTriangles<'a> {
     pub verts: Vec<DVec3>,
-    pub faces: Vec<[u32; 3]>,
+    pub faces: &'a [[u32; 3]],
 }
 
 /// The occluder layers of every mesh on `grid` (kernel depths, unit-scaled),
 /// front first, the peeled ones, back last.
 pub fn occluder_layers(grid: &MapGrid, tris: &LightTriangles, passes: u32) -> Vec<Vec<f32>> {
     let near = crate::pipeline::near_plane(&tris.verts);
-    let prepared = Prepared::new(grid, &tris.verts, &tris.faces, near);
+    let prepared = Prepared::new(grid, &tris.verts, tris.faces, near);
     let o = prepared.nearest_farthest(passes >= 2);
     let mut layers = vec![o.nearest];
     for k in 0..passes.saturating_sub(2) as usize {

@@ -158,10 +158,9 @@ pub(crate) struct Framed {
     /// The kernels' depth unit, and the light's size in it.
     pub unit: f64,
     pub light_size: [f64; 2],
-    /// Every vertex in kernel light space, unit-scaled, and the faces
-    /// into them (`SceneTriangles::faces`).
+    /// Every vertex in kernel light space, unit-scaled (the faces into them
+    /// are `SceneTriangles::faces`).
     pub verts: Vec<DVec3>,
-    pub faces: Vec<[u32; 3]>,
 }
 
 /// The light space, depth unit and light-space triangles of an image whose
@@ -208,7 +207,6 @@ pub(crate) fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Resu
         unit,
         light_size,
         verts,
-        faces: scene.faces.clone(),
     })
 }
 
@@ -235,8 +233,9 @@ pub(crate) fn exact_samples(call: &EyeCall, method: &MethodConfig) -> u32 {
 }
 
 /// The triangles `exact` traces: the corners in f32.
-pub(crate) fn traced_triangles(f: &Framed) -> Vec<[Vec3; 3]> {
-    f.faces
+pub(crate) fn traced_triangles(f: &Framed, scene: &SceneTriangles) -> Vec<[Vec3; 3]> {
+    scene
+        .faces
         .par_iter()
         .map(|t| t.map(|i| f.verts[i as usize].as_vec3()))
         .collect()
@@ -296,11 +295,14 @@ pub(crate) fn map_grid(
 }
 
 /// Every triangle as one indexed mesh in kernel light space (the map
-/// methods' occluders), taken out of `f`.
-pub(crate) fn light_triangles(f: &mut Framed) -> maps::LightTriangles {
+/// methods' occluders), its vertices taken out of `f`.
+pub(crate) fn light_triangles<'s>(
+    f: &mut Framed,
+    scene: &'s SceneTriangles,
+) -> maps::LightTriangles<'s> {
     maps::LightTriangles {
         verts: std::mem::take(&mut f.verts),
-        faces: std::mem::take(&mut f.faces),
+        faces: &scene.faces,
     }
 }
 
@@ -318,7 +320,7 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     if call.method.kernel().reads_input(Input::OccluderTriangles) {
         method = resolve_at_camera(call, Backend::Cpu)?;
         let samples = exact_samples(call, &method);
-        let tris = traced_triangles(&f);
+        let tris = traced_triangles(&f, &scene);
         sw.lap("triangles");
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
         let v = rays::visibility(f.light_size, tris, &starts, samples);
@@ -330,7 +332,7 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         let (grid, m) = map_grid(call, &g, &f, Backend::Cpu)?;
         method = m;
         sw.lap("extent");
-        let tris = light_triangles(&mut f);
+        let tris = light_triangles(&mut f, &scene);
         let (v, m) = maps::shade(
             &f.space,
             f.unit,

@@ -21,14 +21,15 @@
 //!   of the point's index and the sample, as `rays::visibility`.
 //! * `ssm`, `bitmask`: the occluder layers (front, peeled, back) rasterized
 //!   on the device from the CPU's set-up triangles (`raster.wgsl`, bit for bit
-//!   the CPU's `maps::occluder_layers`), the biased points made on the CPU
-//!   (`maps::biased_points`), sorted and cut into groups of 64 as
-//!   `methods::gather::visibility_points` does (`point_order`,
+//!   the CPU's `maps::occluder_layers`), the biased points and their
+//!   tangent-plane bounds made on the CPU (`maps::shading_points`), sorted
+//!   and cut into groups of 64 as `methods::gather::visibility_points` does
+//!   (`point_order`,
 //!   `point_group`), and shaded by the points mode of `gather.wgsl` (one
 //!   workgroup per group, the group's window from its bounds, rows outward
 //!   from its centre: `Kernel::shade_points`' traversal). No hierarchy, f32
 //!   sums (configs resolve so on the GPU); then, on the CPU, maps::shade's
-//!   last steps (0 where the biases left no point, the tangent-plane bound).
+//!   last step (`maps::finish`: each point cut to its bound).
 //!   A hard light has no GPU map kernel and is refused (`exact` runs it,
 //!   with one ray).
 //!
@@ -187,7 +188,7 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     if traced {
         method = eye::resolve_at_camera(call, Backend::Gpu)?;
         let samples = eye::exact_samples(call, &method);
-        let tris = eye::traced_triangles(&f);
+        let tris = eye::traced_triangles(&f, &scene);
         sw.lap("triangles");
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()
@@ -204,7 +205,7 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         method = m;
         check_side("map_resolution", (grid.width, grid.height))?;
         sw.lap("extent");
-        let tris = eye::light_triangles(&mut f);
+        let tris = eye::light_triangles(&mut f, &scene);
         let (v, m, t) = shade_maps(
             g,
             &f,
@@ -601,7 +602,7 @@ fn shade_maps(
     fits(g, "map_resolution", texels * 4)?;
     // maps::occluder_layers' near plane.
     let near = crate::pipeline::near_plane(&tris.verts);
-    let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, &tris.faces, near)
+    let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, tris.faces, near)
         .iter()
         .map(GpuTri::from_setup)
         .collect();

@@ -91,7 +91,7 @@ pub fn from_scene(
     } else {
         let tris = maps::LightTriangles {
             verts: occ_ls,
-            faces: scene.faces.to_vec(),
+            faces: scene.faces,
         };
         let pts_ls: Vec<DVec3> = points
             .par_iter()
