@@ -141,6 +141,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         backend: Backend::Cpu,
         resolution: (w, h),
         depth_layers: None,
+        eye: false,
     };
     let backend = call
         .backend
@@ -206,6 +207,7 @@ pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
         backend: Backend::Cpu,
         resolution: (w, h),
         depth_layers: None,
+        eye: false,
     };
     let method = call.method.resolve(&ctx)?;
     let (output, threads) = threads::run_capped(cap, || {
@@ -344,6 +346,7 @@ pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
         backend: Backend::Cpu,
         resolution: (grid.width, grid.height),
         depth_layers: Some((layers, (og.width, og.height))),
+        eye: false,
     };
     let backend = call.backend.pick(&call.method, ctx, light_size);
     let method = call.method.resolve(&CallContext { backend, ..ctx })?;

@@ -3,7 +3,7 @@
 Soft shadow maps (Atty et al. 2005), their bitmask variant and exact ray
 casting, computed by a Rust core on all CPU cores or on a GPU through wgpu
 (``backend="gpu"``). Pick a method with a typed config (``Ssm``,
-``Bitmask``, ``Exact``, ``Auto``) or its name; :func:`capabilities` lists
+``Bitmask``, ``Exact``, ``Auto``, ``ShadowMapping``) or its name; :func:`capabilities` lists
 every method's options, defaults, limits and backends. See the README and
 docs/ for the conventions.
 """
@@ -13,12 +13,40 @@ from .backend import gpu_available, gpu_info
 from .camera import Camera
 from .errors import GpuUnavailableError, TooLargeError
 from .light import DirectionalLight, RectLight
-from .methods import Auto, Bitmask, Exact, MethodConfig, MethodInfo, OptionInfo, Ssm, capabilities, limits
+from .methods import (
+    PCF,
+    Auto,
+    BackFaces,
+    Bitmask,
+    ConstantBias,
+    Exact,
+    EyeSpaceBlur,
+    LinearDepthBias,
+    LiSPSM,
+    MethodConfig,
+    MethodInfo,
+    MidpointBias,
+    OptionInfo,
+    ShadowMapping,
+    SlopeScaleBias,
+    Ssm,
+    capabilities,
+    limits,
+)
 from .render import Image, render
 from .scene import Scene
 from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
 __all__ = [
+    "SlopeScaleBias",
+    "ShadowMapping",
+    "MidpointBias",
+    "LinearDepthBias",
+    "LiSPSM",
+    "EyeSpaceBlur",
+    "ConstantBias",
+    "BackFaces",
+    "PCF",
     "Auto",
     "Bitmask",
     "Camera",

@@ -102,6 +102,29 @@ def city(resolution: tuple[int, int] = (640, 480)) -> EyeScene:
     return scene, sun, cam
 
 
+def large_city(resolution: tuple[int, int] = (640, 480)) -> EyeScene:
+    """Scherzer's setting: a large scene under the sun seen from near the
+    ground. 40 x 40 blocks of buildings (2 to 18 units tall, 10 apart) on a
+    400-unit ground, the camera 1.7 units up in the middle looking along a
+    street (a 35-degree vertical field of view), the sun across the view
+    (its direction at about 80 degrees to the view's), as in the paper's
+    "near perpendicular view and light"."""
+    rng = np.random.default_rng(11)
+    meshes = []
+    for i in range(40):
+        for j in range(40):
+            h = float(rng.uniform(2.0, 18.0))
+            w = float(rng.uniform(3.0, 6.0))
+            meshes.append(box((-195.0 + 10 * i, h / 2, -195.0 + 10 * j), (w, h, w)))
+    meshes.append(quad((0.0, 0.0, 0.0), 200.0))
+    scene = Scene(meshes=meshes)
+    sun = DirectionalLight(direction=(0.15, -0.6, -0.8), up=(0.0, 1.0, 0.0), angular_size=(0.53, 0.53))
+    cam = Camera.look_at(
+        eye=(0.0, 1.7, 0.0), target=(100.0, 0.0, 0.0), up=(0.0, 1.0, 0.0), fov_y=35.0, resolution=resolution
+    )
+    return scene, sun, cam
+
+
 #: The eye-view scenes by name; each call builds ``(scene, light, camera)`` afresh.
 EYE_SCENES: dict[str, Callable[..., EyeScene]] = {
     "bunny_on_floor": bunny_on_floor,

@@ -12,9 +12,25 @@ from __future__ import annotations
 from typing import Any
 
 from . import _core
-from ._core import Auto, Bitmask, Exact, MethodInfo, OptionInfo, Ssm
+from ._core import (
+    PCF,
+    Auto,
+    BackFaces,
+    Bitmask,
+    ConstantBias,
+    Exact,
+    EyeSpaceBlur,
+    LinearDepthBias,
+    LiSPSM,
+    MethodInfo,
+    MidpointBias,
+    OptionInfo,
+    ShadowMapping,
+    SlopeScaleBias,
+    Ssm,
+)
 
-MethodConfig = Ssm | Bitmask | Exact | Auto
+MethodConfig = Ssm | Bitmask | Exact | Auto | ShadowMapping
 """Any method config."""
 
 
@@ -34,4 +50,23 @@ def limits() -> dict[str, Any]:
     return dict(_core.limits())
 
 
-__all__ = ["Auto", "Bitmask", "Exact", "MethodConfig", "MethodInfo", "OptionInfo", "Ssm", "capabilities", "limits"]
+__all__ = [
+    "PCF",
+    "Auto",
+    "BackFaces",
+    "Bitmask",
+    "ConstantBias",
+    "Exact",
+    "EyeSpaceBlur",
+    "LiSPSM",
+    "LinearDepthBias",
+    "MethodConfig",
+    "MethodInfo",
+    "MidpointBias",
+    "OptionInfo",
+    "ShadowMapping",
+    "SlopeScaleBias",
+    "Ssm",
+    "capabilities",
+    "limits",
+]

@@ -21,6 +21,7 @@ pub mod focus;
 pub mod gbuffer;
 pub mod maps;
 pub mod rays;
+pub mod shadow_mapping;
 pub mod tangent_plane;
 
 pub use gbuffer::GBuffer;
@@ -117,6 +118,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
                 backend: Backend::Gpu,
                 resolution: (call.camera.width, call.camera.height),
                 depth_layers: None,
+                eye: true,
             };
             if crate::backend::real_gpu()
                 && !call.light.is_hard()
@@ -220,6 +222,7 @@ pub(crate) fn resolve_at_camera(call: &EyeCall, backend: Backend) -> Result<Meth
         backend,
         resolution: (call.camera.width, call.camera.height),
         depth_layers: None,
+        eye: true,
     })
 }
 
@@ -286,6 +289,7 @@ pub(crate) fn map_grid(
         backend,
         resolution,
         depth_layers: None,
+        eye: true,
     })?;
     // The eye view has occluder maps only: the resolved config's
     // occluder resolution (the fitted one unless the config sets it;
@@ -311,6 +315,24 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     let scene = SceneTriangles::new(call.meshes)?;
     let g = gbuffer::first_hits(call.camera, &scene);
     sw.lap("first_hits");
+    if let MethodConfig::ShadowMapping(cfg) = call.method {
+        let method = resolve_at_camera(call, Backend::Cpu)?;
+        let (visibility, _map) = shadow_mapping::render(call, &cfg, &scene, &g, &mut sw)?;
+        let light_space = match call.light {
+            Light::Rect(l) => LightSpace::Rect(*l),
+            Light::Sun(s) => LightSpace::Sun(SunSpace::fit(*s, scene.points())?),
+        };
+        return Ok((
+            EyeImage {
+                gbuffer: g,
+                visibility,
+                maps: None,
+                light_space,
+                timings: sw.timings,
+            },
+            method,
+        ));
+    }
     let mut f = frame(call, &scene, &g)?;
     sw.lap("transform");
 

@@ -1,10 +1,12 @@
 //! Geometry: the light and its map grid, the camera, meshes, the depth unit the kernels
 //! compute in, and the fitted extent of a light-view map.
 
+pub mod body;
 pub mod camera;
 pub mod extent;
 pub mod light;
 pub mod light_space;
 pub mod mesh;
+pub mod shadow_projection;
 pub mod sun;
 pub mod units;

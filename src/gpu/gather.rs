@@ -205,6 +205,13 @@ fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
                 method.name()
             ),
         )),
+        _ => Err(Error::invalid(
+            "backend",
+            format!(
+                "{:?} runs on the CPU only in this version; use backend=\"cpu\"",
+                method.name()
+            ),
+        )),
     }
 }
 
@@ -220,7 +227,7 @@ fn pipelines(device: &wgpu::Device, method: Method) -> Result<&'static MethodPip
     let cell = match method {
         Method::Ssm { .. } => &SSM,
         Method::Bitmask { .. } => &BITMASK,
-        Method::Exact { .. } => unreachable!("method_source refused it"),
+        _ => unreachable!("method_source refused it"),
     };
     Ok(cell.get_or_init(|| {
         let m = module(device, name, &module_source(source));
@@ -245,7 +252,7 @@ fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static Po
     let cell = match method {
         Method::Ssm { .. } => &SSM,
         Method::Bitmask { .. } => &BITMASK,
-        Method::Exact { .. } => unreachable!("method_source refused it"),
+        _ => unreachable!("method_source refused it"),
     };
     Ok(cell.get_or_init(|| {
         let m = module(device, name, &module_source(source));

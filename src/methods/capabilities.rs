@@ -36,6 +36,11 @@ pub enum Kind {
     Resolution {
         max_texels: i64,
     },
+    /// An instance of one of these config classes (their own options are
+    /// checked by their constructors).
+    Config(Vec<&'static str>),
+    /// A real number (its limits in the option's doc).
+    Float,
 }
 
 /// One option of a method's config.
@@ -210,6 +215,7 @@ pub fn methods() -> Vec<MethodInfo> {
                 restricted_on: vec![],
             }],
         },
+        shadow_mapping_row(),
         MethodInfo {
             name: "auto",
             config: "Auto",
@@ -221,6 +227,75 @@ pub fn methods() -> Vec<MethodInfo> {
             options: vec![],
         },
     ]
+}
+
+/// ShadowMapping's row: the eye view, the CPU, its parts as config classes.
+fn shadow_mapping_row() -> MethodInfo {
+    use super::shadow_mapping::config::{DEFAULT_SM_RESOLUTION, MAX_SM_SIDE};
+    let part = |name, classes: Vec<&'static str>, doc| OptionInfo {
+        name,
+        kind: Kind::Config(classes),
+        default: Value::Resolved,
+        default_doc: "None (off)",
+        doc,
+        restricted_on: vec![],
+    };
+    MethodInfo {
+        name: "shadow_mapping",
+        config: "ShadowMapping",
+        summary: "The standard shadow map from the light's centre or direction with Scherzer \
+                  2005's practical extensions: bias methods, PCF, focusing on the \
+                  intersection body, LiSPSM (directional lights), the eye-space blur; hard \
+                  shadows, the eye view only",
+        reads: vec![Input::SceneTriangles, Input::Camera],
+        backends: vec![Backend::Cpu],
+        options: vec![
+            OptionInfo {
+                name: "resolution",
+                kind: Kind::Resolution {
+                    max_texels: (MAX_SM_SIDE * MAX_SM_SIDE) as i64,
+                },
+                default: Value::Int(DEFAULT_SM_RESOLUTION as i64),
+                default_doc: "2048 x 2048 (Scherzer's)",
+                doc: "the shadow map's (W, H), each side at most 16384",
+                restricted_on: vec![],
+            },
+            OptionInfo {
+                name: "bias",
+                kind: Kind::Config(vec![
+                    "ConstantBias",
+                    "SlopeScaleBias",
+                    "LinearDepthBias",
+                    "BackFaces",
+                    "MidpointBias",
+                ]),
+                default: Value::Str("SlopeScaleBias"),
+                default_doc: "SlopeScaleBias(constant=4, slope=2): glPolygonOffset(2, 4), Scherzer's",
+                doc: "how the depth test keeps surfaces from shadowing themselves (Scherzer §4.2)",
+                restricted_on: vec![],
+            },
+            part("filter", vec!["PCF"], "percentage-closer filtering of the depth test"),
+            part(
+                "warp",
+                vec!["LiSPSM"],
+                "LiSPSM (directional lights only): more texels near the camera",
+            ),
+            OptionInfo {
+                name: "focus",
+                kind: Kind::Bool,
+                default: Value::Bool(true),
+                default_doc: "True",
+                doc: "fit the map to the intersection body B (view frustum and scene bounds, \
+                      extended toward the light); False: to the whole scene",
+                restricted_on: vec![],
+            },
+            part(
+                "blur",
+                vec!["EyeSpaceBlur"],
+                "the depth-dependent eye-space blur of the shadow image (Scherzer §4.3)",
+            ),
+        ],
+    }
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ use super::{bitmask, ssm::Precision, Method, HIERARCHY_DEFAULT_BITMASK, HIERARCH
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 pub use crate::geom::light::check_resolution;
+pub use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 
 /// Default light samples per receiver for the sampling methods (a 16x16
 /// stratification).
@@ -68,6 +69,9 @@ pub enum MethodConfig {
     Ssm(SsmConfig),
     Bitmask(BitmaskConfig),
     Exact(ExactConfig),
+    /// Scherzer 2005's practical shadow mapping (hard shadows from the
+    /// light's centre or direction; `shadow_mapping/`).
+    ShadowMapping(ShadowMappingConfig),
 }
 
 /// Options given loosely by name (the string form `method="bitmask",
@@ -104,7 +108,7 @@ impl LooseOptions<'_> {
 }
 
 /// The method names a user can pass as `method=`, in the table's order.
-pub const METHOD_NAMES: [&str; 4] = ["ssm", "bitmask", "exact", "auto"];
+pub const METHOD_NAMES: [&str; 5] = ["ssm", "bitmask", "exact", "shadow_mapping", "auto"];
 
 /// Light samples of `exact`: 1 to MAX_SAMPLES.
 pub fn check_exact_samples(n: i64) -> Result<u32> {
@@ -243,6 +247,8 @@ pub struct CallContext {
     /// From depth maps: how many occluder layers the user gave and their
     /// (W, H). `None`: from meshes (the pipeline makes the layers).
     pub depth_layers: Option<(u32, (usize, usize))>,
+    /// Whether the call has a camera (the eye view).
+    pub eye: bool,
 }
 
 /// What `method="auto"` runs at output `resolution` (W, H): the paper's
@@ -263,6 +269,19 @@ pub fn auto_rule(resolution: (usize, usize)) -> SsmConfig {
         hierarchy: None,
         precision: Precision::F32,
     }
+}
+
+/// The methods the GPU backend has no kernels for yet.
+fn cpu_only(ctx: &CallContext, name: &str) -> Result<()> {
+    if ctx.backend == Backend::Gpu {
+        return Err(Error::invalid(
+            "backend",
+            format!(
+                "{name:?} runs on the CPU only in this version; use backend=\"cpu\" (or \"auto\")"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Options shared by the occluder-map methods, resolved for a call.
@@ -389,6 +408,15 @@ impl MethodConfig {
                     o.precision,
                 )?)
             }
+            "shadow_mapping" => {
+                if let Some(opt) = o.given().first() {
+                    return refuse(
+                        opt,
+                        "the soft shadow map methods; give ShadowMapping(...) its own options",
+                    );
+                }
+                MethodConfig::ShadowMapping(ShadowMappingConfig::default())
+            }
             other => {
                 return Err(Error::invalid(
                     "method",
@@ -419,6 +447,7 @@ impl MethodConfig {
             MethodConfig::Ssm(_) => "ssm",
             MethodConfig::Bitmask(_) => "bitmask",
             MethodConfig::Exact(_) => "exact",
+            MethodConfig::ShadowMapping(_) => "shadow_mapping",
         }
     }
 
@@ -489,6 +518,24 @@ impl MethodConfig {
                 }
                 MethodConfig::Exact(c)
             }
+            MethodConfig::ShadowMapping(c) => {
+                cpu_only(ctx, "shadow_mapping")?;
+                if !ctx.eye {
+                    return Err(Error::invalid(
+                        "method",
+                        "ShadowMapping renders the eye view (ss.render): its map is focused, \
+                         warped and blurred for a camera; in the light view use method=\"ssm\" \
+                         or \"exact\" with a point light for hard shadows",
+                    ));
+                }
+                if ctx.depth_layers.is_some() {
+                    return Err(Error::invalid(
+                        "method",
+                        "ShadowMapping rasterizes its own map of the meshes; depth maps are not enough",
+                    ));
+                }
+                MethodConfig::ShadowMapping(c)
+            }
         })
     }
 
@@ -509,6 +556,7 @@ impl MethodConfig {
                 hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
                 precision: c.precision,
             },
+            MethodConfig::ShadowMapping(c) => Method::ShadowMapping(c),
         }
     }
 
@@ -517,7 +565,7 @@ impl MethodConfig {
         match *self {
             MethodConfig::Ssm(c) => c.passes.unwrap_or(DEFAULT_PASSES),
             MethodConfig::Bitmask(c) => c.passes.unwrap_or(DEFAULT_PASSES),
-            MethodConfig::Exact(_) | MethodConfig::Auto(_) => 0,
+            MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => 0,
         }
     }
 
@@ -527,7 +575,7 @@ impl MethodConfig {
         match *self {
             MethodConfig::Ssm(c) => c.occluder_resolution,
             MethodConfig::Bitmask(c) => c.occluder_resolution,
-            MethodConfig::Exact(_) | MethodConfig::Auto(_) => None,
+            MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => None,
         }
     }
 }
@@ -541,6 +589,7 @@ mod tests {
             backend: Backend::Cpu,
             resolution,
             depth_layers: None,
+            eye: false,
         }
     }
 

@@ -10,6 +10,7 @@ pub mod config;
 pub mod exact;
 pub(crate) mod gather;
 pub mod point_light;
+pub mod shadow_mapping;
 pub mod ssm;
 
 pub use config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
@@ -60,6 +61,12 @@ pub enum Input {
     OccluderLayers,
     /// The occluder triangles in light space.
     OccluderTriangles,
+    /// A camera: the eye view's visible points (what ShadowMapping focuses,
+    /// warps and blurs for).
+    Camera,
+    /// Every mesh's triangles in world space, rasterized into the method's
+    /// own shadow map.
+    SceneTriangles,
 }
 
 impl Input {
@@ -68,6 +75,8 @@ impl Input {
         match self {
             Input::OccluderLayers => "occluder_layers",
             Input::OccluderTriangles => "occluder_triangles",
+            Input::Camera => "camera",
+            Input::SceneTriangles => "scene_triangles",
         }
     }
 }
@@ -89,6 +98,9 @@ pub enum Method {
     /// Micro-patches marking light samples in a bit mask per receiver (OR);
     /// `hierarchy` as for Ssm (on by default).
     Bitmask { samples: u32, hierarchy: bool },
+    /// Scherzer 2005's shadow mapping: its own map and depth test
+    /// (`shadow_mapping/`, the eye view only).
+    ShadowMapping(shadow_mapping::config::ShadowMappingConfig),
 }
 
 /// The level choice of the occluder hierarchy: a texel may back-project onto
@@ -114,6 +126,7 @@ impl Method {
             Method::Ssm { .. } => "ssm",
             Method::Exact { .. } => "exact",
             Method::Bitmask { .. } => "bitmask",
+            Method::ShadowMapping(_) => "shadow_mapping",
         }
     }
 
@@ -122,6 +135,7 @@ impl Method {
         match self {
             Method::Ssm { .. } | Method::Bitmask { .. } => &[Input::OccluderLayers],
             Method::Exact { .. } => &[Input::OccluderTriangles],
+            Method::ShadowMapping(_) => &[Input::SceneTriangles, Input::Camera],
         }
     }
 
@@ -144,6 +158,8 @@ impl Method {
                 samples,
                 hierarchy.then_some(HIERARCHY),
             )),
+            // Refused outside the eye view when the config is resolved.
+            Method::ShadowMapping(_) => unreachable!("ShadowMapping has no light-view kernel"),
         }
     }
 }

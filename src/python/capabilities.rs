@@ -19,7 +19,9 @@ fn value(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
 pub struct OptionInfo {
     #[pyo3(get)]
     name: &'static str,
-    /// "int", "one_of", "bool", "choice" or "resolution".
+    /// "int", "one_of", "bool", "choice", "resolution", "float" (limits in
+    /// its doc) or "config" (one of the config classes in `choices`, or
+    /// None where the default is None).
     #[pyo3(get)]
     kind: &'static str,
     /// The default; None where it is resolved when the config runs.
@@ -119,6 +121,13 @@ fn option(py: Python<'_>, o: &caps::OptionInfo) -> PyResult<OptionInfo> {
             Some(v.clone().into_pyobject(py)?.into_any().unbind()),
         ),
         Kind::Resolution { max_texels } => ("resolution", Some(1), Some(*max_texels), None),
+        Kind::Config(v) => (
+            "config",
+            None,
+            None,
+            Some(v.clone().into_pyobject(py)?.into_any().unbind()),
+        ),
+        Kind::Float => ("float", None, None, None),
     };
     let restricted = PyDict::new(py);
     for (b, vals) in &o.restricted_on {

@@ -260,6 +260,9 @@ fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
     if v.cast::<PyAuto>().is_ok() {
         return Some(MethodConfig::Auto(SsmConfig::default()));
     }
+    if let Ok(c) = v.cast::<super::shadow_configs::PyShadowMapping>() {
+        return Some(MethodConfig::ShadowMapping(c.get().0));
+    }
     None
 }
 
@@ -305,7 +308,7 @@ pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<Meth
     }
     if method.extract::<String>().is_err() {
         return Err(PyTypeError::new_err(format!(
-            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto), got {}",
+            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, ShadowMapping), got {}",
             method.get_type().name()?
         )));
     }
@@ -319,6 +322,9 @@ pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
         MethodConfig::Bitmask(c) => Py::new(py, PyBitmask(c))?.into_any(),
         MethodConfig::Exact(c) => Py::new(py, PyExact(c))?.into_any(),
         MethodConfig::Auto(_) => Py::new(py, PyAuto)?.into_any(),
+        MethodConfig::ShadowMapping(c) => {
+            Py::new(py, super::shadow_configs::PyShadowMapping(c))?.into_any()
+        }
     })
 }
 

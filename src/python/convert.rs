@@ -108,6 +108,24 @@ pub fn opt_bool(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<bool
     }
 }
 
+/// A real number (int or float, not bool), or None.
+pub fn opt_float(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+    match v.filter(|v| !v.is_none()) {
+        None => Ok(None),
+        Some(v) => {
+            if is_bool(v)? {
+                return Err(PyTypeError::new_err(format!(
+                    "{arg}: must be a number, got {}",
+                    type_name(v)
+                )));
+            }
+            v.extract::<f64>().map(Some).map_err(|_| {
+                PyTypeError::new_err(format!("{arg}: must be a number, got {}", type_name(v)))
+            })
+        }
+    }
+}
+
 /// A str.
 pub fn string(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
     v.extract::<String>()

@@ -22,6 +22,7 @@ mod errors;
 mod eye;
 mod gpu;
 mod results;
+mod shadow_configs;
 
 use pyo3::prelude::*;
 
@@ -34,6 +35,7 @@ static ALLOCATOR: crate::block_cache::BlockCache = crate::block_cache::BlockCach
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     ALLOCATOR.configure_from_env();
     configs::register(m)?;
+    shadow_configs::register(m)?;
     m.add_class::<camera::PyCamera>()?;
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;

@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 /// A clip plane in light space: keep points where a.X + b.Y + c.Z + d >= 0.
-pub(super) type Plane = [f64; 4];
+pub(crate) type Plane = [f64; 4];
 
 pub(super) fn plane_dist(p: &Plane, q: DVec3) -> f64 {
     p[0] * q.x + p[1] * q.y + p[2] * q.z + p[3]
@@ -27,7 +27,7 @@ fn clip_point(p: &Plane, a: DVec3, b: DVec3) -> DVec3 {
 }
 
 /// Sutherland-Hodgman against one plane. `out` is cleared first.
-pub(super) fn clip_polygon(p: &Plane, poly: &[DVec3], out: &mut Vec<DVec3>) {
+pub(crate) fn clip_polygon(p: &Plane, poly: &[DVec3], out: &mut Vec<DVec3>) {
     out.clear();
     let n = poly.len();
     for k in 0..n {

@@ -19,7 +19,7 @@
 //! one triangle, `layers.rs` the binning by band and the depth layers
 //! (nearest, farthest, peeling), and `depth_plane.rs` the f32 form of 1/Z.
 
-mod clip;
+pub(crate) mod clip;
 pub(crate) mod depth_plane;
 mod layers;
 mod scan;

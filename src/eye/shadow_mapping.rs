@@ -1,0 +1,191 @@
+//! ShadowMapping (Scherzer 2005) in the eye view: its own shadow map of
+//! every mesh, from the light's centre (a rectangle: a perspective map) or
+//! along its direction (the sun: orthographic, or LiSPSM-warped), then the
+//! depth test at each visible point and, if asked, the eye-space blur.
+//!
+//! The map is fitted to the intersection body B (`geom/body.rs`) when
+//! `focus` is on, else to the whole scene's bounds. A directional map's
+//! axes follow the view (S and Vp of `geom/shadow_projection.rs`) whenever
+//! the view is not along the light, so focusing, LiSPSM and its fallback
+//! frame the same body the same way. A point whose camera-facing normal
+//! turns away from the light's centre (or that lies behind a rectangle's
+//! plane) gets 0: a renderer's N·L does that before any depth test.
+
+use super::gbuffer::{GBuffer, SceneTriangles};
+use super::EyeCall;
+use crate::error::Result;
+use crate::geom::body::{extend_toward_light, view_body, Aabb};
+use crate::geom::light_space::Light;
+use crate::geom::shadow_projection::{ShadowProjection, ViewVector, MIN_SIN_GAMMA};
+use crate::methods::shadow_mapping::blur::blur;
+use crate::methods::shadow_mapping::config::{DepthBias, ShadowMappingConfig};
+use crate::methods::shadow_mapping::lookup::Lookup;
+use crate::methods::shadow_mapping::raster::{rasterize, DepthMap, Faces, Toward};
+use crate::pipeline::Stopwatch;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// What the map of an image was.
+#[derive(Debug, Clone)]
+pub struct ShadowMapInfo {
+    pub map: DepthMap,
+    pub projection: ShadowProjection,
+}
+
+fn toward(light: &Light) -> Toward {
+    match light {
+        Light::Rect(l) => Toward::Point(l.center),
+        Light::Sun(s) => Toward::Direction(-s.n),
+    }
+}
+
+/// The shadow map's projection for `call`.
+fn projection(
+    call: &EyeCall,
+    cfg: &ShadowMappingConfig,
+    bounds: &Aabb,
+    g: &GBuffer,
+) -> Option<ShadowProjection> {
+    let cam = call.camera;
+    let body = if cfg.focus {
+        view_body(cam, bounds)
+    } else {
+        vec![]
+    };
+    let body = if body.is_empty() {
+        bounds.corners().to_vec()
+    } else {
+        body
+    };
+    let tw = toward(call.light);
+    let extended = extend_toward_light(&body, bounds, |p| match tw {
+        Toward::Direction(d) => (d, f64::INFINITY),
+        Toward::Point(c) => ((c - p).normalize_or_zero(), (c - p).length()),
+    });
+    match call.light {
+        Light::Rect(l) => ShadowProjection::perspective(l.center, l.n, l.u, l.v, &extended),
+        Light::Sun(s) => {
+            let l = s.n;
+            let view = match cfg.warp.map(|w| w.vector) {
+                Some(ViewVector::Middle) => {
+                    let m: DVec3 = body.iter().map(|p| *p - cam.eye).sum();
+                    m.normalize_or(cam.forward)
+                }
+                _ => cam.forward,
+            };
+            let sin_gamma = l.cross(view).length();
+            let (x, y) = if sin_gamma >= MIN_SIN_GAMMA {
+                let vp = (view - view.dot(l) * l).normalize();
+                (l.cross(vp), vp)
+            } else {
+                (s.u, s.v)
+            };
+            let uniform = ShadowProjection::orthographic(l, x, y, &extended)?;
+            match cfg.warp {
+                None => Some(uniform),
+                Some(w) => {
+                    let (zn, zf) = g
+                        .depth
+                        .par_iter()
+                        .filter(|z| z.is_finite())
+                        .fold(
+                            || (f64::INFINITY, 0f64),
+                            |(a, b), &z| (a.min(z as f64), b.max(z as f64)),
+                        )
+                        .reduce(
+                            || (f64::INFINITY, 0f64),
+                            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+                        );
+                    if !zn.is_finite() {
+                        return Some(uniform);
+                    }
+                    Some(ShadowProjection::lispsm(
+                        l,
+                        cam.eye,
+                        view,
+                        &extended,
+                        w.n.map(|n| n.0),
+                        zn,
+                        zf,
+                        uniform,
+                    ))
+                }
+            }
+        }
+    }
+}
+
+/// The visibility of every pixel of `g` (1 where no surface) and the map.
+pub(crate) fn render(
+    call: &EyeCall,
+    cfg: &ShadowMappingConfig,
+    scene: &SceneTriangles,
+    g: &GBuffer,
+    sw: &mut Stopwatch,
+) -> Result<(Vec<f32>, Option<ShadowMapInfo>)> {
+    let mut visibility = vec![1f32; g.len()];
+    let hits = g.hits();
+    let bounds = Aabb::of(scene.points()).expect("a checked scene has finite vertices");
+    let Some(proj) = projection(call, cfg, &bounds, g) else {
+        // No geometry in front of the rectangle: nothing it lights.
+        for &k in &hits {
+            visibility[k] = 0.0;
+        }
+        return Ok((visibility, None));
+    };
+    sw.lap("focus");
+    let tw = toward(call.light);
+    let faces = match cfg.bias {
+        DepthBias::BackFaces => Faces::BackOnly(tw),
+        _ => Faces::All,
+    };
+    let map = rasterize(
+        &proj,
+        &scene.vertices,
+        &scene.faces,
+        cfg.resolution,
+        cfg.bias.distribution(),
+        cfg.bias.offset(),
+        faces,
+        cfg.bias == DepthBias::Midpoint,
+    );
+    sw.lap("raster");
+    let lookup = Lookup {
+        map: &map,
+        proj: &proj,
+        bias: cfg.bias,
+        filter: cfg.filter,
+    };
+    let in_front = |p: DVec3| match call.light {
+        Light::Rect(l) => (p - l.center).dot(l.n) > 0.0,
+        Light::Sun(_) => true,
+    };
+    let v: Vec<f32> = hits
+        .par_iter()
+        .with_min_len(256)
+        .map(|&k| {
+            let p = DVec3::from_array(g.position[k]);
+            let n = glam::Vec3::from_array(g.normal[k]).as_dvec3();
+            if !in_front(p) || n.dot(tw.at(p)) <= 0.0 {
+                0.0
+            } else {
+                lookup.visibility(p)
+            }
+        })
+        .collect();
+    for (&k, v) in hits.iter().zip(v) {
+        visibility[k] = v;
+    }
+    sw.lap("shadow");
+    if let Some(b) = cfg.blur {
+        blur(&b, g.width, g.height, &g.depth, &mut visibility);
+        sw.lap("blur");
+    }
+    Ok((
+        visibility,
+        Some(ShadowMapInfo {
+            map,
+            projection: proj,
+        }),
+    ))
+}
