@@ -10,6 +10,7 @@ pub mod config;
 pub mod exact;
 pub(crate) mod gather;
 pub mod point_light;
+pub mod smoothies;
 pub mod ssm;
 
 pub use config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
