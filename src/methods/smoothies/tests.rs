@@ -199,6 +199,39 @@ fn the_remap_divides_by_1_minus_b_over_r() {
 }
 
 #[test]
+fn points_interpolate_the_texels_bilinearly_and_depth_tests_both_maps() {
+    let g = grid();
+    let (vis, front, buf) = plate_case(4.0, Falloff::Linear);
+    let s = sm(Falloff::Linear);
+    let j = N / 2 - 1;
+    let y = g.y_of(j) as f32;
+    for i in N / 2 + 14..N / 2 + 26 {
+        let (k, x0, x1) = (j * N + i, g.x_of(i), g.x_of(i + 1));
+        let pts: Vec<LightPoint> = [0.0, 0.25, 0.5]
+            .iter()
+            .map(|f| LightPoint {
+                x: (x0 + f * (x1 - x0)) as f32,
+                y,
+                z: 4.0,
+            })
+            .collect();
+        let v = s.visibility_points(&g, &front, &buf, &pts);
+        for (f, got) in [0.0f32, 0.25, 0.5].iter().zip(&v) {
+            let expect = (1.0 - f) * vis[k] + f * vis[k + 1];
+            assert!((got - expect).abs() < 1e-5, "{i} +{f}: {got} vs {expect}");
+        }
+    }
+    // A receiver nearer the light than the smoothie (1.5 < b = 2) is lit;
+    // one between the smoothie and the floor reads the penumbra, remapped
+    // against the shadow map's r = 4 (not its own depth).
+    let k = j * N + N / 2 + 18;
+    assert!(buf.alpha[k] > 0.0 && buf.alpha[k] < 1.0);
+    let at = |z: f32| s.visibility_map(&g, &front, &buf, &vec![z; g.len()])[k];
+    assert_eq!(at(1.5), 1.0);
+    assert_eq!(at(3.0), buf.alpha[k]);
+}
+
+#[test]
 fn falloffs_are_as_specified_and_monotone() {
     let (l, s) = (Falloff::Linear, Falloff::Sine);
     assert!(s.apply(0.25) < 0.25 && s.apply(0.75) > 0.75);
@@ -305,6 +338,29 @@ fn minimum_blending_keeps_the_winners_depth() {
         }
     }
     assert!(both > 2);
+}
+
+#[test]
+fn smoothies_behind_a_blocker_are_discarded() {
+    // A small plate at depth 3 under a large one at depth 1: the small
+    // plate's smoothies lie behind the large plate and leave no trace.
+    let g = grid();
+    let (mut v, mut f) = plate(0.45, 1.0, [0.0, 0.0]);
+    let (v2, f2) = plate(0.1, 3.0, [0.0, 0.0]);
+    f.extend(f2.iter().map(|t| t.map(|i| i + v.len() as u32)));
+    v.extend(v2);
+    let front = crate::raster::rasterize(&g, &v, &f, 1e-9, false).nearest;
+    let s = sm(Falloff::Linear);
+    let buf = s.buffer(&g, [1.0, 1.0], &front, &v, &f);
+    assert_eq!(buf.stats.silhouette_edges, 8);
+    // Only the large plate's smoothies (whose width is set by b_ref = 3 here).
+    assert!(buf.stats.texels > 0);
+    for (k, (a, z)) in buf.alpha.iter().zip(&buf.depth).enumerate() {
+        let (x, y) = (g.x_of(k % N), g.y_of(k / N));
+        if x.abs().max(y.abs()) < 0.44 {
+            assert_eq!((*a, *z), (1.0, f32::INFINITY), "texel {k}");
+        }
+    }
 }
 
 fn finite_unit(v: &[f32]) -> bool {
