@@ -11,6 +11,7 @@ pub mod exact;
 pub(crate) mod gather;
 pub mod point_light;
 pub mod shadow_mapping;
+pub mod smoothies;
 pub mod ssm;
 
 pub use config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
