@@ -29,6 +29,7 @@ from .methods import (
     OptionInfo,
     ShadowMapping,
     SlopeScaleBias,
+    Smoothies,
     Ssm,
     capabilities,
     limits,
@@ -39,6 +40,7 @@ from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
 __all__ = [
     "SlopeScaleBias",
+    "Smoothies",
     "ShadowMapping",
     "MidpointBias",
     "LinearDepthBias",

@@ -27,10 +27,11 @@ from ._core import (
     OptionInfo,
     ShadowMapping,
     SlopeScaleBias,
+    Smoothies,
     Ssm,
 )
 
-MethodConfig = Ssm | Bitmask | Exact | Auto | ShadowMapping
+MethodConfig = Ssm | Bitmask | Exact | Auto | ShadowMapping | Smoothies
 """Any method config."""
 
 
@@ -66,6 +67,7 @@ __all__ = [
     "OptionInfo",
     "ShadowMapping",
     "SlopeScaleBias",
+    "Smoothies",
     "Ssm",
     "capabilities",
     "limits",

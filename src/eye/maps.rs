@@ -201,7 +201,15 @@ pub(crate) fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    let mut v = crate::pipeline::shade_points(method, &inputs, &sp.points);
+    let mut v = match method {
+        // Every mesh is an occluder: its silhouette straight from the mesh.
+        Method::Smoothies { width, falloff } => crate::methods::smoothies::Smoothies {
+            width: width.0,
+            falloff,
+        }
+        .shade(&inputs, &tris.verts, tris.faces, &sp.points),
+        _ => crate::pipeline::shade_points(method, &inputs, &sp.points),
+    };
     sw.lap("shadow");
     finish(&mut v, &sp.bound);
     for l in layers.iter_mut() {

@@ -36,7 +36,7 @@ use crate::geom::mesh::MeshRef;
 use crate::geom::sun::SunSpace;
 use crate::geom::units::{check_unit, depth_unit, light_size_in};
 use crate::methods::config::CallContext;
-use crate::methods::{Input, MethodConfig};
+use crate::methods::MethodConfig;
 use crate::pipeline::{Stopwatch, Timings};
 use crate::threads;
 use gbuffer::SceneTriangles;
@@ -339,7 +339,7 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     let mut visibility = vec![1f32; g.len()];
     let mut maps = None;
     let method;
-    if call.method.kernel().reads_input(Input::OccluderTriangles) {
+    if call.method.kernel().traces() {
         method = resolve_at_camera(call, Backend::Cpu)?;
         let samples = exact_samples(call, &method);
         let tris = traced_triangles(&f, &scene);

@@ -166,7 +166,7 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     // Refuse what the GPU cannot run before any GPU work: a config that does
     // not resolve there, a hard light for the map methods.
     eye::resolve_at_camera(call, Backend::Gpu)?;
-    let traced = call.method.kernel().reads_input(Input::OccluderTriangles);
+    let traced = call.method.kernel().traces();
     if !traced {
         if call.light.is_hard() {
             return Err(point_light_on_gpu("size"));

@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::geom::light::is_point;
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
-use crate::methods::{Input, Method};
+use crate::methods::Method;
 use crate::pipeline::{
     frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
 };
@@ -61,7 +61,7 @@ pub fn from_meshes(
     s: &MapSettings,
 ) -> Result<ShadowResult> {
     // Map methods shade occluder maps; `exact` traces the triangles.
-    let traced = s.method.reads_input(Input::OccluderTriangles);
+    let traced = s.method.traces();
     if !traced {
         gather::check_method(s.method)?;
     }

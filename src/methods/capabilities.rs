@@ -16,6 +16,7 @@ pub enum Value {
     Int(i64),
     Bool(bool),
     Str(&'static str),
+    Float(f64),
 }
 
 /// What values an option takes.
@@ -215,6 +216,51 @@ pub fn methods() -> Vec<MethodInfo> {
                 restricted_on: vec![],
             }],
         },
+        MethodInfo {
+            name: "smoothies",
+            config: "Smoothies",
+            summary: "Fake soft shadows (Chan & Durand 2003): the hard shadow map's umbra and an \
+                      outer penumbra from smoothies on the occluders' silhouette edges, their \
+                      alpha remapped by 1/(1 - b/r); CPU only in this version",
+            reads: vec![Input::OccluderLayers, Input::OccluderTriangles],
+            backends: vec![Backend::Cpu],
+            options: vec![
+                OptionInfo {
+                    name: "width",
+                    kind: Kind::Float,
+                    default: Value::Float(super::config::DEFAULT_SMOOTHIE_WIDTH),
+                    default_doc:
+                        "1.0: the penumbra of the light's size for blockers at the median \
+                                  silhouette depth",
+                    doc: "the smoothies' width in the light's image plane, as a factor of the \
+                          light-matched width, in (0, 16]",
+                    restricted_on: vec![],
+                },
+                OptionInfo {
+                    name: "falloff",
+                    kind: Kind::Choice(
+                        super::smoothies::Falloff::ALL
+                            .iter()
+                            .map(|f| f.name())
+                            .collect(),
+                    ),
+                    default: Value::Str("linear"),
+                    default_doc: "linear",
+                    doc:
+                        "the penumbra's profile: linear alpha, or the sinusoidal (1 - cos(pi v))/2",
+                    restricted_on: vec![],
+                },
+                OptionInfo {
+                    name: "filter",
+                    kind: Kind::Choice(super::config::SMOOTHIE_FILTERS.to_vec()),
+                    default: Value::Str("bilinear"),
+                    default_doc: "bilinear",
+                    doc: "the lookup: the paper's 2x2 tent over the shadow map and smoothie buffer",
+                    restricted_on: vec![],
+                },
+                occluder_resolution(),
+            ],
+        },
         shadow_mapping_row(),
         MethodInfo {
             name: "auto",
@@ -270,11 +316,16 @@ fn shadow_mapping_row() -> MethodInfo {
                     "MidpointBias",
                 ]),
                 default: Value::Str("SlopeScaleBias"),
-                default_doc: "SlopeScaleBias(constant=4, slope=2): glPolygonOffset(2, 4), Scherzer's",
+                default_doc:
+                    "SlopeScaleBias(constant=4, slope=2): glPolygonOffset(2, 4), Scherzer's",
                 doc: "how the depth test keeps surfaces from shadowing themselves (Scherzer §4.2)",
                 restricted_on: vec![],
             },
-            part("filter", vec!["PCF"], "percentage-closer filtering of the depth test"),
+            part(
+                "filter",
+                vec!["PCF"],
+                "percentage-closer filtering of the depth test",
+            ),
             part(
                 "warp",
                 vec!["LiSPSM"],

@@ -17,6 +17,8 @@ use crate::backend::Backend;
 use crate::error::{Error, Result};
 pub use crate::geom::light::check_resolution;
 pub use crate::methods::shadow_mapping::config::ShadowMappingConfig;
+use crate::methods::shadow_mapping::config::{check_real, Real};
+use crate::methods::smoothies::Falloff;
 
 /// Default light samples per receiver for the sampling methods (a 16x16
 /// stratification).
@@ -72,6 +74,86 @@ pub enum MethodConfig {
     /// Scherzer 2005's practical shadow mapping (hard shadows from the
     /// light's centre or direction; `shadow_mapping/`).
     ShadowMapping(ShadowMappingConfig),
+    /// Chan & Durand 2003's smoothies (`smoothies/`).
+    Smoothies(SmoothiesConfig),
+}
+
+/// Smoothies (Chan & Durand 2003): fake soft shadows from the hard shadow
+/// map and silhouette-edge smoothies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SmoothiesConfig {
+    /// The smoothies' width, dimensionless: 1 matches the penumbra of the
+    /// light's size for blockers at the median silhouette depth.
+    pub width: Real,
+    pub falloff: Falloff,
+    /// The shadow map's (W, H); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
+}
+
+pub const DEFAULT_SMOOTHIE_WIDTH: f64 = 1.0;
+pub const MAX_SMOOTHIE_WIDTH: f64 = 16.0;
+/// The lookups Smoothies offers: the paper's 2x2 tent.
+pub const SMOOTHIE_FILTERS: [&str; 1] = ["bilinear"];
+
+impl SmoothiesConfig {
+    pub fn new(
+        width: Option<f64>,
+        falloff: Option<&str>,
+        filter: Option<&str>,
+        occluder_resolution: Option<(i64, i64)>,
+    ) -> Result<Self> {
+        if let Some(f) = filter.filter(|f| !SMOOTHIE_FILTERS.contains(f)) {
+            return Err(Error::invalid(
+                "filter",
+                format!("must be one of {SMOOTHIE_FILTERS:?} (the paper's 2x2 tent), got {f:?}"),
+            ));
+        }
+        let falloff = match falloff {
+            None => Falloff::Linear,
+            Some(f) => Falloff::parse(f).ok_or_else(|| {
+                Error::invalid(
+                    "falloff",
+                    format!(
+                        "must be one of {:?}, got {f:?}",
+                        Falloff::ALL.map(|f| f.name())
+                    ),
+                )
+            })?,
+        };
+        Ok(SmoothiesConfig {
+            width: check_real(
+                "width",
+                width.unwrap_or(DEFAULT_SMOOTHIE_WIDTH),
+                0.0,
+                MAX_SMOOTHIE_WIDTH,
+                "a factor of the light-matched width",
+            )
+            .and_then(|w| {
+                if w.0 > 0.0 {
+                    Ok(w)
+                } else {
+                    Err(Error::invalid(
+                        "width",
+                        "must be > 0 (0 would be the hard shadow map)",
+                    ))
+                }
+            })?,
+            falloff,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+        })
+    }
+}
+
+impl Default for SmoothiesConfig {
+    fn default() -> Self {
+        SmoothiesConfig {
+            width: Real(DEFAULT_SMOOTHIE_WIDTH),
+            falloff: Falloff::Linear,
+            occluder_resolution: None,
+        }
+    }
 }
 
 /// Options given loosely by name (the string form `method="bitmask",
@@ -108,7 +190,14 @@ impl LooseOptions<'_> {
 }
 
 /// The method names a user can pass as `method=`, in the table's order.
-pub const METHOD_NAMES: [&str; 5] = ["ssm", "bitmask", "exact", "shadow_mapping", "auto"];
+pub const METHOD_NAMES: [&str; 6] = [
+    "ssm",
+    "bitmask",
+    "exact",
+    "smoothies",
+    "shadow_mapping",
+    "auto",
+];
 
 /// Light samples of `exact`: 1 to MAX_SAMPLES.
 pub fn check_exact_samples(n: i64) -> Result<u32> {
@@ -408,6 +497,17 @@ impl MethodConfig {
                     o.precision,
                 )?)
             }
+            "smoothies" => {
+                if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
+                    return refuse(opt, "other methods; give Smoothies(...) its own options");
+                }
+                MethodConfig::Smoothies(SmoothiesConfig::new(
+                    None,
+                    None,
+                    None,
+                    o.occluder_resolution,
+                )?)
+            }
             "shadow_mapping" => {
                 if let Some(opt) = o.given().first() {
                     return refuse(
@@ -448,6 +548,7 @@ impl MethodConfig {
             MethodConfig::Bitmask(_) => "bitmask",
             MethodConfig::Exact(_) => "exact",
             MethodConfig::ShadowMapping(_) => "shadow_mapping",
+            MethodConfig::Smoothies(_) => "smoothies",
         }
     }
 
@@ -536,6 +637,20 @@ impl MethodConfig {
                 }
                 MethodConfig::ShadowMapping(c)
             }
+            MethodConfig::Smoothies(c) => {
+                cpu_only(ctx, "smoothies")?;
+                if ctx.depth_layers.is_some() {
+                    return Err(Error::invalid(
+                        "method",
+                        "Smoothies find the occluders' silhouette edges, which depth maps do not \
+                         have; use soft_shadow_map with meshes",
+                    ));
+                }
+                MethodConfig::Smoothies(SmoothiesConfig {
+                    occluder_resolution: Some(c.occluder_resolution.unwrap_or(ctx.resolution)),
+                    ..c
+                })
+            }
         })
     }
 
@@ -557,6 +672,10 @@ impl MethodConfig {
                 precision: c.precision,
             },
             MethodConfig::ShadowMapping(c) => Method::ShadowMapping(c),
+            MethodConfig::Smoothies(c) => Method::Smoothies {
+                width: c.width,
+                falloff: c.falloff,
+            },
         }
     }
 
@@ -565,6 +684,8 @@ impl MethodConfig {
         match *self {
             MethodConfig::Ssm(c) => c.passes.unwrap_or(DEFAULT_PASSES),
             MethodConfig::Bitmask(c) => c.passes.unwrap_or(DEFAULT_PASSES),
+            // The shadow map: the front layer.
+            MethodConfig::Smoothies(_) => 1,
             MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => 0,
         }
     }
@@ -575,6 +696,7 @@ impl MethodConfig {
         match *self {
             MethodConfig::Ssm(c) => c.occluder_resolution,
             MethodConfig::Bitmask(c) => c.occluder_resolution,
+            MethodConfig::Smoothies(c) => c.occluder_resolution,
             MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => None,
         }
     }

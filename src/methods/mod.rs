@@ -102,6 +102,12 @@ pub enum Method {
     /// Scherzer 2005's shadow mapping: its own map and depth test
     /// (`shadow_mapping/`, the eye view only).
     ShadowMapping(shadow_mapping::config::ShadowMappingConfig),
+    /// Smoothies (Chan & Durand 2003) from the front layer and the
+    /// occluders' silhouette.
+    Smoothies {
+        width: shadow_mapping::config::Real,
+        falloff: smoothies::Falloff,
+    },
 }
 
 /// The level choice of the occluder hierarchy: a texel may back-project onto
@@ -128,6 +134,7 @@ impl Method {
             Method::Exact { .. } => "exact",
             Method::Bitmask { .. } => "bitmask",
             Method::ShadowMapping(_) => "shadow_mapping",
+            Method::Smoothies { .. } => "smoothies",
         }
     }
 
@@ -137,7 +144,14 @@ impl Method {
             Method::Ssm { .. } | Method::Bitmask { .. } => &[Input::OccluderLayers],
             Method::Exact { .. } => &[Input::OccluderTriangles],
             Method::ShadowMapping(_) => &[Input::SceneTriangles, Input::Camera],
+            Method::Smoothies { .. } => &[Input::OccluderLayers, Input::OccluderTriangles],
         }
+    }
+
+    /// Whether the method only traces triangles (reads no occluder maps):
+    /// `exact`.
+    pub fn traces(&self) -> bool {
+        self.reads_input(Input::OccluderTriangles) && !self.reads_input(Input::OccluderLayers)
     }
 
     /// Whether the method reads `input`.
@@ -161,6 +175,10 @@ impl Method {
             )),
             // Refused outside the eye view when the config is resolved.
             Method::ShadowMapping(_) => unreachable!("ShadowMapping has no light-view kernel"),
+            Method::Smoothies { width, falloff } => Box::new(smoothies::Smoothies {
+                width: width.0,
+                falloff,
+            }),
         }
     }
 }

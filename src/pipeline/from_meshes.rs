@@ -81,11 +81,12 @@ pub fn from_meshes(
     // Only what the method reads: occluder maps for the map methods, light-space
     // triangles for the ray-traced one.
     let mut middle: Vec<Vec<f32>> = vec![];
-    let (occ, triangles) = if s.method.reads_input(Input::OccluderTriangles) {
+    let triangles = s.method.reads_input(Input::OccluderTriangles).then(|| {
         let t = light_space_triangles(&occ_ls, occluders.faces);
         sw.lap("triangles");
-        (None, Some(t))
-    } else {
+        t
+    });
+    let occ = s.method.reads_input(Input::OccluderLayers).then(|| {
         // One set-up serves every layer: front and back in one traversal,
         // then one traversal per peeled layer (passes >= 3).
         let prepared = Prepared::new(&occluder_grid, &occ_ls, occluders.faces, near);
@@ -95,8 +96,8 @@ pub fn from_meshes(
             middle.push(next);
         }
         sw.lap("raster_occluders");
-        (Some(o), None)
-    };
+        o
+    });
     let mut layers: Vec<&[f32]> = vec![];
     if let Some(o) = &occ {
         layers.push(&o.nearest);

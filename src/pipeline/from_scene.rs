@@ -13,7 +13,6 @@ use crate::error::Result;
 use crate::eye::{maps, rays, Bias};
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
-use crate::methods::Input;
 use crate::raster::Prepared;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -62,7 +61,7 @@ pub fn from_scene(
         .unzip();
     sw.lap("receiver_points");
     let mut visibility = vec![1f32; grid.len()];
-    let (front, back, middle) = if s.method.reads_input(Input::OccluderTriangles) {
+    let (front, back, middle) = if s.method.traces() {
         let tris: Vec<[Vec3; 3]> = light_space_triangles(&occ_ls, scene.faces);
         sw.lap("triangles");
         let starts = rays::ray_starts(light, unit, &points, &normals);

@@ -88,6 +88,16 @@ pub fn sample_points(
         })
         .unzip();
     let (layers, triangles, occluder_grid) = match occluders {
+        OccluderSource::Maps { .. } if method.reads_input(Input::OccluderTriangles) => {
+            return Err(Error::invalid(
+                "method",
+                format!(
+                    "{:?} reads the occluder mesh and its maps; sampling a map at points \
+                     supports the map methods (\"ssm\", \"bitmask\") and \"exact\" in this version",
+                    method.name()
+                ),
+            ));
+        }
         OccluderSource::Maps { grid: og, layers } => {
             if !method.reads_input(Input::OccluderLayers) {
                 return Err(Error::invalid(
@@ -125,7 +135,7 @@ pub fn sample_points(
             (scaled, None, og)
         }
         OccluderSource::Mesh(mesh) => {
-            if !method.reads_input(Input::OccluderTriangles) {
+            if !method.traces() {
                 return Err(Error::invalid(
                     "method",
                     "reads occluder maps: pass them, not the mesh",

@@ -11,6 +11,7 @@ fn value(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
         Value::Int(n) => n.into_pyobject(py)?.into_any().unbind(),
         Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any().unbind(),
         Value::Str(s) => s.into_pyobject(py)?.into_any().unbind(),
+        Value::Float(x) => x.into_pyobject(py)?.into_any().unbind(),
     })
 }
 

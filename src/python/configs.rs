@@ -260,6 +260,9 @@ fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
     if v.cast::<PyAuto>().is_ok() {
         return Some(MethodConfig::Auto(SsmConfig::default()));
     }
+    if let Ok(c) = v.cast::<super::shadow_configs::PySmoothies>() {
+        return Some(MethodConfig::Smoothies(c.get().0));
+    }
     if let Ok(c) = v.cast::<super::shadow_configs::PyShadowMapping>() {
         return Some(MethodConfig::ShadowMapping(c.get().0));
     }
@@ -308,7 +311,7 @@ pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<Meth
     }
     if method.extract::<String>().is_err() {
         return Err(PyTypeError::new_err(format!(
-            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, ShadowMapping), got {}",
+            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, Smoothies, ShadowMapping), got {}",
             method.get_type().name()?
         )));
     }
@@ -324,6 +327,9 @@ pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
         MethodConfig::Auto(_) => Py::new(py, PyAuto)?.into_any(),
         MethodConfig::ShadowMapping(c) => {
             Py::new(py, super::shadow_configs::PyShadowMapping(c))?.into_any()
+        }
+        MethodConfig::Smoothies(c) => {
+            Py::new(py, super::shadow_configs::PySmoothies(c))?.into_any()
         }
     })
 }

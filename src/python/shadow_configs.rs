@@ -3,6 +3,7 @@
 //! the core (`methods/shadow_mapping/config.rs`).
 
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string};
+use crate::methods::config::SmoothiesConfig;
 use crate::methods::shadow_mapping::config::{
     DepthBias, EyeSpaceBlur, LiSPSM, Pcf, ShadowMappingConfig,
 };
@@ -489,7 +490,81 @@ impl PyShadowMapping {
     }
 }
 
+/// Smoothies (Chan & Durand 2003). See ``capabilities()["smoothies"]``.
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Smoothies")]
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct PySmoothies(pub SmoothiesConfig);
+
+#[pymethods]
+impl PySmoothies {
+    #[new]
+    #[pyo3(signature = (*, width=None, falloff=None, filter=None, occluder_resolution=None))]
+    fn new(
+        width: Option<&Bound<'_, PyAny>>,
+        falloff: Option<&Bound<'_, PyAny>>,
+        filter: Option<&Bound<'_, PyAny>>,
+        occluder_resolution: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let falloff = opt_string("falloff", falloff)?;
+        let filter = opt_string("filter", filter)?;
+        Ok(PySmoothies(SmoothiesConfig::new(
+            opt_float("width", width)?,
+            falloff.as_deref(),
+            filter.as_deref(),
+            opt_resolution("occluder_resolution", occluder_resolution)?,
+        )?))
+    }
+    /// "smoothies", the name given as ``method=``.
+    #[getter]
+    fn name(&self) -> &'static str {
+        "smoothies"
+    }
+    #[getter]
+    fn width(&self) -> f64 {
+        self.0.width.0
+    }
+    #[getter]
+    fn falloff(&self) -> &'static str {
+        self.0.falloff.name()
+    }
+    #[getter]
+    fn filter(&self) -> &'static str {
+        "bilinear"
+    }
+    #[getter]
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.0.occluder_resolution
+    }
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("width", self.width())?;
+        d.set_item("falloff", self.falloff())?;
+        d.set_item("filter", self.filter())?;
+        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
+        Ok(d)
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        Ok(newargs(py, self.to_dict(py)?))
+    }
+    fn __repr__(&self) -> String {
+        let r = self
+            .0
+            .occluder_resolution
+            .map(|(w, h)| format!("({w}, {h})"))
+            .unwrap_or_else(|| "None".into());
+        format!(
+            "Smoothies(width={:?}, falloff='{}', filter='bilinear', occluder_resolution={r})",
+            self.width(),
+            self.falloff()
+        )
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PySmoothies>()?;
     m.add_class::<PyShadowMapping>()?;
     m.add_class::<PyConstantBias>()?;
     m.add_class::<PySlopeScaleBias>()?;

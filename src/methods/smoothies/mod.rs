@@ -23,6 +23,7 @@
 mod buffer;
 mod construct;
 mod lookup;
+pub mod method;
 mod silhouette;
 #[cfg(test)]
 mod tests;
