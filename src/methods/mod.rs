@@ -9,6 +9,8 @@ pub mod capabilities;
 pub mod config;
 pub mod exact;
 pub(crate) mod gather;
+pub mod pcf;
+pub mod pcss;
 pub mod point_light;
 pub mod shadow_mapping;
 pub mod smoothies;
