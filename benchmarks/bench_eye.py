@@ -62,6 +62,11 @@ CALLS: list[tuple[str, Any]] = [
     ("bitmask 256", ss.Bitmask(samples=256)),
     ("exact 16", ss.Exact(samples=16)),
     ("exact 64", ss.Exact(samples=64)),
+    ("pcss", ss.Pcss()),
+    ("smoothies", ss.Smoothies()),
+    ("shadow map", ss.ShadowMapping()),
+    ("shadow map, PCF 3", ss.ShadowMapping(filter=ss.PCF(size=3), bias=ss.SlopeScaleBias(slope=4))),
+    ("shadow map, blur 4", ss.ShadowMapping(blur=ss.EyeSpaceBlur(iterations=4))),
 ]
 #: Rays per Dr.Jit launch: keeps the ray arrays to a few hundred MB.
 BATCH_RAYS = 1 << 23

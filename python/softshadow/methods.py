@@ -25,13 +25,14 @@ from ._core import (
     MethodInfo,
     MidpointBias,
     OptionInfo,
+    Pcss,
     ShadowMapping,
     SlopeScaleBias,
     Smoothies,
     Ssm,
 )
 
-MethodConfig = Ssm | Bitmask | Exact | Auto | ShadowMapping | Smoothies
+MethodConfig = Ssm | Bitmask | Exact | Auto | Pcss | ShadowMapping | Smoothies
 """Any method config."""
 
 
@@ -65,6 +66,7 @@ __all__ = [
     "MethodInfo",
     "MidpointBias",
     "OptionInfo",
+    "Pcss",
     "ShadowMapping",
     "SlopeScaleBias",
     "Smoothies",

@@ -7,13 +7,14 @@
 //! `focus` is on, else to the whole scene's bounds. A directional map's
 //! axes follow the view (S and Vp of `geom/shadow_projection.rs`) whenever
 //! the view is not along the light, so focusing, LiSPSM and its fallback
-//! frame the same body the same way. A point whose camera-facing normal
+//! frame the same body the same way (LiSPSM with the camera's axis as its
+//! view vector tends to exactly this map as n grows). A point whose camera-facing normal
 //! turns away from the light's centre (or that lies behind a rectangle's
 //! plane) gets 0: a renderer's N·L does that before any depth test.
 
 use super::gbuffer::{GBuffer, SceneTriangles};
 use super::EyeCall;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geom::body::{extend_toward_light, view_body, Aabb};
 use crate::geom::light_space::Light;
 use crate::geom::shadow_projection::{ShadowProjection, ViewVector, MIN_SIN_GAMMA};
@@ -66,19 +67,20 @@ fn projection(
         Light::Rect(l) => ShadowProjection::perspective(l.center, l.n, l.u, l.v, &extended),
         Light::Sun(s) => {
             let l = s.n;
+            // The uniform map (and LiSPSM's fallback) follows the camera's
+            // axis; the warp follows its own view vector.
+            let (x, y) = if l.cross(cam.forward).length() >= MIN_SIN_GAMMA {
+                let vp = (cam.forward - cam.forward.dot(l) * l).normalize();
+                (l.cross(vp), vp)
+            } else {
+                (s.u, s.v)
+            };
             let view = match cfg.warp.map(|w| w.vector) {
                 Some(ViewVector::Middle) => {
                     let m: DVec3 = body.iter().map(|p| *p - cam.eye).sum();
                     m.normalize_or(cam.forward)
                 }
                 _ => cam.forward,
-            };
-            let sin_gamma = l.cross(view).length();
-            let (x, y) = if sin_gamma >= MIN_SIN_GAMMA {
-                let vp = (view - view.dot(l) * l).normalize();
-                (l.cross(vp), vp)
-            } else {
-                (s.u, s.v)
             };
             let uniform = ShadowProjection::orthographic(l, x, y, &extended)?;
             match cfg.warp {
@@ -123,6 +125,15 @@ pub(crate) fn render(
     g: &GBuffer,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, Option<ShadowMapInfo>)> {
+    if let (Some(_), Light::Rect(_)) = (cfg.warp, call.light) {
+        return Err(Error::invalid(
+            "warp",
+            "LiSPSM warps directional lights only (Scherzer 2005 centres on them, §6): a \
+             rectangle's map is already a perspective one from its centre, and warping it needs \
+             the light's post-perspective space, which this version does not build; use \
+             warp=None or a DirectionalLight",
+        ));
+    }
     let mut visibility = vec![1f32; g.len()];
     let hits = g.hits();
     let bounds = Aabb::of(scene.points()).expect("a checked scene has finite vertices");
@@ -150,12 +161,7 @@ pub(crate) fn render(
         cfg.bias == DepthBias::Midpoint,
     );
     sw.lap("raster");
-    let lookup = Lookup {
-        map: &map,
-        proj: &proj,
-        bias: cfg.bias,
-        filter: cfg.filter,
-    };
+    let lookup = Lookup::new(&map, &proj, cfg.bias, cfg.filter);
     let in_front = |p: DVec3| match call.light {
         Light::Rect(l) => (p - l.center).dot(l.n) > 0.0,
         Light::Sun(_) => true,

@@ -217,6 +217,30 @@ pub fn methods() -> Vec<MethodInfo> {
             }],
         },
         MethodInfo {
+            name: "pcss",
+            config: "Pcss",
+            summary: "Percentage-closer soft shadows (Fernando 2005), what real-time engines \
+                      ship: a blocker search on the shadow map, the penumbra estimated from the \
+                      mean blocker depth, a box PCF of that width; CPU only in this version",
+            reads: vec![Input::OccluderLayers],
+            backends: vec![Backend::Cpu],
+            options: vec![
+                OptionInfo {
+                    name: "max_taps",
+                    kind: Kind::Int {
+                        min: 1,
+                        max: super::pcss::MAX_TAPS as i64,
+                    },
+                    default: Value::Int(super::pcss::DEFAULT_MAX_TAPS as i64),
+                    default_doc: "32",
+                    doc: "taps per axis of the blocker search and of the filter: a box spanning \
+                          more texels is sampled by this many strata (bounded work per point)",
+                    restricted_on: vec![],
+                },
+                occluder_resolution(),
+            ],
+        },
+        MethodInfo {
             name: "smoothies",
             config: "Smoothies",
             summary: "Fake soft shadows (Chan & Durand 2003): the hard shadow map's umbra and an \

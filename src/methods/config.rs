@@ -76,21 +76,66 @@ pub enum MethodConfig {
     ShadowMapping(ShadowMappingConfig),
     /// Chan & Durand 2003's smoothies (`smoothies/`).
     Smoothies(SmoothiesConfig),
+    /// Fernando 2005's percentage-closer soft shadows (`pcss.rs`).
+    Pcss(PcssConfig),
+}
+
+/// PCSS: blocker search, penumbra estimate and PCF on the shadow map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PcssConfig {
+    /// Taps per axis of the blocker search and of the filter (each box
+    /// wider than this many texels is sampled by as many strata).
+    pub max_taps: u32,
+    /// The shadow map's (W, H); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
+}
+
+impl PcssConfig {
+    pub fn new(max_taps: Option<i64>, occluder_resolution: Option<(i64, i64)>) -> Result<Self> {
+        let t = max_taps.unwrap_or(crate::methods::pcss::DEFAULT_MAX_TAPS as i64);
+        let max = crate::methods::pcss::MAX_TAPS as i64;
+        if !(1..=max).contains(&t) {
+            return Err(Error::invalid(
+                "max_taps",
+                format!("must be in [1, {max}], got {t}"),
+            ));
+        }
+        Ok(PcssConfig {
+            max_taps: t as u32,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+        })
+    }
+}
+
+impl Default for PcssConfig {
+    fn default() -> Self {
+        PcssConfig {
+            max_taps: crate::methods::pcss::DEFAULT_MAX_TAPS,
+            occluder_resolution: None,
+        }
+    }
 }
 
 /// Smoothies (Chan & Durand 2003): fake soft shadows from the hard shadow
 /// map and silhouette-edge smoothies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct SmoothiesConfig {
-    /// The smoothies' width, dimensionless: 1 matches the penumbra of the
-    /// light's size for blockers at the median silhouette depth.
+    /// The smoothies' width, dimensionless: 1 spans the whole penumbra of
+    /// the light's size for blockers at the median silhouette depth.
     pub width: Real,
     pub falloff: Falloff,
     /// The shadow map's (W, H); `None`: the output's.
     pub occluder_resolution: Option<(usize, usize)>,
 }
 
-pub const DEFAULT_SMOOTHIE_WIDTH: f64 = 1.0;
+/// Measured by `benchmarks/bench_shadow_mapping.py`
+/// (docs/benchmarks/shadow_mapping.md): against 256-sample `exact` on the
+/// four eye-view scenes, width 0.5 is within 0.0006 of the best of
+/// 0.25-4 on each, width 1 is 0.0003-0.015 worse. Smoothies darken only
+/// outside the hard shadow, where the true penumbra has half its width.
+pub const DEFAULT_SMOOTHIE_WIDTH: f64 = 0.5;
 pub const MAX_SMOOTHIE_WIDTH: f64 = 16.0;
 /// The lookups Smoothies offers: the paper's 2x2 tent.
 pub const SMOOTHIE_FILTERS: [&str; 1] = ["bilinear"];
@@ -497,6 +542,12 @@ impl MethodConfig {
                     o.precision,
                 )?)
             }
+            "pcss" => {
+                if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
+                    return refuse(opt, "other methods; give Pcss(...) its own options");
+                }
+                MethodConfig::Pcss(PcssConfig::new(None, o.occluder_resolution)?)
+            }
             "smoothies" => {
                 if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
                     return refuse(opt, "other methods; give Smoothies(...) its own options");
@@ -549,6 +600,7 @@ impl MethodConfig {
             MethodConfig::Exact(_) => "exact",
             MethodConfig::ShadowMapping(_) => "shadow_mapping",
             MethodConfig::Smoothies(_) => "smoothies",
+            MethodConfig::Pcss(_) => "pcss",
         }
     }
 
@@ -651,6 +703,24 @@ impl MethodConfig {
                     ..c
                 })
             }
+            MethodConfig::Pcss(c) => {
+                cpu_only(ctx, "pcss")?;
+                // From depth maps: the front layer the user gave.
+                let (_, occ, _) = resolve_maps(
+                    Some(1),
+                    c.occluder_resolution,
+                    Some(false),
+                    false,
+                    &CallContext {
+                        depth_layers: ctx.depth_layers.map(|(_, shape)| (1, shape)),
+                        ..*ctx
+                    },
+                )?;
+                MethodConfig::Pcss(PcssConfig {
+                    occluder_resolution: Some(occ),
+                    ..c
+                })
+            }
         })
     }
 
@@ -676,6 +746,9 @@ impl MethodConfig {
                 width: c.width,
                 falloff: c.falloff,
             },
+            MethodConfig::Pcss(c) => Method::Pcss {
+                max_taps: c.max_taps,
+            },
         }
     }
 
@@ -685,7 +758,7 @@ impl MethodConfig {
             MethodConfig::Ssm(c) => c.passes.unwrap_or(DEFAULT_PASSES),
             MethodConfig::Bitmask(c) => c.passes.unwrap_or(DEFAULT_PASSES),
             // The shadow map: the front layer.
-            MethodConfig::Smoothies(_) => 1,
+            MethodConfig::Smoothies(_) | MethodConfig::Pcss(_) => 1,
             MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => 0,
         }
     }
@@ -697,6 +770,7 @@ impl MethodConfig {
             MethodConfig::Ssm(c) => c.occluder_resolution,
             MethodConfig::Bitmask(c) => c.occluder_resolution,
             MethodConfig::Smoothies(c) => c.occluder_resolution,
+            MethodConfig::Pcss(c) => c.occluder_resolution,
             MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => None,
         }
     }

@@ -110,6 +110,8 @@ pub enum Method {
         width: shadow_mapping::config::Real,
         falloff: smoothies::Falloff,
     },
+    /// PCSS (Fernando 2005) on the front layer.
+    Pcss { max_taps: u32 },
 }
 
 /// The level choice of the occluder hierarchy: a texel may back-project onto
@@ -137,13 +139,16 @@ impl Method {
             Method::Bitmask { .. } => "bitmask",
             Method::ShadowMapping(_) => "shadow_mapping",
             Method::Smoothies { .. } => "smoothies",
+            Method::Pcss { .. } => "pcss",
         }
     }
 
     /// What the method reads of the occluders.
     pub fn reads(&self) -> &'static [Input] {
         match self {
-            Method::Ssm { .. } | Method::Bitmask { .. } => &[Input::OccluderLayers],
+            Method::Ssm { .. } | Method::Bitmask { .. } | Method::Pcss { .. } => {
+                &[Input::OccluderLayers]
+            }
             Method::Exact { .. } => &[Input::OccluderTriangles],
             Method::ShadowMapping(_) => &[Input::SceneTriangles, Input::Camera],
             Method::Smoothies { .. } => &[Input::OccluderLayers, Input::OccluderTriangles],
@@ -181,6 +186,7 @@ impl Method {
                 width: width.0,
                 falloff,
             }),
+            Method::Pcss { max_taps } => Box::new(pcss::Pcss { max_taps }),
         }
     }
 }

@@ -260,6 +260,9 @@ fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
     if v.cast::<PyAuto>().is_ok() {
         return Some(MethodConfig::Auto(SsmConfig::default()));
     }
+    if let Ok(c) = v.cast::<super::shadow_configs::PyPcss>() {
+        return Some(MethodConfig::Pcss(c.get().0));
+    }
     if let Ok(c) = v.cast::<super::shadow_configs::PySmoothies>() {
         return Some(MethodConfig::Smoothies(c.get().0));
     }
@@ -311,7 +314,7 @@ pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<Meth
     }
     if method.extract::<String>().is_err() {
         return Err(PyTypeError::new_err(format!(
-            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, Smoothies, ShadowMapping), got {}",
+            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, Pcss, Smoothies, ShadowMapping), got {}",
             method.get_type().name()?
         )));
     }
@@ -331,6 +334,7 @@ pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
         MethodConfig::Smoothies(c) => {
             Py::new(py, super::shadow_configs::PySmoothies(c))?.into_any()
         }
+        MethodConfig::Pcss(c) => Py::new(py, super::shadow_configs::PyPcss(c))?.into_any(),
     })
 }
 

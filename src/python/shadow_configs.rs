@@ -3,9 +3,9 @@
 //! the core (`methods/shadow_mapping/config.rs`).
 
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string};
-use crate::methods::config::SmoothiesConfig;
+use crate::methods::config::{PcssConfig, SmoothiesConfig};
 use crate::methods::shadow_mapping::config::{
-    DepthBias, EyeSpaceBlur, LiSPSM, Pcf, ShadowMappingConfig,
+    check_pcf, DepthBias, EyeSpaceBlur, LiSPSM, Pcf, ShadowMappingConfig,
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -224,7 +224,7 @@ impl PyPcf {
     #[new]
     #[pyo3(signature = (*, size=None))]
     fn new(size: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
-        Ok(PyPcf(Pcf::new(opt_int("size", size)?)?))
+        Ok(PyPcf(check_pcf(opt_int("size", size)?)?))
     }
     #[getter]
     fn size(&self) -> u32 {
@@ -563,7 +563,64 @@ impl PySmoothies {
     }
 }
 
+/// PCSS (Fernando 2005). See ``capabilities()["pcss"]``.
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Pcss")]
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct PyPcss(pub PcssConfig);
+
+#[pymethods]
+impl PyPcss {
+    #[new]
+    #[pyo3(signature = (*, max_taps=None, occluder_resolution=None))]
+    fn new(
+        max_taps: Option<&Bound<'_, PyAny>>,
+        occluder_resolution: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(PyPcss(PcssConfig::new(
+            opt_int("max_taps", max_taps)?,
+            opt_resolution("occluder_resolution", occluder_resolution)?,
+        )?))
+    }
+    /// "pcss", the name given as ``method=``.
+    #[getter]
+    fn name(&self) -> &'static str {
+        "pcss"
+    }
+    #[getter]
+    fn max_taps(&self) -> u32 {
+        self.0.max_taps
+    }
+    #[getter]
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.0.occluder_resolution
+    }
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("max_taps", self.0.max_taps)?;
+        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
+        Ok(d)
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        Ok(newargs(py, self.to_dict(py)?))
+    }
+    fn __repr__(&self) -> String {
+        let r = self
+            .0
+            .occluder_resolution
+            .map(|(w, h)| format!("({w}, {h})"))
+            .unwrap_or_else(|| "None".into());
+        format!(
+            "Pcss(max_taps={}, occluder_resolution={r})",
+            self.0.max_taps
+        )
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyPcss>()?;
     m.add_class::<PySmoothies>()?;
     m.add_class::<PyShadowMapping>()?;
     m.add_class::<PyConstantBias>()?;

@@ -28,6 +28,11 @@ def _values(o: methods.OptionInfo) -> str:
         return f"int or `(W, H)`, at least 1, at most {o.max} texels"
     if o.kind == "bool":
         return "`True` / `False`"
+    if o.kind == "float":
+        return "a number (limits in its description)"
+    if o.kind == "config":
+        assert o.choices is not None
+        return " or ".join(f"`ss.{c}(...)`" for c in o.choices) + " or `None`"
     assert o.choices is not None
     return ", ".join(f"`{c!r}`" if isinstance(c, str) else str(c) for c in o.choices)
 

@@ -131,32 +131,25 @@ impl DepthBias {
     }
 }
 
-/// Percentage-closer filtering (Reeves et al. 1987): `size`×`size` taps
-/// one texel apart centred on the point, each the bilinear blend of its
-/// four nearest texels' tests (a box convolved with the 2×2 tent: the
-/// texel weights of one axis are those of a box of `size` + 1 texels with
-/// linear ends): a step edge becomes a linear ramp `size` texels wide.
-/// `size` 1 is the 2×2 bilinear PCF of hardware.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Pcf {
-    pub size: u32,
-}
+/// Percentage-closer filtering (Reeves et al. 1987): `methods/pcf.rs`'s
+/// `Pcf { size }`, size×size taps one texel apart centred on the point,
+/// each the bilinear blend of its four nearest texels' tests (the box
+/// filter of width `size` texels: a step edge becomes a linear ramp `size`
+/// texels wide). `size` 1 is the 2×2 bilinear PCF of hardware.
+pub use crate::methods::pcf::Pcf;
 pub const MAX_PCF: u32 = 33;
 pub const DEFAULT_PCF: u32 = 3;
 
-impl Pcf {
-    pub fn new(size: Option<i64>) -> Result<Self> {
-        let size = size.unwrap_or(DEFAULT_PCF as i64);
-        if (1..=MAX_PCF as i64).contains(&size) {
-            Ok(Pcf { size: size as u32 })
-        } else {
-            Err(Error::invalid(
-                "size",
-                format!(
-                    "PCF's size must be a number of taps per axis in [1, {MAX_PCF}], got {size}"
-                ),
-            ))
-        }
+/// `PCF(size=)`: 1 to MAX_PCF taps per axis.
+pub fn check_pcf(size: Option<i64>) -> Result<Pcf> {
+    let size = size.unwrap_or(DEFAULT_PCF as i64);
+    if (1..=MAX_PCF as i64).contains(&size) {
+        Ok(Pcf { size: size as u32 })
+    } else {
+        Err(Error::invalid(
+            "size",
+            format!("PCF's size must be a number of taps per axis in [1, {MAX_PCF}], got {size}"),
+        ))
     }
 }
 

@@ -13,18 +13,37 @@
 
 use super::config::{DepthBias, Pcf};
 use super::raster::{DepthMap, Distribution};
+use crate::geom::light::MapGrid;
 use crate::geom::shadow_projection::ShadowProjection;
+use crate::methods::pcf::Border;
 use glam::DVec3;
 
 /// A shadow map ready to be looked up.
 pub struct Lookup<'a> {
-    pub map: &'a DepthMap,
-    pub proj: &'a ShadowProjection,
-    pub bias: DepthBias,
-    pub filter: Option<Pcf>,
+    map: &'a DepthMap,
+    proj: &'a ShadowProjection,
+    bias: DepthBias,
+    filter: Option<Pcf>,
+    /// The map's texel grid, as `pcf.rs` reads it.
+    grid: Option<MapGrid>,
 }
 
-impl Lookup<'_> {
+impl<'a> Lookup<'a> {
+    pub fn new(
+        map: &'a DepthMap,
+        proj: &'a ShadowProjection,
+        bias: DepthBias,
+        filter: Option<Pcf>,
+    ) -> Self {
+        let grid = MapGrid::new(map.width, map.height, [1.0, 1.0]).ok();
+        Lookup {
+            map,
+            proj,
+            bias,
+            filter,
+            grid,
+        }
+    }
     /// Whether texel (i, j) passes at depth d (out of the map: lit).
     #[inline]
     fn pass(&self, i: i64, j: i64, d: f32) -> f32 {
@@ -51,28 +70,16 @@ impl Lookup<'_> {
             Distribution::Linear => q.linear,
         } as f32;
         let (x, y) = self.map.texel_of(q.u, q.v);
-        match self.filter {
-            None => self.pass(x.round() as i64, y.round() as i64, d),
-            Some(Pcf { size }) => {
-                let half = 0.5 * (size as f64 - 1.0);
-                let mut sum = 0.0f32;
-                for b in 0..size {
-                    for a in 0..size {
-                        sum += self.bilinear(x - half + a as f64, y - half + b as f64, d);
-                    }
-                }
-                sum / (size * size) as f32
+        match (self.filter, &self.grid) {
+            (Some(pcf), Some(grid)) => {
+                let w = self.map.width as i64;
+                // pcf.rs's texel i covers [i, i + 1]: its centre is ours + 1/2.
+                pcf.filter(grid, x + 0.5, y + 0.5, Border::Constant(1.0), |k| {
+                    self.pass(k as i64 % w, k as i64 / w, d)
+                })
             }
+            _ => self.pass(x.round() as i64, y.round() as i64, d),
         }
-    }
-
-    fn bilinear(&self, x: f64, y: f64, d: f32) -> f32 {
-        let (i, j) = (x.floor(), y.floor());
-        let (fx, fy) = ((x - i) as f32, (y - j) as f32);
-        let (i, j) = (i as i64, j as i64);
-        let top = self.pass(i, j, d) * (1.0 - fx) + self.pass(i + 1, j, d) * fx;
-        let bottom = self.pass(i, j + 1, d) * (1.0 - fx) + self.pass(i + 1, j + 1, d) * fx;
-        top * (1.0 - fy) + bottom * fy
     }
 }
 
@@ -113,12 +120,7 @@ mod tests {
         let bias = DepthBias::Constant {
             constant: Real(0.0),
         };
-        let l = Lookup {
-            map: &map,
-            proj: &proj,
-            bias,
-            filter: None,
-        };
+        let l = Lookup::new(&map, &proj, bias, None);
         assert_eq!(at(&l, 7.0, n), 0.0);
         assert_eq!(at(&l, 8.0, n), 1.0);
         assert_eq!(at(&l, 7.6, n), 1.0);
@@ -132,12 +134,7 @@ mod tests {
             constant: Real(0.0),
         };
         for size in [1u32, 3] {
-            let l = Lookup {
-                map: &map,
-                proj: &proj,
-                bias,
-                filter: Some(Pcf { size }),
-            };
+            let l = Lookup::new(&map, &proj, bias, Some(Pcf { size }));
             // The edge lies between texels 15 and 16 (at 15.5): the ramp is
             // centred there and spans `size` texels.
             let w = size as f64;
@@ -157,12 +154,7 @@ mod tests {
         let mut second = vec![0.6; n * n];
         second[0] = f32::INFINITY;
         map.second = Some(second);
-        let l = Lookup {
-            map: &map,
-            proj: &proj,
-            bias: DepthBias::Midpoint,
-            filter: None,
-        };
+        let l = Lookup::new(&map, &proj, DepthBias::Midpoint, None);
         // Depth 0.5 > (0.2 + 0.6)/2: shadowed.
         assert_eq!(l.visibility(DVec3::new(0.1, 0.1, 0.5)), 0.0);
         // At depth 0.3 it is lit.
