@@ -75,7 +75,9 @@ def main() -> None:
     add_output_arguments(p, DOCS / "shadow_mapping.md")
     args = p.parse_args()
     res = tuple(args.resolution)
-    report = Report(f"Practical shadow mapping and smoothies ({res[0]}×{res[1]})", command_line(__file__), mitsuba=False)
+    report = Report(
+        f"Practical shadow mapping and smoothies ({res[0]}×{res[1]})", command_line(__file__), mitsuba=False
+    )
 
     report.line("## Bias methods: acne and peter-panning (2048² maps)")
     report.line("")
@@ -106,7 +108,9 @@ def main() -> None:
     for label, kw in MAPS:
         cells = []
         for r in RESOLUTIONS:
-            sec, img = timed(lambda kw=kw, r=r: ss.render(scene, h, cam, method=ss.ShadowMapping(resolution=r, **kw)), args.repeats)
+            sec, img = timed(
+                lambda kw=kw, r=r: ss.render(scene, h, cam, method=ss.ShadowMapping(resolution=r, **kw)), args.repeats
+            )
             wrong = np.mean(((img.visibility > 0.5) != (ref.visibility > 0.5))[ref.mask])
             cells.append(f"{wrong:.4f} ({sec * 1000:.0f} ms)")
         alias.append(f"| {label} | " + " | ".join(cells) + " |")
@@ -123,7 +127,9 @@ def main() -> None:
         cells = []
         for s, li, c, r in soft:
             blur = ss.EyeSpaceBlur(iterations=it) if it else None
-            sec, img = timed(lambda s=s, li=li, c=c, b=blur: ss.render(s, li, c, method=ss.ShadowMapping(blur=b)), args.repeats)
+            sec, img = timed(
+                lambda s=s, li=li, c=c, b=blur: ss.render(s, li, c, method=ss.ShadowMapping(blur=b)), args.repeats
+            )
             err = np.abs(img.visibility - r.visibility)[r.mask].mean()
             cells.append(f"{err:.4f} ({sec * 1000:.0f} ms)")
         report.line(f"| {it} | " + " | ".join(cells) + " |")
@@ -136,7 +142,9 @@ def main() -> None:
     for w in (0.25, 0.5, 1.0, 2.0, 4.0):
         cells = []
         for s, li, c, r in soft:
-            sec, img = timed(lambda s=s, li=li, c=c, w=w: ss.render(s, li, c, method=ss.Smoothies(width=w)), args.repeats)
+            sec, img = timed(
+                lambda s=s, li=li, c=c, w=w: ss.render(s, li, c, method=ss.Smoothies(width=w)), args.repeats
+            )
             err = np.abs(img.visibility - r.visibility)[r.mask].mean()
             cells.append(f"{err:.4f} ({sec * 1000:.0f} ms)")
         report.line(f"| {w} | " + " | ".join(cells) + " |")

@@ -164,7 +164,13 @@ def test_smoothies_light_view_penumbra_widens_with_the_receiver_distance():
 
 def test_configs_compare_pickle_and_repr():
     for c in [
-        ss.ShadowMapping(resolution=512, bias=ss.LinearDepthBias(slope=1.5), filter=ss.PCF(size=2), warp=ss.LiSPSM(vector="camera"), blur=ss.EyeSpaceBlur(iterations=2)),
+        ss.ShadowMapping(
+            resolution=512,
+            bias=ss.LinearDepthBias(slope=1.5),
+            filter=ss.PCF(size=2),
+            warp=ss.LiSPSM(vector="camera"),
+            blur=ss.EyeSpaceBlur(iterations=2),
+        ),
         ss.Smoothies(width=0.5, falloff="sine"),
         ss.ShadowMapping(bias=ss.BackFaces()),
         ss.ShadowMapping(bias=ss.MidpointBias()),
@@ -263,3 +269,39 @@ MEASURED_SOFT: dict[str, dict[str, float]] = {
     "contact_boxes": {"pcss": 0.0230, "smoothies": 0.0774},
     "city": {"pcss": 0.0125, "smoothies": 0.0124},
 }
+
+
+@pytest.mark.parametrize("method", [ss.Pcss(), ss.Smoothies(), ss.Pcss(max_taps=2), ss.Smoothies(width=16.0)])
+def test_light_view_hard_cases_of_pcss_and_smoothies(method):
+    """Degenerate, open and non-manifold occluders, a point light, a huge
+    light, a grazing one and occluders touching the floor: finite, in [0, 1],
+    and where nothing occludes, exactly 1."""
+    from softshadow import scenes
+
+    plate_v, plate_f = scenes.quad((0.0, 2.0, 0.0), 0.5)
+    degenerate = np.array([[0, 0, 1], [1, 1, 1], [2, 3, 2]], np.uint32)
+    fin_v = np.array([[-0.5, 2.0, 0.0], [0.5, 2.0, 0.0], [0.0, 2.5, 0.0]])
+    floor = scenes.floor()
+    touching = (np.array([[-0.3, 0.0, -0.3], [0.3, 0.0, -0.3], [0.0, 0.6, 0.3]]), np.array([[0, 1, 2]], np.uint32))
+    cases = [
+        ([(plate_v, np.vstack([plate_f, plate_f, degenerate, plate_f[:, ::-1]])), (fin_v, [[0, 1, 2]])], None),
+        ([(plate_v, plate_f)], (0.0, 0.0)),
+        ([(plate_v, plate_f)], (40.0, 40.0)),
+        ([touching], None),
+    ]
+    for occluders, size in cases:
+        light = scenes.default_light()
+        if size is not None:
+            light = ss.RectLight(light.center, light.normal, light.up, size=size)
+        sm = ss.soft_shadow_map(ss.Scene(occluders=occluders, receivers=[floor]), light, resolution=32, method=method)
+        v = sm.visibility
+        assert v.dtype == np.float32 and np.isfinite(v).all() and v.min() >= 0 and v.max() <= 1
+        np.testing.assert_array_equal(v[~np.isfinite(sm.receiver_depth)], 1.0)
+    only_degenerate = ss.Scene(occluders=[(plate_v, degenerate)], receivers=[floor])
+    v = ss.soft_shadow_map(only_degenerate, scenes.default_light(), resolution=32, method=method).visibility
+    np.testing.assert_array_equal(v, 1.0)
+    grazing = ss.RectLight(center=(8.0, 0.3, 0.0), normal=(-1.0, -0.02, 0.0), up=(0, 1, 0), size=(0.5, 0.5))
+    v = ss.soft_shadow_map(
+        ss.Scene(occluders=[(plate_v, plate_f)], receivers=[floor]), grazing, resolution=32, method=method
+    ).visibility
+    assert np.isfinite(v).all() and v.min() >= 0 and v.max() <= 1

@@ -35,6 +35,8 @@ def test_study_plane_on_a_small_map(tmp_path):
     assert "| square_plate | ssm | 2 passes, occluders 64² |" in md
     assert "| square_plate | exact | 16 samples |" in md
     assert "| square_plate | mitsuba | 16 samples |" in md
+    assert "| square_plate | pcss | occluders 64² |" in md
+    assert "| square_plate | smoothies | width 0.5, occluders 64² |" in md
     assert (out / "plane_square_plate.png").stat().st_size > 10_000
     assert (out / "time_vs_map_size.png").exists()
     # The plate is the paper's easy case: the SSM is nearly exact on it.

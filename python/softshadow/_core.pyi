@@ -18,6 +18,17 @@ __all__ = [
     "Bitmask",
     "Exact",
     "Auto",
+    "Pcss",
+    "Smoothies",
+    "ShadowMapping",
+    "ConstantBias",
+    "SlopeScaleBias",
+    "LinearDepthBias",
+    "BackFaces",
+    "MidpointBias",
+    "PCF",
+    "LiSPSM",
+    "EyeSpaceBlur",
     "Camera",
     "MeshShadowResult",
     "DepthShadowResult",
@@ -286,7 +297,7 @@ class Auto:
         """The ``Ssm`` the rule picks for an output resolution, from meshes."""
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
 
-_MethodArg = str | Ssm | Bitmask | Exact | Auto
+_MethodArg = str | Ssm | Bitmask | Exact | Auto | Pcss | Smoothies | ShadowMapping
 
 @final
 class Camera:
@@ -400,7 +411,7 @@ class MeshShadowResult:
     @property
     def timings(self) -> dict[str, float]: ...
     @property
-    def method(self) -> Ssm | Bitmask | Exact: ...
+    def method(self) -> Ssm | Bitmask | Exact | Pcss | Smoothies | ShadowMapping: ...
     @property
     def backend(self) -> str: ...
     @property
@@ -431,7 +442,7 @@ class EyeResult:
     @property
     def timings(self) -> dict[str, float]: ...
     @property
-    def method(self) -> Ssm | Bitmask | Exact: ...
+    def method(self) -> Ssm | Bitmask | Exact | Pcss | Smoothies | ShadowMapping: ...
     @property
     def backend(self) -> str: ...
     @property
@@ -468,7 +479,7 @@ class DepthShadowResult:
     @property
     def timings(self) -> dict[str, float]: ...
     @property
-    def method(self) -> Ssm | Bitmask | Exact: ...
+    def method(self) -> Ssm | Bitmask | Exact | Pcss | Smoothies | ShadowMapping: ...
     @property
     def backend(self) -> str: ...
     @property

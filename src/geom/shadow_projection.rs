@@ -30,9 +30,9 @@
 //! centre C_p, whose (b, c) are the eye's and whose a is B's nearest a
 //! minus n (Scherzer eq. 2: its near plane touches B): with
 //! `a' = a - a_C ∈ [n, f]`, `f = n + Δa` (B's extent along Vp),
-//!     u ∝ b'/a',   v = ((f+n) a' - 2 f n) / ((f-n) a'),   depth ∝ c'/a'.
-//! The free parameter n (Scherzer eq. 1, Wimmer 2004's n_opt):
-//!     n_opt = (z_n + √(z_n z_f)) / sin γ,
+//! `u ∝ b'/a'`, `v = ((f+n) a' - 2 f n) / ((f-n) a')`, `depth ∝ c'/a'`.
+//! The free parameter n (Scherzer eq. 1, Wimmer 2004's n_opt) is
+//! `n_opt = (z_n + √(z_n z_f)) / sin γ`,
 //! γ the angle between L and V, z_n and z_f the nearest and farthest
 //! visible depths along the camera's axis (the camera has no clip planes;
 //! Scherzer §4.4 derives the far distance from visibility too). As n grows

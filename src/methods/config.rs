@@ -235,10 +235,11 @@ impl LooseOptions<'_> {
 }
 
 /// The method names a user can pass as `method=`, in the table's order.
-pub const METHOD_NAMES: [&str; 6] = [
+pub const METHOD_NAMES: [&str; 7] = [
     "ssm",
     "bitmask",
     "exact",
+    "pcss",
     "smoothies",
     "shadow_mapping",
     "auto",

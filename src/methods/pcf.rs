@@ -8,9 +8,11 @@
 //! shadow, or anything a caller computes: a biased test, two layers...). The
 //! filters here are the exact box filter of that piecewise-constant function:
 //!
+//! ```text
 //!     F(px, py) = (1 / (4 hx hy)) ∫∫_{[px ± hx] x [py ± hy]} test(x, y) dx dy
 //!               = Σ_{j,i} wy_j wx_i test(j W + i),
 //!     wx_i = |[px - hx, px + hx] ∩ [i, i+1]| / (2 hx)   (the same along y),
+//! ```
 //!
 //! separable, non-negative, each texel weighted by its overlap with the box.
 //! Half-widths below half a texel are raised to half a texel: the box of one

@@ -9,7 +9,9 @@
 //! point R (tangent t_r, depth z_r) to a light point l (in z = 0) is
 //! l + s (R - l), s in [0, 1]; at depth z (s = z / z_r) its tangent is
 //!
+//! ```text
 //!     t(z) = l / z + t_r - l / z_r = t_r + l (1/z - 1/z_r).
+//! ```
 //!
 //! So the occluder points at depth z that hide part of the light from R are
 //! those whose tangent lies in the box t_r ± (L/2)(1/z - 1/z_r) (per axis,

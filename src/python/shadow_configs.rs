@@ -373,7 +373,7 @@ fn bias_to_py(py: Python<'_>, b: DepthBias) -> PyResult<Py<PyAny>> {
 }
 
 /// An optional part of the config: None, or an instance of `T`.
-fn part<T: pyo3::PyClass + Clone, U>(
+fn part<T, U>(
     arg: &str,
     class: &str,
     v: Option<&Bound<'_, PyAny>>,

@@ -9,7 +9,8 @@ Against Mitsuba 3 references (1024 stratified light samples per texel), on
    spheres at different heights, torus): error (the paper's §4.2.1 metric)
    against time for ``ssm`` (1 and 2 passes, occluder maps at the output's
    resolution and coarser), ``bitmask`` (64 and 256 samples, two occluder
-   resolutions), ``exact`` (several sample counts) and Mitsuba's
+   resolutions), ``exact`` (several sample counts), ``pcss`` (Fernando
+   2005) and ``smoothies`` (Chan & Durand 2003), and Mitsuba's
    ``ray_test`` (several sample counts). SSM and exact times are end to end
    from meshes; Mitsuba's are ``ray_test`` alone.
 2. The paper's §4.2 experiments (bunny floating): error against occluder-map
@@ -35,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import Auto, metrics, scenes
+from .. import Auto, Pcss, Smoothies, metrics, scenes
 from ..light import RectLight
 from ..scene import Scene
 from ..shadow_map import ShadowMap, soft_shadow_map
@@ -122,6 +123,12 @@ class Study:
         )
         for k in (16, 64, 256) if not self.quick else (16, 64):
             measure("exact", f"{k} samples", method="exact", samples=k)
+        # The other two papers' light-view methods (ShadowMapping has no
+        # light view: it is focused, warped and blurred for a camera).
+        for occ in occ_levels:
+            measure("pcss", f"occluders {occ}²", method=Pcss(occluder_resolution=occ))
+        for w in (0.5, 1.0) if not self.quick else (0.5,):
+            measure("smoothies", f"width {w}, occluders {res}²", method=Smoothies(width=w))
         rscene = self.reference.ReferenceScene(scene.occluders)
         for k in (4, 16, 64, 256) if not self.quick else (4, 16, 64):
             ts, err = [], 0.0
@@ -217,6 +224,8 @@ def plot_plane(points: list[Point], path: str, title: str) -> None:
         "auto": ("*", "tab:orange"),
         "bitmask": ("D", "tab:purple"),
         "exact": ("s", "tab:green"),
+        "pcss": ("v", "tab:brown"),
+        "smoothies": ("P", "tab:pink"),
         "mitsuba": ("^", "tab:red"),
     }
     for method, (marker, color) in styles.items():
