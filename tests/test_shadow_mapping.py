@@ -130,7 +130,6 @@ def test_smoothies_umbra_is_the_hard_shadow_and_its_penumbra_lies_outside(hard_r
     # Its own hard shadow: smoothies too thin to cover a texel, on the same
     # map (the map's resolution comes from the pixels' footprint).
     hard_sm = ss.render(scene, light, cam, method=ss.Smoothies(width=1e-4))
-    assert set(np.unique(hard_sm.visibility[m])) <= {0.0, 1.0} | set(np.unique(hard_sm.visibility[m])[1:-1])
     umbra = (hard_sm.visibility < 0.5) & m
     # Outer penumbra only: what the hard map shadows stays dark, and the
     # penumbra is where the hard map is lit.

@@ -1,32 +1,20 @@
 //! Smoothies behind the methods' interface (`ShadowMethod`): the front
 //! occluder layer is the shadow map (step 1), the occluder triangles give
-//! the silhouette. The pipelines hand the triangles over unindexed, so
-//! their corners are welded back into a mesh first: corners shared in the
-//! user's mesh are bit-identical after the same transform, so welding on
-//! their bits recovers its adjacency exactly (and never joins two vertices
-//! that differ).
+//! the silhouette. The pipelines hand the triangles over unindexed; the
+//! silhouette welds corners on their exact position (`silhouette.rs`), and
+//! corners shared in the user's mesh are bit-identical after the same
+//! transform, so the soup's adjacency is the mesh's.
 
 use super::Smoothies;
 use crate::methods::{LightPoint, ShadowInputs, ShadowMethod};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use std::collections::HashMap;
 
-/// Triangle soup -> indexed mesh, welding bit-identical corners.
-pub fn weld(tris: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(tris.len() * 2);
-    let mut verts = Vec::with_capacity(tris.len() * 2);
-    let faces = tris
-        .iter()
-        .map(|t| {
-            t.map(|c| {
-                let key = c.to_array().map(f32::to_bits);
-                *index.entry(key).or_insert_with(|| {
-                    verts.push(c.as_dvec3());
-                    (verts.len() - 1) as u32
-                })
-            })
-        })
+/// Triangle soup -> a mesh of three corners per face (welded later).
+fn soup(tris: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let verts = tris.iter().flatten().map(|c| c.as_dvec3()).collect();
+    let faces = (0..tris.len() as u32)
+        .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
         .collect();
     (verts, faces)
 }
@@ -62,7 +50,7 @@ impl Smoothies {
     }
 
     fn welded(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        let (verts, faces) = weld(inputs.occluder_triangles.unwrap_or(&[]));
+        let (verts, faces) = soup(inputs.occluder_triangles.unwrap_or(&[]));
         self.shade(inputs, &verts, &faces, points)
     }
 }
@@ -91,14 +79,37 @@ mod tests {
     use super::*;
 
     #[test]
-    fn welding_recovers_shared_corners_only() {
-        let a = Vec3::new(0.0, 0.0, 1.0);
-        let b = Vec3::new(1.0, 0.0, 1.0);
-        let c = Vec3::new(0.0, 1.0, 1.0);
-        let d = Vec3::new(1.0, 1.0, 1.0);
-        let near_d = Vec3::new(1.0, 1.0, 1.0 + 1e-6);
-        let (v, f) = weld(&[[a, b, c], [b, d, c], [b, near_d, c]]);
-        assert_eq!(v.len(), 5);
-        assert_eq!(f, vec![[0, 1, 2], [1, 3, 2], [1, 4, 2]]);
+    fn a_soup_has_the_silhouette_of_its_indexed_mesh() {
+        // A quad as two triangles: indexed, and as a soup of six corners.
+        let v = [
+            DVec3::new(-0.3, -0.3, 1.0),
+            DVec3::new(0.3, -0.3, 1.0),
+            DVec3::new(0.3, 0.3, 1.0),
+            DVec3::new(-0.3, 0.3, 1.0),
+        ];
+        let faces = [[0u32, 1, 2], [0, 2, 3]];
+        let tris: Vec<[Vec3; 3]> = faces
+            .iter()
+            .map(|f| f.map(|i| v[i as usize].as_vec3()))
+            .collect();
+        let (sv, sf) = soup(&tris);
+        assert_eq!((sv.len(), sf.len()), (6, 2));
+        let grid = crate::geom::light::MapGrid::new(32, 32, [0.5, 0.5]).unwrap();
+        let front: Vec<f32> = (0..grid.len()).map(|_| f32::INFINITY).collect();
+        let s = Smoothies {
+            width: 1.0,
+            falloff: super::super::Falloff::Linear,
+        };
+        let a = s.buffer(
+            &grid,
+            [0.2, 0.2],
+            &front,
+            &v.map(|p| p.as_vec3().as_dvec3()),
+            &faces,
+        );
+        let b = s.buffer(&grid, [0.2, 0.2], &front, &sv, &sf);
+        // Four boundary edges either way (the shared diagonal is no silhouette).
+        assert_eq!(a.stats.silhouette_edges, 4);
+        assert_eq!(a, b);
     }
 }
