@@ -17,7 +17,8 @@ smoothies, measured.
   width against error: against 256-sample ``exact`` under the scene's own
   (soft) light.
 
-Writes ``docs/benchmarks/shadow_mapping.md`` and the aliasing table into
+The measurements are ``softshadow.experiments.scherzer``'s (shared with the
+study). Writes ``docs/benchmarks/shadow_mapping.md`` and the aliasing table into
 ``docs/methods/shadow_mapping.md`` between ``<!-- aliasing:start -->`` and
 ``<!-- aliasing:end -->``.
 """
@@ -25,47 +26,21 @@ Writes ``docs/benchmarks/shadow_mapping.md`` and the aliasing table into
 from __future__ import annotations
 
 import argparse
-import time
-from typing import Any
 
-import numpy as np
 from _report import DOCS, ROOT, Report, add_output_arguments, command_line
 
-import softshadow as ss
-from softshadow.eye_scenes import EYE_SCENES, large_city
+from softshadow.experiments import scherzer
+from softshadow.eye_scenes import EYE_SCENES
 
 PAGE = ROOT / "docs" / "methods" / "shadow_mapping.md"
 START, END = "<!-- aliasing:start -->", "<!-- aliasing:end -->"
-BIASES: list[tuple[str, Any]] = [
-    ("none (ConstantBias(constant=0))", ss.ConstantBias(constant=0)),
-    ("ConstantBias(constant=1000)", ss.ConstantBias(constant=1000)),
-    ("SlopeScaleBias() (default)", ss.SlopeScaleBias()),
-    ("LinearDepthBias()", ss.LinearDepthBias()),
-    ("BackFaces()", ss.BackFaces()),
-    ("MidpointBias()", ss.MidpointBias()),
-]
-MAPS: list[tuple[str, dict[str, Any]]] = [
-    ("unfocused", dict(focus=False)),
-    ("focused", dict(focus=True)),
-    ("focused LiSPSM (middle vector)", dict(warp=ss.LiSPSM())),
-    ("focused LiSPSM (camera axis)", dict(warp=ss.LiSPSM(vector="camera"))),
-]
-RESOLUTIONS = (512, 1024, 2048, 4096)
 
 
-def hard(light: Any) -> Any:
-    if isinstance(light, ss.RectLight):
-        return ss.RectLight(light.center, light.normal, light.up, size=(0.0, 0.0))
-    return ss.DirectionalLight(light.direction, light.up, angular_size=(0.0, 0.0))
-
-
-def timed(fn: Any, repeats: int) -> tuple[float, Any]:
-    out, times = None, []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return float(np.median(times)), out
+def curve_rows(xs: tuple, curves: dict[str, list[tuple[float, float]]]) -> list[str]:
+    return [
+        f"| {x} | " + " | ".join(f"{c[i][0]:.4f} ({c[i][1] * 1000:.0f} ms)" for c in curves.values()) + " |"
+        for i, x in enumerate(xs)
+    ]
 
 
 def main() -> None:
@@ -78,76 +53,43 @@ def main() -> None:
     report = Report(
         f"Practical shadow mapping and smoothies ({res[0]}×{res[1]})", command_line(__file__), mitsuba=False
     )
+    names = list(EYE_SCENES)
 
     report.line("## Bias methods: acne and peter-panning (2048² maps)")
     report.line("")
-    names = list(EYE_SCENES)
     report.line("| bias | " + " | ".join(f"{n}: acne / peter-panning" for n in names) + " |")
     report.line("|---|" + "---|" * len(names))
-    cases = []
-    for name in names:
-        scene, light, cam = EYE_SCENES[name](res)
-        h = hard(light)
-        cases.append((scene, light, h, cam, ss.render(scene, h, cam, method="exact")))
-    for label, bias in BIASES:
-        cells = []
-        for scene, _, h, cam, ref in cases:
-            img = ss.render(scene, h, cam, method=ss.ShadowMapping(bias=bias))
-            r, v, m = ref.visibility > 0.5, img.visibility > 0.5, ref.mask
-            cells.append(f"{np.mean((r & ~v)[m]):.4f} / {np.mean((~r & v)[m]):.4f}")
+    for label, per_scene in scherzer.bias_errors(res).items():
+        cells = [f"{per_scene[n][0]:.4f} / {per_scene[n][1]:.4f}" for n in names]
         report.line(f"| {label} | " + " | ".join(cells) + " |")
 
     report.line("")
     report.line("## Aliasing: uniform, focused and LiSPSM maps in a large city")
     report.line("")
-    scene, sun, cam = large_city(res)
-    h = hard(sun)
-    ref = ss.render(scene, h, cam, method="exact")
-    alias = ["| map | " + " | ".join(f"{r}²: misclassified (time)" for r in RESOLUTIONS) + " |"]
-    alias.append("|---|" + "---|" * len(RESOLUTIONS))
-    for label, kw in MAPS:
-        cells = []
-        for r in RESOLUTIONS:
-            sec, img = timed(
-                lambda kw=kw, r=r: ss.render(scene, h, cam, method=ss.ShadowMapping(resolution=r, **kw)), args.repeats
-            )
-            wrong = np.mean(((img.visibility > 0.5) != (ref.visibility > 0.5))[ref.mask])
-            cells.append(f"{wrong:.4f} ({sec * 1000:.0f} ms)")
-        alias.append(f"| {label} | " + " | ".join(cells) + " |")
+    rs = scherzer.RESOLUTIONS
+    alias = ["| map | " + " | ".join(f"{r}²: misclassified (time)" for r in rs) + " |"]
+    alias.append("|---|" + "---|" * len(rs))
+    for label, curve in scherzer.aliasing_errors(res, args.repeats).items():
+        alias.append(f"| {label} | " + " | ".join(f"{e:.4f} ({t * 1000:.0f} ms)" for e, t in curve) + " |")
     for line in alias:
         report.line(line)
 
+    blur, width = scherzer.soft_curves(res, args.repeats)
     report.line("")
     report.line("## The eye-space blur: iterations against error and time (2048², soft light)")
     report.line("")
     report.line("| iterations | " + " | ".join(f"{n}: error (time)" for n in names) + " |")
     report.line("|---|" + "---|" * len(names))
-    soft = [(s, li, c, ss.render(s, li, c, method=ss.Exact(samples=256))) for s, li, _, c, _ in cases]
-    for it in (0, 1, 2, 4, 8, 16):
-        cells = []
-        for s, li, c, r in soft:
-            blur = ss.EyeSpaceBlur(iterations=it) if it else None
-            sec, img = timed(
-                lambda s=s, li=li, c=c, b=blur: ss.render(s, li, c, method=ss.ShadowMapping(blur=b)), args.repeats
-            )
-            err = np.abs(img.visibility - r.visibility)[r.mask].mean()
-            cells.append(f"{err:.4f} ({sec * 1000:.0f} ms)")
-        report.line(f"| {it} | " + " | ".join(cells) + " |")
+    for line in curve_rows(scherzer.BLUR_ITERATIONS, blur):
+        report.line(line)
 
     report.line("")
     report.line("## Smoothies: width against error (soft light)")
     report.line("")
     report.line("| width | " + " | ".join(f"{n}: error (time)" for n in names) + " |")
     report.line("|---|" + "---|" * len(names))
-    for w in (0.25, 0.5, 1.0, 2.0, 4.0):
-        cells = []
-        for s, li, c, r in soft:
-            sec, img = timed(
-                lambda s=s, li=li, c=c, w=w: ss.render(s, li, c, method=ss.Smoothies(width=w)), args.repeats
-            )
-            err = np.abs(img.visibility - r.visibility)[r.mask].mean()
-            cells.append(f"{err:.4f} ({sec * 1000:.0f} ms)")
-        report.line(f"| {w} | " + " | ".join(cells) + " |")
+    for line in curve_rows(scherzer.SMOOTHIE_WIDTHS, width):
+        report.line(line)
 
     if not args.no_write:
         report.write(

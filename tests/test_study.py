@@ -57,3 +57,32 @@ def test_mitsuba_time_at_equal_error_follows_the_sample_law():
         t, out = mitsuba_seconds_at(0.4 / k**0.5, pts)
         assert t == pytest.approx(k * 1e-3, rel=1e-9)
         assert out is outside
+
+
+def test_study_eye_view_and_scherzer_parts_write_tables_plots_and_the_readme_block(tmp_path):
+    from softshadow.study import main
+
+    out = tmp_path / "study"
+    readme = tmp_path / "README.md"
+    readme.write_text("intro\n<!-- study-summary:start -->\nold\n<!-- study-summary:end -->\nrest\n")
+    args = ["--out", str(out), "--parts", "eye", "scherzer", "--eye-resolution", "64", "48", "--repeats", "1"]
+    args += ["--eye-reference-samples", "64", "--eye-scenes", "city", "--readme", str(readme)]
+    assert main(args) == 0
+    md = (out / "study.md").read_text()
+    for label in ("ssm", "exact 16", "pcss", "smoothies", "shadow map", "shadow map, PCF 3", "shadow map, blur 4"):
+        assert f"| softshadow {label} |" in md
+    assert "| Mitsuba | 16 samples |" in md
+    for name in ("eye_city", "bias_acne_peter_panning", "aliasing_vs_resolution", "blur_iterations", "smoothie_width"):
+        assert (out / f"{name}.png").stat().st_size > 10_000
+    # Every bias method and map kind has its row; the uniform unfocused map
+    # misclassifies something in the large city at 512².
+    for label in ("SlopeScaleBias() (default)", "BackFaces()", "MidpointBias()", "LinearDepthBias()"):
+        assert f"| {label} |" in md
+    alias = [line.split("|")[1:-1] for line in md.split("### Aliasing")[1].split("###")[0].splitlines()]
+    alias = [[c.strip() for c in row] for row in alias if row]
+    head, at_512 = alias[0], next(row for row in alias if row[0] == "512")
+    assert float(at_512[head.index("unfocused")]) > 0
+    text = readme.read_text()
+    assert text.startswith("intro\n<!-- study-summary:start -->\nFrom `python -m softshadow.study")
+    assert "old" not in text and text.endswith("<!-- study-summary:end -->\nrest\n")
+    assert "| shadow map, PCF |" in text

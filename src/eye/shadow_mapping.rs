@@ -48,8 +48,23 @@ fn projection(
     g: &GBuffer,
 ) -> Option<ShadowProjection> {
     let cam = call.camera;
+    // The nearest and farthest planar depths the image sees: LiSPSM's z_n,
+    // z_f, and the focused body's far cut.
+    let (zn, zf) = g
+        .depth
+        .par_iter()
+        .filter(|z| z.is_finite())
+        .fold(
+            || (f64::INFINITY, 0f64),
+            |(a, b), &z| (a.min(z as f64), b.max(z as f64)),
+        )
+        .reduce(
+            || (f64::INFINITY, 0f64),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
     let body = if cfg.focus {
-        view_body(cam, bounds)
+        // Just past the farthest seen surface (f32 depths, rounded down).
+        view_body(cam, bounds, zn.is_finite().then(|| zf * (1.0 + 1e-5)))
     } else {
         vec![]
     };
@@ -86,18 +101,6 @@ fn projection(
             match cfg.warp {
                 None => Some(uniform),
                 Some(w) => {
-                    let (zn, zf) = g
-                        .depth
-                        .par_iter()
-                        .filter(|z| z.is_finite())
-                        .fold(
-                            || (f64::INFINITY, 0f64),
-                            |(a, b), &z| (a.min(z as f64), b.max(z as f64)),
-                        )
-                        .reduce(
-                            || (f64::INFINITY, 0f64),
-                            |a, b| (a.0.min(b.0), a.1.max(b.1)),
-                        );
                     if !zn.is_finite() {
                         return Some(uniform);
                     }

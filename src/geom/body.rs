@@ -92,14 +92,19 @@ impl Aabb {
 }
 
 /// The camera's frustum as a convex polyhedron: apex at the eye, its far
-/// plane just past `bounds`. `None` when the bounds lie wholly behind the
-/// camera.
-fn frustum(camera: &Camera, bounds: &Aabb) -> Option<(Vec<Vec<DVec3>>, Vec<Plane>)> {
+/// plane just past `bounds`, or at the planar depth `visible` when that is
+/// nearer. `None` when the bounds lie wholly behind the camera.
+fn frustum(
+    camera: &Camera,
+    bounds: &Aabb,
+    visible: Option<f64>,
+) -> Option<(Vec<Vec<DVec3>>, Vec<Plane>)> {
     let far = bounds
         .corners()
         .iter()
         .map(|c| (*c - camera.eye).dot(camera.forward))
         .fold(f64::NEG_INFINITY, f64::max);
+    let far = visible.map_or(far, |v| far.min(v));
     if far <= 0.0 {
         return None;
     }
@@ -155,9 +160,15 @@ fn clip_all(poly: &[DVec3], planes: &[Plane], out: &mut Vec<DVec3>) {
 }
 
 /// The vertices of (view frustum) ∩ `bounds`: empty when the camera sees
-/// none of the bounds.
-pub fn view_body(camera: &Camera, bounds: &Aabb) -> Vec<DVec3> {
-    let Some((f_faces, f_planes)) = frustum(camera, bounds) else {
+/// none of the bounds. `visible`, the farthest planar depth (along the
+/// camera's axis) of any surface the image sees, cuts the frustum's far
+/// plane there: no pixel looks past it, and the occluders beyond it that
+/// shadow what is seen are caught by `extend_toward_light`, so the body
+/// shrinks to what the image needs (the far cut of sample-distribution
+/// shadow maps, Lauritzen et al. 2011; Scherzer's B with the view
+/// frustum's far plane pulled in).
+pub fn view_body(camera: &Camera, bounds: &Aabb, visible: Option<f64>) -> Vec<DVec3> {
+    let Some((f_faces, f_planes)) = frustum(camera, bounds, visible) else {
         return vec![];
     };
     let mut out = vec![];
@@ -215,7 +226,7 @@ mod tests {
             lo: DVec3::splat(-0.2),
             hi: DVec3::splat(0.2),
         };
-        let body = view_body(&camera(), &b);
+        let body = view_body(&camera(), &b, None);
         let hull = Aabb::of(body.iter().copied()).unwrap();
         assert!((hull.lo - b.lo).abs().max_element() < 1e-9);
         assert!((hull.hi - b.hi).abs().max_element() < 1e-9);
@@ -236,7 +247,7 @@ mod tests {
             (64, 48),
         )
         .unwrap();
-        let body = view_body(&cam, &b);
+        let body = view_body(&cam, &b, None);
         assert!(!body.is_empty());
         // Every vertex is in the box and in front of the eye, inside the
         // image's field of view (with rounding slack).
@@ -260,7 +271,7 @@ mod tests {
             lo: DVec3::new(-1.0, -1.0, 10.0),
             hi: DVec3::new(1.0, 1.0, 12.0),
         };
-        assert!(view_body(&camera(), &b).is_empty());
+        assert!(view_body(&camera(), &b, None).is_empty());
     }
 
     #[test]

@@ -212,7 +212,7 @@ def sphere_scene(segments: float) -> tuple[Scene, RectLight, int]:
     return Scene(occluders=[mesh], receivers=[scenes.floor()]), scenes.default_light(), 256
 
 
-def plot_plane(points: list[Point], path: str, title: str) -> None:
+def plot_plane(points: list[Point], path: str, title: str, ylabel: str = "over shadow texels") -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -226,6 +226,9 @@ def plot_plane(points: list[Point], path: str, title: str) -> None:
         "exact": ("s", "tab:green"),
         "pcss": ("v", "tab:brown"),
         "smoothies": ("P", "tab:pink"),
+        "shadow map": ("x", "tab:olive"),
+        "shadow map, PCF": ("X", "tab:cyan"),
+        "shadow map, blur": ("h", "tab:gray"),
         "mitsuba": ("^", "tab:red"),
     }
     for method, (marker, color) in styles.items():
@@ -244,7 +247,7 @@ def plot_plane(points: list[Point], path: str, title: str) -> None:
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("time (ms, 2 cores)")
-    ax.set_ylabel("error (mean |V - V_ref| over shadow texels)")
+    ax.set_ylabel(f"error (mean |V - V_ref| {ylabel})")
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
@@ -345,30 +348,173 @@ def markdown_curves(xlabel: str, x: list[float], curves: dict[str, list[float]],
     return "\n".join([head, sep, *rows])
 
 
+README_START, README_END = "<!-- study-summary:start -->", "<!-- study-summary:end -->"
+
+
+def command(argv: list[str] | None) -> str:
+    return " ".join(["python -m softshadow.study", *(argv if argv is not None else sys.argv[1:])])
+
+
+def write_readme_block(path: str, lines: list[str]) -> None:
+    """Replaces the README's text between the study-summary markers."""
+    with open(path) as f:
+        text = f.read()
+    if README_START not in text or README_END not in text:
+        raise SystemExit(f"{path}: no {README_START} ... {README_END} block to write the summary into")
+    head, rest = text.split(README_START, 1)
+    _, tail = rest.split(README_END, 1)
+    with open(path, "w") as f:
+        f.write(head + README_START + "\n" + "\n".join(lines) + "\n" + README_END + tail)
+
+
+def eye_part(a: argparse.Namespace, md: list[str]) -> list[str]:
+    """4. The accuracy-time plane in eye view (every family, Mitsuba's whole
+    job); returns the summary table."""
+    from ..eye_scenes import EYE_SCENES
+    from .eye_plane import eye_plane, markdown_eye_plane, markdown_eye_summary
+
+    res = (int(a.eye_resolution[0]), int(a.eye_resolution[1]))
+    names = a.eye_scenes or list(EYE_SCENES)
+    md += [
+        f"## 4. Accuracy against time in eye view ({res[0]}×{res[1]})",
+        "",
+        "Every family end to end from the meshes (`softshadow.render`) against Mitsuba's whole eye-view "
+        "job (first hits, then stratified shadow rays with `ray_test`); errors are mean |V - V_ref| over "
+        f"the pixels both see alike, against {a.eye_reference_samples}-sample references. "
+        "Mitsuba's time at a method's error: † where its one sample a pixel already does as well, "
+        "* where it extrapolates.",
+        "",
+    ]
+    planes = []
+    for name in names:
+        plane = eye_plane(name, res, repeats=max(1, a.repeats // 2), reference_samples=a.eye_reference_samples)
+        planes.append(plane)
+        plot_plane(plane.points(), os.path.join(a.out, f"eye_{name}.png"), f"{name}, {res[0]}×{res[1]}", "over pixels")
+        md += [f"### {name} ({plane.light})", "", *markdown_eye_plane(plane), "", f"![{name}](eye_{name}.png)", ""]
+        print(f"eye {name}: {len(plane.rows)} calls", flush=True)
+    summary = markdown_eye_summary(planes)
+    md += ["### Summary", "", *summary, ""]
+    return summary
+
+
+def scherzer_part(a: argparse.Namespace, md: list[str]) -> None:
+    """5. Scherzer 2005's experiments and Smoothies' width, as tables and plots."""
+    from . import scherzer
+
+    res = (int(a.eye_resolution[0]), int(a.eye_resolution[1]))
+    md += [f"## 5. Practical shadow mapping (Scherzer 2005) and smoothies ({res[0]}×{res[1]})", ""]
+    bias = scherzer.bias_errors(res)
+    names = list(next(iter(bias.values())))
+    md += [
+        "### Bias methods: acne and peter-panning (2048² maps, against the exact hard shadow)",
+        "",
+        "| bias | " + " | ".join(f"{n}: acne / peter-panning" for n in names) + " |",
+        "|---|" + "---|" * len(names),
+        *(
+            f"| {label} | " + " | ".join(f"{v[n][0]:.4f} / {v[n][1]:.4f}" for n in names) + " |"
+            for label, v in bias.items()
+        ),
+        "",
+    ]
+    _plot_bias(bias, os.path.join(a.out, "bias_acne_peter_panning.png"))
+    md += ["![](bias_acne_peter_panning.png)", ""]
+    rs = [float(r) for r in scherzer.RESOLUTIONS]
+    alias = scherzer.aliasing_errors(res, max(1, a.repeats // 2))
+    curves = {k: [e for e, _ in v] for k, v in alias.items()}
+    plot_curves(
+        rs,
+        curves,
+        os.path.join(a.out, "aliasing_vs_resolution.png"),
+        "map side (texels)",
+        "misclassified fraction",
+        "large_city: aliasing error",
+        logy=True,
+    )
+    md += [
+        "### Aliasing: misclassified pixels against map resolution (large_city, the sun, eye near the ground)",
+        "",
+        markdown_curves("map side", rs, curves, ".4f"),
+        "",
+        "![](aliasing_vs_resolution.png)",
+        "",
+    ]
+    blur, width = scherzer.soft_curves(res, max(1, a.repeats // 2))
+    for label, xs, data, fname in (
+        (
+            "eye-space blur iterations (2048²)",
+            [float(i) for i in scherzer.BLUR_ITERATIONS],
+            blur,
+            "blur_iterations.png",
+        ),
+        ("smoothie width", list(scherzer.SMOOTHIE_WIDTHS), width, "smoothie_width.png"),
+    ):
+        err = {k: [e for e, _ in v] for k, v in data.items()}
+        ms = {k: [t * 1e3 for _, t in v] for k, v in data.items()}
+        plot_curves(xs, err, os.path.join(a.out, fname), label, "error against 256-sample exact", f"error vs {label}")
+        md += [
+            f"### Error against {label} (soft light; time in ms below)",
+            "",
+            markdown_curves(label, xs, err, ".4f"),
+            "",
+            markdown_curves(label, xs, ms, ".0f"),
+            "",
+            f"![]({fname})",
+            "",
+        ]
+    print("scherzer: done", flush=True)
+
+
+def _plot_bias(bias: dict[str, dict[str, tuple[float, float]]], path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = list(bias)
+    names = list(next(iter(bias.values())))
+    fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.8), dpi=110, sharey=True)
+    width = 0.8 / len(names)
+    for ax, which, title in ((axes[0], 0, "acne"), (axes[1], 1, "peter-panning")):
+        for j, n in enumerate(names):
+            ys = [max(bias[lab][n][which], 1e-5) for lab in labels]
+            ax.barh([i + j * width for i in range(len(labels))], ys, height=width, label=n)
+        ax.set_xscale("log")
+        ax.set_title(f"{title} (fraction of pixels; 0 drawn at 1e-5)")
+        ax.grid(True, axis="x", alpha=0.3)
+    axes[0].set_yticks([i + 0.4 - width / 2 for i in range(len(labels))], [lab.split(" (")[0] for lab in labels])
+    axes[1].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m softshadow.experiments.study", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="python -m softshadow.study", description=__doc__.split("\n")[0])
     p.add_argument("--out", default="study", help="output folder (default: study)")
     p.add_argument("--resolution", type=int, default=256, help="map size for the accuracy-time plane")
     p.add_argument("--repeats", type=int, default=7, help="timing repeats (medians are reported)")
     p.add_argument("--reference-samples", type=int, default=1024)
     p.add_argument("--quick", action="store_true", help="fewer settings, 128² experiments (a few minutes)")
     p.add_argument("--scenes", nargs="+", default=list(PLANE_SCENES), choices=sorted(scenes.SCENES))
-    p.add_argument(
-        "--parts", nargs="+", default=["plane", "experiments", "timings"], choices=["plane", "experiments", "timings"]
-    )
+    parts = ["plane", "experiments", "timings", "eye", "scherzer"]
+    p.add_argument("--parts", nargs="+", default=parts, choices=parts)
+    p.add_argument("--eye-resolution", type=int, nargs=2, default=(320, 240), metavar=("W", "H"))
+    p.add_argument("--eye-reference-samples", type=int, default=4096)
+    p.add_argument("--eye-scenes", nargs="+", default=None, help="eye-view scenes (default: all)")
+    p.add_argument("--readme", default=None, help="also write the summary tables into this README's study block")
     a = p.parse_args(argv)
     os.makedirs(a.out, exist_ok=True)
     st = Study(a.resolution, a.repeats, a.reference_samples, a.quick)
     md = [
         "# softshadow study",
         "",
-        f"Generated by `python -m softshadow.experiments.study {' '.join(argv or sys.argv[1:])}`.",
+        f"Generated by `{command(argv)}`.",
         "",
     ]
 
+    all_points: list[Point] = []
     if "plane" in a.parts:
         md += ["## 1. Accuracy against time", ""]
-        all_points: list[Point] = []
         for name in a.scenes:
             pts = st.plane(name)
             all_points += pts
@@ -445,8 +591,31 @@ def main(argv: list[str] | None = None) -> int:
             ]
             print(f"timing {label}: done", flush=True)
 
+    summary: list[str] = []
+    if "plane" in a.parts:
+        summary += [
+            f"Light view ({a.resolution}², against {a.reference_samples}-sample Mitsuba maps):",
+            "",
+            markdown_summary(all_points),
+            "",
+        ]
+    if "eye" in a.parts:
+        lines = eye_part(a, md)
+        summary += [
+            f"Eye view ({a.eye_resolution[0]}×{a.eye_resolution[1]}, against {a.eye_reference_samples}-sample "
+            "Mitsuba images): each family's most accurate setting, its time, and Mitsuba's time at that "
+            "error over it († Mitsuba's one sample a pixel already does as well; * extrapolated):",
+            "",
+            *lines,
+            "",
+        ]
+    if "scherzer" in a.parts:
+        scherzer_part(a, md)
+
     with open(os.path.join(a.out, "study.md"), "w") as f:
         f.write("\n".join(md) + "\n")
+    if a.readme and summary:
+        write_readme_block(a.readme, [f"From `{command(argv)}`:", "", *summary])
     print(f"wrote {a.out}/study.md and its plots")
     return 0
 
