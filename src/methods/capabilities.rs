@@ -232,7 +232,7 @@ pub fn methods() -> Vec<MethodInfo> {
                         max: super::pcss::MAX_TAPS as i64,
                     },
                     default: Value::Int(super::pcss::DEFAULT_MAX_TAPS as i64),
-                    default_doc: "32",
+                    default_doc: "16",
                     doc: "taps per axis of the blocker search and of the filter: a box spanning \
                           more texels is sampled by this many strata (bounded work per point)",
                     restricted_on: vec![],
@@ -381,5 +381,25 @@ mod tests {
     fn every_method_name_has_one_row() {
         let names: Vec<_> = methods().iter().map(|m| m.name).collect();
         assert_eq!(names, super::super::config::METHOD_NAMES);
+    }
+
+    /// A default written out as a number in the docs is the default the
+    /// config takes (the text is hand-written beside the value).
+    #[test]
+    fn numeric_default_docs_match_the_defaults() {
+        for m in methods() {
+            for o in &m.options {
+                let lead: String = o
+                    .default_doc
+                    .chars()
+                    .take_while(|c| c.is_ascii_digit() || *c == '.')
+                    .collect();
+                match (&o.default, lead.parse::<f64>()) {
+                    (Value::Int(v), Ok(d)) => assert_eq!(*v as f64, d, "{}.{}", m.name, o.name),
+                    (Value::Float(v), Ok(d)) => assert_eq!(*v, d, "{}.{}", m.name, o.name),
+                    _ => {}
+                }
+            }
+        }
     }
 }

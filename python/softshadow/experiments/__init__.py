@@ -6,9 +6,14 @@ softshadow`` never imports this package, and their options and output may
 change between releases.
 
 ``study``
-    What accuracy costs in time, and the paper's experiments, against
-    Mitsuba references (``python -m softshadow.experiments.study``; needs the
-    ``reference`` and ``study`` extras).
+    What accuracy costs in time, in light view and eye view, and the papers'
+    experiments, against Mitsuba references (``python -m softshadow.study``;
+    needs the ``reference`` and ``study`` extras).
+``eye_plane``, ``scherzer``
+    The study's eye-view measurements (every family against Mitsuba's whole
+    eye-view job; Scherzer 2005's bias, aliasing and blur experiments and
+    Smoothies' width), shared with ``benchmarks/bench_eye.py`` and
+    ``benchmarks/bench_shadow_mapping.py``.
 ``fp16``
     The paper's FP16 study, Figure 14 and Appendix A
     (``python -m softshadow.experiments.fp16``; needs nothing extra).
