@@ -98,7 +98,9 @@ def test_gpu_render_is_the_cpu_render(gpu, scene, camera, light_name, method_nam
 
 
 @pytest.mark.parametrize("light_name", sorted(LIGHTS))
-@pytest.mark.parametrize("config", [ss.Smoothies(), ss.Smoothies(width=2.0, falloff="sine")], ids=["default", "wide-sine"])
+@pytest.mark.parametrize(
+    "config", [ss.Smoothies(), ss.Smoothies(width=2.0, falloff="sine")], ids=["default", "wide-sine"]
+)
 def test_gpu_smoothies_render_is_the_cpu_render(gpu, scene, camera, light_name, config):
     light = LIGHTS[light_name]
     cpu = ss.render(scene, light, camera, method=config, backend="cpu")

@@ -34,7 +34,7 @@ use crate::eye::maps::{self, LightTriangles};
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
 use crate::methods::smoothies::method::soup;
-use crate::methods::smoothies::{Falloff, Shape, SmoothieStats, Smoothies};
+use crate::methods::smoothies::{Falloff, Shape, Smoothies};
 use crate::methods::{LightPoint, Method};
 use crate::pipeline::{light_space_triangles, Stopwatch, Timings};
 use crate::raster::setup_triangles;
@@ -200,8 +200,10 @@ pub struct Prepared {
     q_axes: Vec<f32>,
     params: SmoothieParams,
     og: MapGrid,
-    /// The stats known before rasterizing (`texels` comes back from the device).
-    pub stats: SmoothieStats,
+    /// The stats known before rasterizing (`texels` comes back from the
+    /// device; the device tests compare them).
+    #[cfg(test)]
+    pub stats: crate::methods::smoothies::SmoothieStats,
     /// Dispatches of the buffer pass: the most smoothies in one tile over
     /// `per_chunk`, rounded up (at least 1).
     pub chunks: u32,
@@ -292,6 +294,7 @@ impl Prepared {
                 ..Default::default()
             },
             og: *og,
+            #[cfg(test)]
             stats: built.stats,
             chunks: most.div_ceil(per_chunk).max(1),
         }
@@ -375,8 +378,13 @@ fn pipelines(device: &wgpu::Device) -> &'static Pipelines {
 /// Where the receivers come from: the receiver map of the output grid in
 /// `maps` (light view), or points (eye view), or none (the buffer alone).
 pub enum Receivers<'a> {
-    Map { grid: &'a MapGrid, offset: u32 },
+    Map {
+        grid: &'a MapGrid,
+        offset: u32,
+    },
     Points(&'a [TentPoint]),
+    /// The buffer alone (the device tests read it).
+    #[cfg(test)]
     None,
 }
 
@@ -395,9 +403,8 @@ pub struct SmoothieShading {
     tents: Option<wgpu::Buffer>,
     points: Option<wgpu::Buffer>,
     pub vis: wgpu::Buffer,
-    /// Bytes of `vis` (0 without receivers) and of the buffer's maps.
+    /// Bytes of `vis` (0 without receivers).
     pub vis_bytes: u64,
-    pub map_bytes: u64,
 }
 
 impl SmoothieShading {
@@ -410,8 +417,7 @@ impl SmoothieShading {
             ..p.params
         };
         let occ_len = (params.occ_w as u64) * (params.occ_h as u64);
-        let (mut tents, mut points, mut n_vis) = (None, None, 0u64);
-        match rec {
+        let (tents, points, n_vis) = match rec {
             Receivers::Map { grid, offset } => {
                 let og = p.og;
                 params.rec_w = grid.width as u32;
@@ -419,17 +425,18 @@ impl SmoothieShading {
                 params.rec_offset = offset;
                 // The paper's shadow map holds the receivers where they share a grid.
                 params.merge = (*grid == og) as u32;
-                tents = Some(upload(device, "smoothie tents", &map_tents(grid, &og)));
-                n_vis = grid.len() as u64;
+                let tents = upload(device, "smoothie tents", &map_tents(grid, &og));
+                (Some(tents), None, grid.len() as u64)
             }
             Receivers::Points(pts) => {
                 params.rec_w = pts.len() as u32;
                 params.rec_h = 1;
-                points = Some(upload(device, "smoothie points", pts));
-                n_vis = pts.len() as u64;
+                let points = upload(device, "smoothie points", pts);
+                (None, Some(points), pts.len() as u64)
             }
-            Receivers::None => {}
-        }
+            #[cfg(test)]
+            Receivers::None => (None, None, 0),
+        };
         let rw = wgpu::BufferUsages::COPY_SRC;
         SmoothieShading {
             params,
@@ -451,7 +458,6 @@ impl SmoothieShading {
             points,
             vis: storage(device, "visibility", n_vis * 4, rw),
             vis_bytes: n_vis * 4,
-            map_bytes: occ_len * 4,
         }
     }
 
@@ -671,6 +677,7 @@ pub fn buffer_on_device(
     let p = Prepared::new(s, grid, light_size, verts, faces, per_chunk);
     let words: Vec<u32> = front.iter().map(|z| z.to_bits()).collect();
     let mut sw = Stopwatch::new();
+    let map_bytes = grid.len() as u64 * 4;
     let out = with_error_scopes(g, || {
         let maps = upload(&g.device, "maps", &words);
         let shading = SmoothieShading::new(g, &p, 0, Receivers::None);
@@ -686,8 +693,8 @@ pub fn buffer_on_device(
             enc,
             &timer,
             &[
-                (&shading.alpha, shading.map_bytes),
-                (&shading.depth, shading.map_bytes),
+                (&shading.alpha, map_bytes),
+                (&shading.depth, map_bytes),
                 (&shading.counters, 4),
             ],
             &mut sw,
