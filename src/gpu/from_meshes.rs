@@ -102,9 +102,18 @@ pub fn from_meshes(
             .collect()
     };
     // Smoothies: steps 2-3 on the CPU (smoothies.rs).
-    let smoothies = smoothies::options(s.method).map(|m| {
-        smoothies::prepare_light_view(&m, &occluder_grid, light_size, &occ_ls, occluders.faces)
-    });
+    let smoothies = smoothies::options(s.method)
+        .map(|m| {
+            smoothies::prepare_light_view(
+                g,
+                &m,
+                &occluder_grid,
+                light_size,
+                &occ_ls,
+                occluders.faces,
+            )
+        })
+        .transpose()?;
     sw.lap("setup");
     // The occluders' largest 1/depth, from their vertices in front of the near plane.
     let w_max = occ_ls.iter().fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));

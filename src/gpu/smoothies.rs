@@ -301,6 +301,31 @@ impl Prepared {
     }
 }
 
+impl Prepared {
+    /// Refuses smoothies (or bins) that one buffer binding cannot hold: a
+    /// silhouette of very many smoothies, each wider than much of the map.
+    pub fn check_fits(&self, g: &Gpu) -> Result<()> {
+        let bytes = [
+            std::mem::size_of_val(&self.smoothies[..]),
+            std::mem::size_of_val(&self.tile_items[..]),
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0) as u64;
+        if bytes > g.max_storage_binding || self.tile_items.len() >= u32::MAX as usize {
+            return Err(Error::too_large(
+                "width",
+                format!(
+                    "the smoothies and their tiles need {bytes} bytes in one GPU buffer; the \
+                     device binds at most {}; use backend=\"cpu\" or a smaller width",
+                    g.max_storage_binding
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// lookup.rs's tent along one axis at continuous pixel coordinate `p` on
 /// an axis of `n` texels, in f64 as at_point computes it.
 fn tent_axis(p: f64, n: usize) -> TentAxis {
@@ -561,15 +586,18 @@ pub fn options(method: Method) -> Option<Smoothies> {
 /// The light view's steps 2-3: the occluders as `method.rs` hands them to
 /// the CPU method (f32 light-space triangles, a soup the silhouette welds).
 pub fn prepare_light_view(
+    g: &Gpu,
     s: &Smoothies,
     og: &MapGrid,
     light_size: [f64; 2],
     occ_ls: &[DVec3],
     faces: &[[u32; 3]],
-) -> Prepared {
+) -> Result<Prepared> {
     let tris = light_space_triangles(occ_ls, faces);
     let (verts, faces) = soup(&tris);
-    Prepared::new(s, og, light_size, &verts, &faces, PER_CHUNK)
+    let p = Prepared::new(s, og, light_size, &verts, &faces, PER_CHUNK);
+    p.check_fits(g)?;
+    Ok(p)
 }
 
 /// Refuses a shadow map that one binding cannot hold.
@@ -620,6 +648,7 @@ pub(super) fn shade_eye(
     );
     // Every mesh is an occluder: the silhouette straight from the mesh.
     let prepared = Prepared::new(s, &grid, f.light_size, &tris.verts, tris.faces, PER_CHUNK);
+    prepared.check_fits(g)?;
     let tents = point_tents(&grid, &sp.points);
     sw.lap("setup");
     let map_bytes = grid.len() as u64 * 4;
