@@ -97,6 +97,34 @@ def test_gpu_render_is_the_cpu_render(gpu, scene, camera, light_name, method_nam
     assert any(k.startswith("gpu") for k in img.timings)
 
 
+@pytest.mark.parametrize("light_name", sorted(LIGHTS))
+@pytest.mark.parametrize(
+    "config", [ss.Smoothies(), ss.Smoothies(width=2.0, falloff="sine")], ids=["default", "wide-sine"]
+)
+def test_gpu_smoothies_render_is_the_cpu_render(gpu, scene, camera, light_name, config):
+    light = LIGHTS[light_name]
+    cpu = ss.render(scene, light, camera, method=config, backend="cpu")
+    img = ss.render(scene, light, camera, method=config, backend="gpu")
+    assert img.backend == "gpu" and cpu.backend == "cpu"
+    assert np.isfinite(img.visibility).all()
+    same = img.mesh_id == cpu.mesh_id
+    assert same.mean() >= 0.995, f"{(~same).sum()} pixels see another mesh"
+    hit = same & cpu.mask & (img.position == cpu.position).all(axis=-1)
+    assert hit.sum() >= 0.995 * (same & cpu.mask).sum()
+    v = cpu.visibility[hit]
+    assert (v < 0.5).sum() > 50 and ((v > 0.02) & (v < 0.98)).sum() > 20
+    dv = np.abs(img.visibility[hit].astype(np.float64) - cpu.visibility[hit])
+    assert dv.mean() <= 1e-4, f"mean |dV| {dv.mean():.2e}, max {dv.max():.2e}"
+    assert (img.visibility[~img.mask] == 1.0).all()
+    # The shadow map: the front layer of every mesh.
+    assert img.map_extent == cpu.map_extent
+    assert len(img.shadow_maps) == len(cpu.shadow_maps) == 1
+    a, b = img.shadow_maps[0], cpu.shadow_maps[0]
+    assert a.shape == b.shape and (a.view(np.uint32) != b.view(np.uint32)).mean() <= 0.005
+    assert repr(img.method) == repr(cpu.method)
+    assert "gpu_smoothie_buffer" in img.timings or "gpu" in img.timings
+
+
 def test_hard_lights_run_exact_and_refuse_the_map_methods(gpu, scene, camera):
     point = ss.RectLight(center=(0.3, 4.0, 0.2), normal=(0.0, -1.0, 0.0), up=(0.0, 0.0, 1.0), size=(0.0, 0.0))
     cpu = ss.render(scene, point, camera, method="exact", samples=4, backend="cpu")

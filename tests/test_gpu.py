@@ -90,6 +90,30 @@ def test_gpu_matches_cpu_on_the_scenes(gpu, name, passes, method, samples):
         assert_depth_maps_agree(a, b, f"{name} middle {k}")
 
 
+@pytest.mark.parametrize(
+    "config",
+    [
+        ss.Smoothies(),
+        ss.Smoothies(width=2.0, falloff="sine"),
+        ss.Smoothies(occluder_resolution=(40, 32)),
+    ],
+    ids=["default", "wide-sine", "coarser"],
+)
+@pytest.mark.parametrize("name", SCENES)
+def test_gpu_smoothies_match_cpu_on_the_scenes(gpu, name, config):
+    # The silhouette and the smoothies are built on the CPU for both; the
+    # buffer (f32 on the device, f64 on the CPU) and the lookup run on the GPU.
+    scene, light = getattr(scenes, name)()
+    c = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=config, backend="cpu")
+    g = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=config, backend="gpu")
+    assert repr(g.method) == repr(c.method) and g.extent == c.extent
+    assert_visibility_agrees(c.visibility, g.visibility, name)
+    assert_depth_maps_agree(c.receiver_depth, g.receiver_depth, f"{name} receiver")
+    assert_depth_maps_agree(c.occluder_depth, g.occluder_depth, f"{name} front")
+    assert g.occluder_depth_back is None and len(g.occluder_depth_middle) == 0
+    assert "gpu_smoothie_buffer" in g.timings or "gpu" in g.timings
+
+
 @pytest.mark.parametrize("method", ["ssm", "bitmask"])
 def test_gpu_with_coarser_occluder_maps_and_an_explicit_extent(gpu, method):
     scene, light = scenes.torus_floating()

@@ -213,8 +213,6 @@ def test_what_a_method_cannot_do_is_refused():
         ss.render(scene, light, cam, method=ss.ShadowMapping(warp=ss.LiSPSM()))
     with pytest.raises(ValueError, match="^method: ShadowMapping renders the eye view"):
         ss.soft_shadow_map(scene, light, resolution=32, method=ss.ShadowMapping())
-    with pytest.raises(ValueError, match="^backend: "):
-        ss.render(scene, light, cam, method=ss.Smoothies(), backend="gpu")
 
 
 @pytest.mark.parametrize(

@@ -587,4 +587,198 @@ mod eye {
         let a = render(&meshes, &point, &cam, ssm, BackendChoice::Auto).unwrap();
         assert_eq!(a.backend, Backend::Cpu);
     }
+    #[test]
+    fn gpu_smoothies_renders_are_the_cpu_renders() {
+        // Smoothies in the eye view: the front layer bit for bit, the
+        // visibility within the map methods' mean; a smoothie texel whose
+        // coverage or alpha an f32 tie flips moves the points of its tent.
+        if !device_or_skip() {
+            return;
+        }
+        use crate::methods::config::SmoothiesConfig;
+        let meshes = scene();
+        let cam = camera((96, 72));
+        for (lname, light) in lights() {
+            for falloff in [None, Some("sine")] {
+                let method = MethodConfig::Smoothies(
+                    SmoothiesConfig::new(None, falloff, None, None).unwrap(),
+                );
+                let c = render(&meshes, &light, &cam, method, BackendChoice::Cpu).unwrap();
+                let g = render(&meshes, &light, &cam, method, BackendChoice::Gpu).unwrap();
+                assert_eq!((c.backend, g.backend), (Backend::Cpu, Backend::Gpu));
+                assert_eq!(c.method, g.method);
+                let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+                let same = same_surface(&c.output, &g.output);
+                let dv: Vec<f64> = (0..cv.len())
+                    .filter(|&k| same[k])
+                    .map(|k| (cv[k] as f64 - gv[k] as f64).abs())
+                    .collect();
+                let mean = dv.iter().sum::<f64>() / dv.len() as f64;
+                let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+                let over = dv.iter().filter(|&&x| x > 2e-3).count();
+                let penumbra = cv.iter().filter(|&&v| v > 0.02 && v < 0.98).count();
+                eprintln!(
+                    "smoothies {lname} {falloff:?}: mean |dV| {mean:.2e}, max {max:.2e}, \
+                     {over} over 2e-3, penumbra {penumbra}"
+                );
+                assert!(penumbra > 20, "{lname}");
+                assert!(mean <= 1e-4, "{lname}: mean |dV| {mean}");
+                assert!(over * 200 <= dv.len(), "{lname}: {over} points differ");
+                let (a, b) = (c.output.maps.unwrap(), g.output.maps.unwrap());
+                assert_eq!(a.grid, b.grid);
+                assert_eq!((a.layers.len(), b.layers.len()), (1, 1));
+                let diff = a.layers[0]
+                    .iter()
+                    .zip(&b.layers[0])
+                    .filter(|(x, y)| x.to_bits() != y.to_bits())
+                    .count();
+                assert_eq!(diff, 0, "{lname}: the front layer");
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Smoothies: the smoothie buffer, the light view and the eye view against
+// the CPU (methods/smoothies/).
+
+mod smoothies {
+    use super::{device_or_skip, run, sphere};
+    use crate::geom::light::MapGrid;
+    use crate::methods::shadow_mapping::config::Real;
+    use crate::methods::smoothies::{shadow_map, Falloff, SmoothieBuffer, Smoothies};
+    use crate::methods::Method;
+    use glam::DVec3;
+
+    /// Texels whose alpha or depth differ beyond f32 rounding (1e-5,
+    /// relative for the depth; inf against a finite value always), and the
+    /// smoothie texels (alpha < 1) of either.
+    fn buffer_diff(c: &SmoothieBuffer, g: &SmoothieBuffer) -> (usize, usize) {
+        let mut differ = 0;
+        let mut texels = 0;
+        for k in 0..c.alpha.len() {
+            let (ca, ga, cd, gd) = (c.alpha[k], g.alpha[k], c.depth[k], g.depth[k]);
+            texels += (ca < 1.0 || ga < 1.0) as usize;
+            let depth_ok = if cd.is_finite() && gd.is_finite() {
+                (cd - gd).abs() <= 1e-5 * cd.abs().max(1.0)
+            } else {
+                cd == gd
+            };
+            if (ca - ga).abs() > 1e-5 || !depth_ok {
+                differ += 1;
+            }
+        }
+        (differ, texels)
+    }
+
+    /// Two spheres (one in front of the other) in kernel light space over
+    /// a receiver at depth 4: silhouettes at two depths, corners at every
+    /// angle, smoothies over a blocker and over the floor.
+    fn scene() -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let mut verts = vec![];
+        let mut faces = vec![];
+        for (c, r, n) in [([0.1, -0.2, 2.0], 0.4, 24), ([-0.15, 0.1, 3.0], 0.5, 32)] {
+            let (v, f) = sphere(c, r, n);
+            let base = verts.len() as u32;
+            verts.extend(v.into_iter().map(DVec3::from_array));
+            faces.extend(f.into_iter().map(|t| t.map(|i| i + base)));
+        }
+        (verts, faces)
+    }
+
+    #[test]
+    fn gpu_smoothie_buffer_is_the_cpus_but_on_f32_ties() {
+        if !device_or_skip() {
+            return;
+        }
+        let (verts, faces) = scene();
+        let light = [0.8, 0.5];
+        for (w, h) in [(96, 80), (257, 131)] {
+            let grid = MapGrid::new(w, h, [0.45, 0.4]).unwrap();
+            let front = crate::raster::rasterize(&grid, &verts, &faces, 1e-3, false).nearest;
+            let map = shadow_map(&front, &vec![4.0; grid.len()]);
+            for falloff in Falloff::ALL {
+                let s = Smoothies {
+                    width: 1.0,
+                    falloff,
+                };
+                let c = s.buffer(&grid, light, &map, &verts, &faces);
+                assert!(c.stats.silhouette_edges > 40 && c.stats.corners > 10);
+                // One dispatch, and the tiles read three smoothies a dispatch.
+                for per_chunk in [super::super::smoothies::PER_CHUNK, 3] {
+                    let (g, chunks) = super::super::smoothies::buffer_on_device(
+                        &s, &grid, light, &map, &verts, &faces, per_chunk,
+                    )
+                    .unwrap();
+                    let (differ, texels) = buffer_diff(&c, &g);
+                    eprintln!(
+                        "{w}x{h} per_chunk {per_chunk}: {chunks} dispatches, {texels} smoothie \
+                         texels, {differ} differ; rasterized {} (CPU {})",
+                        g.stats.texels, c.stats.texels
+                    );
+                    assert!(texels > 200, "the scene must have smoothies");
+                    assert_eq!(chunks > 1, per_chunk == 3);
+                    assert_eq!(
+                        (g.stats.silhouette_edges, g.stats.corners),
+                        (c.stats.silhouette_edges, c.stats.corners)
+                    );
+                    // f32 edge ties: a texel centre within rounding of a
+                    // smoothie's border, or two alphas within rounding.
+                    assert!(differ * 500 <= texels, "{differ} of {texels} texels differ");
+                    assert!(g.stats.texels.abs_diff(c.stats.texels) * 500 <= c.stats.texels);
+                }
+            }
+        }
+    }
+
+    const SMOOTHIES: Method = Method::Smoothies {
+        width: Real(1.0),
+        falloff: Falloff::Linear,
+    };
+
+    /// |dV| statistics: mean, max, and the count over 2e-3 (a smoothie
+    /// texel flipped by an f32 tie moves one texel's tent).
+    fn dv_stats(c: &[f32], g: &[f32]) -> (f64, f64, usize) {
+        let dv: Vec<f64> = c
+            .iter()
+            .zip(g)
+            .map(|(a, b)| (*a as f64 - *b as f64).abs())
+            .collect();
+        let mean = dv.iter().sum::<f64>() / dv.len() as f64;
+        let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+        (mean, max, dv.iter().filter(|&&x| x > 2e-3).count())
+    }
+
+    #[test]
+    fn gpu_light_view_is_the_cpus() {
+        if !device_or_skip() {
+            return;
+        }
+        for method in [
+            SMOOTHIES,
+            Method::Smoothies {
+                width: Real(2.0),
+                falloff: Falloff::Sine,
+            },
+        ] {
+            let c = run(false, 1, method);
+            let g = run(true, 1, method);
+            assert_eq!(super::same_bits(&c.receiver, &g.receiver), 0);
+            let (cf, gf) = (c.occluder_front.unwrap(), g.occluder_front.unwrap());
+            assert_eq!(super::same_bits(&cf, &gf), 0, "front");
+            assert!(g.occluder_back.is_none() && g.occluder_middle.is_empty());
+            let penumbra = c
+                .visibility
+                .iter()
+                .filter(|&&v| v > 0.01 && v < 0.99)
+                .count();
+            let (mean, max, over) = dv_stats(&c.visibility, &g.visibility);
+            eprintln!(
+                "{method:?}: mean |dV| {mean:.2e}, max {max:.2e}, {over} over 2e-3, penumbra {penumbra}"
+            );
+            assert!(penumbra > 50);
+            assert!(mean <= 1e-4, "mean {mean}");
+            assert!(over * 200 <= penumbra, "{over} texels differ");
+        }
+    }
 }

@@ -591,6 +591,10 @@ fn shade_maps(
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
     debug_assert!(method.reads_input(Input::OccluderLayers));
+    // Smoothies: their own buffer and lookup (smoothies.rs).
+    if let Some(s) = super::smoothies::options(method) {
+        return super::smoothies::shade_eye(g, f, tris, grid, &s, bias, sw);
+    }
     let layer_len = grid.len();
     let texels = passes as u64 * layer_len as u64;
     if texels >= u32::MAX as u64 {

@@ -15,6 +15,7 @@ use super::gather;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
+use super::smoothies::{self, Receivers, SmoothieShading};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::geom::light::is_point;
@@ -50,6 +51,7 @@ pub fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
 enum Stage {
     Maps(Shading),
     Rays(ExactShading),
+    Smoothies(SmoothieShading),
 }
 
 /// Soft shadow map from meshes on the GPU; the same result type, maps and
@@ -99,13 +101,35 @@ pub fn from_meshes(
             .map(GpuTri::from_setup)
             .collect()
     };
+    // Smoothies: steps 2-3 on the CPU (smoothies.rs).
+    let smoothies = smoothies::options(s.method)
+        .map(|m| {
+            smoothies::prepare_light_view(
+                g,
+                &m,
+                &occluder_grid,
+                light_size,
+                &occ_ls,
+                occluders.faces,
+            )
+        })
+        .transpose()?;
     sw.lap("setup");
     // The occluders' largest 1/depth, from their vertices in front of the near plane.
     let w_max = occ_ls.iter().fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
     let maps_len = grid.len() + passes * occluder_grid.len();
     let out = with_error_scopes(g, || {
-        let shading = match s.method {
-            Method::Exact { samples } => {
+        let shading = match (s.method, &smoothies) {
+            (_, Some(p)) => Stage::Smoothies(SmoothieShading::new(
+                g,
+                p,
+                grid.len() as u32,
+                Receivers::Map {
+                    grid: &grid,
+                    offset: 0,
+                },
+            )),
+            (Method::Exact { samples }, _) => {
                 let t = light_space_triangles(&occ_ls, occluders.faces);
                 Stage::Rays(ExactShading::new(g, &grid, t, samples, light_size))
             }
@@ -144,6 +168,10 @@ pub fn from_meshes(
                 sh.record(g, &mut enc, &timer, &maps);
                 sources.push((&sh.vis, sh.vis_bytes));
                 sources.push((&sh.status, 4));
+            }
+            Stage::Smoothies(sh) => {
+                sh.record(g, &mut enc, &timer, &maps);
+                sources.push((&sh.vis, sh.vis_bytes));
             }
         }
         submit_and_read(g, enc, &timer, &sources, &mut sw)

@@ -217,6 +217,10 @@ fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
 
 /// Refuses a method the GPU cannot run, before any GPU work.
 pub fn check_method(method: Method) -> Result<()> {
+    // Smoothies have their own kernels (smoothies.rs).
+    if matches!(method, Method::Smoothies { .. }) {
+        return Ok(());
+    }
     method_source(method).map(|_| ())
 }
 

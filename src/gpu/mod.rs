@@ -17,6 +17,10 @@
 //! * `gather.wgsl`'s points mode (`gather.rs`, `eye.rs`): the eye view's
 //!   map methods at arbitrary points; twin `methods::gather`'s
 //!   `visibility_points`.
+//! * `smoothies.wgsl` (`smoothies.rs`): Smoothies' buffer (the smoothies
+//!   built on the CPU, binned to tiles, rasterized per texel with min
+//!   blending) and lookup, light and eye view; twins
+//!   `crate::methods::smoothies::{buffer, lookup}`.
 //! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl` and
 //!   `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
@@ -38,6 +42,7 @@ mod readback;
 #[cfg(test)]
 mod shader_tests;
 mod shading;
+mod smoothies;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};

@@ -9,6 +9,9 @@ use super::gather::{
     BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
+use super::smoothies::{
+    GpuSmoothie, SmoothieChunk, SmoothieParams, TentAxis, TentPoint, SOURCE as SMOOTHIES_SOURCE,
+};
 use std::mem::{offset_of, size_of};
 
 /// Every shader module the backend builds, by name.
@@ -20,6 +23,7 @@ fn modules() -> Vec<(&'static str, String)> {
         ("exact.wgsl", EXACT_SOURCE.to_string()),
         ("exact.wgsl + eye_hits.wgsl", HITS_SOURCE.to_string()),
         ("exact.wgsl + eye_rays.wgsl", RAYS_SOURCE.to_string()),
+        ("smoothies.wgsl", SMOOTHIES_SOURCE.to_string()),
     ]
 }
 
@@ -40,6 +44,7 @@ fn every_wgsl_file_is_used_by_a_module() {
         EXACT_SOURCE,
         HITS_SOURCE,
         RAYS_SOURCE,
+        SMOOTHIES_SOURCE,
     ];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -289,6 +294,75 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             ax_rec_y,
             _pad0,
             _pad1
+        }),
+    );
+}
+
+#[test]
+fn smoothie_structs_have_the_same_layout_in_rust_and_wgsl() {
+    assert_same(
+        SMOOTHIES_SOURCE,
+        "SmoothieParams",
+        rust_layout!(SmoothieParams {
+            occ_w,
+            occ_h,
+            rec_w,
+            rec_h,
+            rec_offset,
+            front_offset,
+            merge,
+            tiles_x,
+            t,
+            falloff,
+            per_chunk,
+            _pad
+        }),
+    );
+    assert_same(
+        SMOOTHIES_SOURCE,
+        "SmoothieChunk",
+        rust_layout!(SmoothieChunk {
+            chunk,
+            _pad0,
+            _pad1,
+            _pad2
+        }),
+    );
+    assert_same(
+        SMOOTHIES_SOURCE,
+        "Smoothie",
+        rust_layout!(GpuSmoothie {
+            kind,
+            len,
+            z0,
+            z1,
+            px,
+            py,
+            ax,
+            ay,
+            bx,
+            by,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        SMOOTHIES_SOURCE,
+        "TentAxis",
+        rust_layout!(TentAxis { a, b, w, _pad }),
+    );
+    assert_same(
+        SMOOTHIES_SOURCE,
+        "TentPoint",
+        rust_layout!(TentPoint {
+            ia,
+            ib,
+            ja,
+            jb,
+            wx,
+            wy,
+            z,
+            live
         }),
     );
 }

@@ -245,9 +245,9 @@ pub fn methods() -> Vec<MethodInfo> {
             config: "Smoothies",
             summary: "Fake soft shadows (Chan & Durand 2003): the hard shadow map's umbra and an \
                       outer penumbra from smoothies on the occluders' silhouette edges, their \
-                      alpha remapped by 1/(1 - b/r); CPU only in this version",
+                      alpha remapped by 1/(1 - b/r)",
             reads: vec![Input::OccluderLayers, Input::OccluderTriangles],
-            backends: vec![Backend::Cpu],
+            backends: backends.clone(),
             options: vec![
                 OptionInfo {
                     name: "width",

@@ -691,7 +691,6 @@ impl MethodConfig {
                 MethodConfig::ShadowMapping(c)
             }
             MethodConfig::Smoothies(c) => {
-                cpu_only(ctx, "smoothies")?;
                 if ctx.depth_layers.is_some() {
                     return Err(Error::invalid(
                         "method",

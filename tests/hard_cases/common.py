@@ -8,14 +8,23 @@ import numpy as np
 
 import softshadow as ss
 
-__all__ = ["BACKENDS", "MAP_METHODS", "METHODS", "SAMPLES", "assert_visibility", "has_option", "options", "runs_on"]
+__all__ = [
+    "BACKENDS",
+    "MAP_METHODS",
+    "METHODS",
+    "SAMPLES",
+    "assert_visibility",
+    "has_option",
+    "options",
+    "runs_on",
+    "samples_points",
+]
 
 _CAPS = ss.capabilities()
 # Every light-view method that runs on every backend of this build ("auto"
 # is a rule that resolves to one of them; a method that reads a camera has
-# the eye view only). The CPU-only methods of this version (pcss,
-# smoothies) have their hard cases in tests/test_shadow_mapping.py until
-# their GPU twins join these lists.
+# the eye view only). A CPU-only method has its hard cases in
+# tests/test_shadow_mapping.py until its GPU twin joins these lists.
 _ALL = set(_CAPS["ssm"].backends)
 METHODS = tuple(
     name for name in _CAPS if name != "auto" and "camera" not in _CAPS[name].reads and set(_CAPS[name].backends) == _ALL
@@ -35,15 +44,24 @@ def runs_on(method: str, backend: str) -> bool:
     return backend in _CAPS[method].backends
 
 
+def samples_points(method: str) -> bool:
+    """Whether ``ShadowMap.sample`` shades a map of ``method`` at points
+    (smoothies read the occluder mesh besides its maps: refused by name)."""
+    return not {"occluder_layers", "occluder_triangles"} <= set(_CAPS[method].reads)
+
+
 def has_option(method: str, option: str) -> bool:
     return option in _CAPS[method].options or (option == "passes" and method == "exact")
 
 
-def options(method: str, backend: str) -> dict:
-    """Keyword arguments for method and backend."""
-    kw = {"method": method, "backend": backend}
+def options(method: str, backend: str, passes: int | None = None) -> dict:
+    """Keyword arguments for method and backend (and ``passes`` where the
+    method has occluder layers to peel: smoothies read the front one only)."""
+    kw: dict = {"method": method, "backend": backend}
     if method in SAMPLES:
         kw["samples"] = SAMPLES[method]
+    if passes is not None and has_option(method, "passes"):
+        kw["passes"] = passes
     return kw
 
 

@@ -88,6 +88,11 @@ def test_thin_maps_from_meshes(method, backend, resolution):
     y = plate.centers(h, 0.5)[::-1]
     if method == "exact":
         rect, bound = (-0.25, 0.25, -0.25, 0.25), 4 * 16 / 256  # 4 edges x 16 strata
+    elif method == "smoothies":
+        # Fake soft shadows: the umbra is the hard shadow's and the penumbra
+        # lies outside it, so across the true penumbra's inner half they read
+        # 0 where the truth rises to 1/2 (measured max 0.45-0.499).
+        rect, bound = (-0.25, 0.25, -0.25, 0.25), 0.5
     else:
         hw, hh = 0.5 / w, 0.5 / h
         xs, ys = x[np.abs(x) < 0.25], y[np.abs(y) < 0.25]
@@ -112,4 +117,6 @@ def test_occluder_just_outside_the_receivers_still_shadows_them(method, backend)
     assert_visibility(sm.visibility)
     assert ref.min() < 0.85 and sm.visibility.min() < 0.86
     shadow = ref < 1 - 1e-3
-    assert np.abs(sm.visibility - ref)[shadow].mean() <= 0.03
+    # Smoothies put the hard shadow's umbra where the truth has none
+    # (measured mean 0.128).
+    assert np.abs(sm.visibility - ref)[shadow].mean() <= (0.15 if method == "smoothies" else 0.03)

@@ -28,7 +28,7 @@ from hypothesis import strategies as st
 
 import softshadow as ss
 from hard_cases import plate as closed
-from hard_cases.common import BACKENDS, MAP_METHODS, METHODS, assert_visibility
+from hard_cases.common import BACKENDS, MAP_METHODS, METHODS, assert_visibility, has_option
 from softshadow import scenes
 
 SETTINGS = settings(
@@ -56,8 +56,9 @@ def scene_and_light(draw):
     return plates, light
 
 
-def _kw(method, backend):
-    return dict(method=method, backend=backend, **({} if method == "ssm" else {"samples": 64}))
+def _kw(method, backend, passes=None):
+    kw = dict(method=method, backend=backend, **({"samples": 64} if has_option(method, "samples") else {}))
+    return kw | ({"passes": passes} if passes is not None and has_option(method, "passes") else {})
 
 
 @SETTINGS
@@ -65,7 +66,7 @@ def _kw(method, backend):
 def test_visibility_is_finite_and_in_unit_interval(sl, method, backend, passes):
     plates, light = sl
     scene = ss.Scene(occluders=plates, receivers=[scenes.floor()])
-    sm = ss.soft_shadow_map(scene, light, resolution=24, passes=passes, **_kw(method, backend))
+    sm = ss.soft_shadow_map(scene, light, resolution=24, **_kw(method, backend, passes))
     assert_visibility(sm.visibility)
     np.testing.assert_array_equal(sm.visibility[~np.isfinite(sm.receiver_depth)], 1.0)
 

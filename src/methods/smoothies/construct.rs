@@ -42,7 +42,7 @@ use glam::{DVec2, DVec3};
 
 /// One smoothie primitive in q space.
 #[derive(Debug, Clone, Copy)]
-pub(super) enum Shape {
+pub(crate) enum Shape {
     Edge {
         p0: DVec2,
         /// Unit direction p0 -> p1, its length, the outward unit normal.
@@ -230,7 +230,7 @@ pub(super) fn build(sil: &Silhouette, grid: &MapGrid, light: [f64; 2], t: f64) -
 
 impl Shape {
     /// The convex polygon (q space) that holds the shape's texels.
-    pub(super) fn hull(&self, t: f64) -> ([DVec2; 4], usize) {
+    pub(crate) fn hull(&self, t: f64) -> ([DVec2; 4], usize) {
         match *self {
             Shape::Edge { p0, d, len, n, .. } => {
                 let p1 = p0 + d * len;

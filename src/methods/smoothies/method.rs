@@ -11,7 +11,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// Triangle soup -> a mesh of three corners per face (welded later).
-fn soup(tris: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+pub(crate) fn soup(tris: &[[Vec3; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let verts = tris.iter().flatten().map(|c| c.as_dvec3()).collect();
     let faces = (0..tris.len() as u32)
         .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])

@@ -30,6 +30,7 @@ mod tests;
 
 use crate::geom::light::MapGrid;
 use crate::methods::LightPoint;
+pub(crate) use construct::Shape;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -106,6 +107,14 @@ pub struct SmoothieBuffer {
     pub stats: SmoothieStats,
 }
 
+/// Steps 2-3's output: the smoothies (q space, width `t`) and the stats
+/// known before rasterizing (`texels` is step 4's).
+pub(crate) struct Built {
+    pub shapes: Vec<Shape>,
+    pub t: f64,
+    pub stats: SmoothieStats,
+}
+
 /// The paper's shadow map from the project's maps on one grid: the nearer of
 /// the front occluder depth and the receiver depth, texel by texel.
 pub fn shadow_map(front: &[f32], receiver: &[f32]) -> Vec<f32> {
@@ -142,6 +151,37 @@ impl Smoothies {
         (t.is_finite() && t > 0.0).then_some(t)
     }
 
+    /// Steps 2-3: the silhouette and its smoothies on `grid` (width t in q
+    /// units, 0 and no shapes without a width), with the stats they give.
+    /// Shared by the CPU's step 4 (`buffer`) and the GPU's (`gpu/smoothies.rs`).
+    pub(crate) fn smoothies(
+        &self,
+        grid: &MapGrid,
+        light_size: [f64; 2],
+        verts: &[DVec3],
+        faces: &[[u32; 3]],
+    ) -> Built {
+        let sil = silhouette::silhouette(verts, faces);
+        let mut stats = SmoothieStats {
+            silhouette_edges: sil.edges.len(),
+            ..Default::default()
+        };
+        let Some(t) = self.q_width(&sil, light_size) else {
+            return Built {
+                shapes: vec![],
+                t: 0.0,
+                stats,
+            };
+        };
+        let smoothies = construct::build(&sil, grid, light_size, t);
+        stats.corners = smoothies.corners;
+        Built {
+            shapes: smoothies.shapes,
+            t,
+            stats,
+        }
+    }
+
     /// Steps 2-4: the silhouette, the smoothies and the smoothie buffer on
     /// `grid`, remapped against the shadow map `front` (H x W on `grid`).
     pub fn buffer(
@@ -153,24 +193,21 @@ impl Smoothies {
         faces: &[[u32; 3]],
     ) -> SmoothieBuffer {
         assert_eq!(front.len(), grid.len(), "front must be H x W on the grid");
+        let built = self.smoothies(grid, light_size, verts, faces);
         let mut buf = SmoothieBuffer {
             depth: vec![f32::INFINITY; grid.len()],
             alpha: vec![1.0; grid.len()],
-            stats: SmoothieStats::default(),
+            stats: built.stats,
         };
-        let sil = silhouette::silhouette(verts, faces);
-        buf.stats.silhouette_edges = sil.edges.len();
-        let Some(t) = self.q_width(&sil, light_size) else {
+        if built.shapes.is_empty() {
             return buf;
-        };
-        let smoothies = construct::build(&sil, grid, light_size, t);
-        buf.stats.corners = smoothies.corners;
+        }
         buf.stats.texels = buffer::rasterize(
             grid,
             light_size,
             front,
-            &smoothies.shapes,
-            t,
+            &built.shapes,
+            built.t,
             &mut buf.depth,
             &mut buf.alpha,
         );
