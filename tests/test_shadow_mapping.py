@@ -9,6 +9,7 @@ the fraction shadowed there but lit by the map.
 
 from __future__ import annotations
 
+import os
 import pickle
 
 import numpy as np
@@ -217,11 +218,18 @@ def test_what_a_method_cannot_do_is_refused():
         ss.render(scene, light, cam, method=ss.Smoothies(), backend="gpu")
 
 
+def _backends():
+    """The CPU, and the GPU where an adapter opens (lavapipe in CI)."""
+    gpu = ss.gpu_available() or os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1"
+    return ["cpu"] + (["gpu"] if gpu else [])
+
+
+@pytest.mark.parametrize("backend", _backends())
 @pytest.mark.parametrize(
     "case",
     ["single_triangle", "light_behind_camera", "camera_into_light", "grazing"],
 )
-def test_hard_cases_stay_finite_and_in_range(case):
+def test_hard_cases_stay_finite_and_in_range(case, backend):
     tri = (np.array([[-1.0, 0.5, -1.0], [1.0, 0.5, -1.0], [0.0, 0.5, 1.0]]), np.array([[0, 1, 2]], dtype=np.uint32))
     floor = quad((0.0, 0.0, 0.0), 3.0)
     cam = ss.Camera.look_at(eye=(0, 2, 4), target=(0, 0, 0), up=(0, 1, 0), fov_y=50, resolution=(64, 48))
@@ -242,9 +250,16 @@ def test_hard_cases_stay_finite_and_in_range(case):
         ss.ShadowMapping(resolution=256, focus=False, blur=ss.EyeSpaceBlur()),
         ss.Smoothies(),
     ]:
-        img = ss.render(scene, sun, cam, method=m)
+        if backend not in ss.capabilities()[m.name].backends:
+            continue
+        img = ss.render(scene, sun, cam, method=m, backend=backend)
         v = img.visibility
         assert np.isfinite(v).all() and v.min() >= 0 and v.max() <= 1, (case, m)
+        if backend == "gpu" and m.name == "shadow_mapping":
+            # The GPU twin: the CPU's image but where the first hits differ.
+            cpu = ss.render(scene, sun, cam, method=m, backend="cpu")
+            hit = (img.mesh_id == cpu.mesh_id) & cpu.mask & (img.position == cpu.position).all(axis=-1)
+            assert np.abs(img.visibility[hit] - cpu.visibility[hit]).mean() <= 1e-3, (case, m)
 
 
 @pytest.mark.parametrize("name", list(EYE_SCENES))

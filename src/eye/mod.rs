@@ -318,20 +318,8 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     if let MethodConfig::ShadowMapping(cfg) = call.method {
         let method = resolve_at_camera(call, Backend::Cpu)?;
         let (visibility, _map) = shadow_mapping::render(call, &cfg, &scene, &g, &mut sw)?;
-        let light_space = match call.light {
-            Light::Rect(l) => LightSpace::Rect(*l),
-            Light::Sun(s) => LightSpace::Sun(SunSpace::fit(*s, scene.points())?),
-        };
-        return Ok((
-            EyeImage {
-                gbuffer: g,
-                visibility,
-                maps: None,
-                light_space,
-                timings: sw.timings,
-            },
-            method,
-        ));
+        let image = shadow_mapping::image(call, &scene, g, visibility, sw.timings)?;
+        return Ok((image, method));
     }
     let mut f = frame(call, &scene, &g)?;
     sw.lap("transform");

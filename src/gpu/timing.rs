@@ -101,6 +101,7 @@ fn gpu_stage_name(name: &'static str) -> &'static str {
         "raster_occluders" => "gpu_raster_occluders",
         "row_stats" => "gpu_row_stats",
         "shadow" => "gpu_shadow",
+        "blur" => "gpu_blur",
         _ => name,
     }
 }
