@@ -17,13 +17,15 @@ use super::{EyeCall, EyeImage};
 use crate::error::{Error, Result};
 use crate::geom::body::{extend_toward_light, view_body, Aabb};
 use crate::geom::light_space::Light;
+use crate::geom::light_space::LightSpace;
 use crate::geom::shadow_projection::{ShadowProjection, ViewVector, MIN_SIN_GAMMA};
+use crate::geom::sun::SunSpace;
 use crate::methods::shadow_mapping::blur::blur;
 use crate::methods::shadow_mapping::config::{DepthBias, ShadowMappingConfig};
 use crate::methods::shadow_mapping::lookup::Lookup;
-use crate::geom::light_space::LightSpace;
-use crate::geom::sun::SunSpace;
-use crate::methods::shadow_mapping::raster::{scan, setup_triangles, DepthMap, Faces, SetupTri, Toward};
+use crate::methods::shadow_mapping::raster::{
+    scan, setup_triangles, DepthMap, Faces, SetupTri, Toward,
+};
 use crate::pipeline::{Stopwatch, Timings};
 use glam::DVec3;
 use rayon::prelude::*;

@@ -805,5 +805,93 @@ mod eye {
                 }
             }
         }
+
+        #[test]
+        fn tiles_with_more_triangles_than_a_chunk_take_several_dispatches() {
+            // 20000 stacked quads over a 16x16 map: one tile whose bin
+            // holds 40000 triangles, scanned in three chunks (lavapipe's
+            // loop cap), both layers as the CPU's.
+            if !device_or_skip() {
+                return;
+            }
+            let g = super::super::super::context::gpu().unwrap();
+            let layers = 20_000;
+            let mut v = vec![];
+            let mut f = vec![];
+            for k in 0..layers {
+                let y = 0.5 + k as f64 * 1e-4;
+                let b = v.len() as u32;
+                v.extend([
+                    [-1.0, y, -1.0],
+                    [1.0, y, -1.0],
+                    [1.0, y, 1.0],
+                    [-1.0, y, 1.0],
+                ]);
+                f.extend([[b, b + 2, b + 1], [b, b + 3, b + 2]]);
+            }
+            let meshes = [(v, f), floor()];
+            let refs: Vec<MeshRef> = meshes
+                .iter()
+                .map(|(v, f)| MeshRef {
+                    vertices: v,
+                    faces: f,
+                })
+                .collect();
+            let scene = SceneTriangles::new(&refs).unwrap();
+            let cam = camera((32, 24));
+            let gb = gbuffer::first_hits(&cam, &scene);
+            let light = lights()[1].1;
+            let cfg = ShadowMappingConfig {
+                resolution: (16, 16),
+                bias: DepthBias::Midpoint,
+                focus: false,
+                ..Default::default()
+            };
+            let call = EyeCall {
+                meshes: &refs,
+                light: &light,
+                camera: &cam,
+                method: MethodConfig::ShadowMapping(cfg),
+                map_resolution: None,
+                bias: DEFAULT_BIAS,
+                backend: BackendChoice::Gpu,
+                threads: None,
+            };
+            let mut sw = Stopwatch::new();
+            let p = match sm::prepare(&call, &cfg, &scene, &gb, &mut sw).unwrap() {
+                Ok(p) => p,
+                Err(_) => panic!("no map"),
+            };
+            let b =
+                super::super::super::shadow_mapping::bins(&p.triangles, cfg.resolution).unwrap();
+            assert!(b.chunks.len() >= 4, "{} chunks", b.chunks.len() - 1);
+            let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
+            let cmap = info.unwrap().map;
+            let mut t = vec![];
+            let (gv, gmap) = super::super::super::shadow_mapping::render_prepared(
+                g, &call, &cfg, &scene, &gb, true, &mut sw, &mut t,
+            )
+            .unwrap();
+            let gmap = gmap.unwrap();
+            let written = cmap.nearest.iter().filter(|z| z.is_finite()).count();
+            let two = cmap
+                .second
+                .as_ref()
+                .unwrap()
+                .iter()
+                .filter(|z| z.is_finite())
+                .count();
+            eprintln!(
+                "{written} texels written, {two} with a second layer, {} chunks",
+                b.chunks.len() - 1
+            );
+            assert!(written > 0 && two > 0);
+            assert_eq!(map_diff(&cmap.nearest, &gmap.nearest).0, 0);
+            assert_eq!(
+                map_diff(cmap.second.as_ref().unwrap(), gmap.second.as_ref().unwrap()).0,
+                0
+            );
+            assert_eq!(cv, gv);
+        }
     }
 }

@@ -307,7 +307,7 @@ fn shadow_mapping_structs_have_the_same_layout_in_rust_and_wgsl() {
             tiles_x,
             linear,
             two_layers,
-            first_chunk,
+            _pad0,
             chunk_start,
             chunk_len,
             work_offset,

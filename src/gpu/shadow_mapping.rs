@@ -76,7 +76,7 @@ pub struct SmParams {
     pub tiles_x: u32,
     pub linear: u32,
     pub two_layers: u32,
-    pub first_chunk: u32,
+    pub _pad0: u32,
     pub chunk_start: u32,
     pub chunk_len: u32,
     pub work_offset: u32,
@@ -386,7 +386,12 @@ pub fn run(
         let start_buf = upload(device, "sm bin starts", &b.start);
         let list_buf = upload(device, "sm bins", &b.list);
         let work_buf = upload(device, "sm work", &b.work);
-        let near = storage(device, "sm nearest", map_bytes, wgpu::BufferUsages::COPY_SRC);
+        let near = storage(
+            device,
+            "sm nearest",
+            map_bytes,
+            wgpu::BufferUsages::COPY_SRC,
+        );
         let second = storage(
             device,
             "sm second",
@@ -396,7 +401,12 @@ pub fn run(
         let points_buf = upload(device, "sm points", &points);
         let img = [
             upload_rw(device, "sm image", &base),
-            storage(device, "sm image 2", img_bytes, wgpu::BufferUsages::COPY_SRC),
+            storage(
+                device,
+                "sm image 2",
+                img_bytes,
+                wgpu::BufferUsages::COPY_SRC,
+            ),
         ];
         let pixels = upload(
             device,
@@ -428,15 +438,7 @@ pub fn run(
             let bg = bind(
                 device,
                 &pl.clear,
-                &[
-                    None,
-                    None,
-                    None,
-                    None,
-                    Some(&near),
-                    Some(&second),
-                    Some(&u),
-                ],
+                &[None, None, None, None, Some(&near), Some(&second), Some(&u)],
             );
             pass.set_pipeline(&pl.clear);
             pass.set_bind_group(0, &bg, &[]);
@@ -449,7 +451,6 @@ pub fn run(
                     device,
                     "sm params",
                     &SmParams {
-                        first_chunk: 0,
                         chunk_start: c as u32 * CHUNK,
                         chunk_len: CHUNK,
                         work_offset: b.chunks[c],
@@ -578,7 +579,16 @@ pub fn render_eye(call: &EyeCall, cfg: &ShadowMappingConfig) -> Result<(EyeImage
     let (hit, mut device_timings) = super::eye::first_hits(g, call.camera, &scene)?;
     let gb = gbuffer::from_hits(call.camera, &scene, &hit);
     sw.lap("first_hits");
-    let (vis, _) = render_prepared(g, call, cfg, &scene, &gb, false, &mut sw, &mut device_timings)?;
+    let (vis, _) = render_prepared(
+        g,
+        call,
+        cfg,
+        &scene,
+        &gb,
+        false,
+        &mut sw,
+        &mut device_timings,
+    )?;
     let mut timings = sw.timings;
     timings.extend(device_timings);
     Ok((sm::image(call, &scene, gb, vis, timings)?, method))

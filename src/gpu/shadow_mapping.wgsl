@@ -30,7 +30,7 @@ struct SmParams {
     tiles_x: u32,
     linear: u32,
     two_layers: u32,
-    first_chunk: u32,
+    _pad0: u32,
     chunk_start: u32,
     chunk_len: u32,
     work_offset: u32,
@@ -186,13 +186,11 @@ fn sm_raster(@builtin(workgroup_id) wid: vec3<u32>,
         return;
     }
     let o = j * params.width + i;
-    var n1 = bitcast<f32>(params.inf_bits);
+    // sm_clear set both layers to +inf before the first chunk.
+    var n1 = near[o];
     var n2 = bitcast<f32>(params.inf_bits);
-    if params.first_chunk == 0u {
-        n1 = near[o];
-        if params.two_layers != 0u {
-            n2 = second[o];
-        }
+    if params.two_layers != 0u {
+        n2 = second[o];
     }
     let start = bin_start[tile] + params.chunk_start;
     let end = min(bin_start[tile + 1u], start + params.chunk_len);

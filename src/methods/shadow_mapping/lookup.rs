@@ -61,7 +61,8 @@ impl<'a> Lookup<'a> {
 
     /// The visibility of world point `p`.
     pub fn visibility(&self, p: DVec3) -> f32 {
-        let Query::At { x, y, depth: d } = query(self.proj, self.bias, self.map.width, self.map.height, p)
+        let Query::At { x, y, depth: d } =
+            query(self.proj, self.bias, self.map.width, self.map.height, p)
         else {
             return 1.0;
         };
@@ -91,7 +92,13 @@ pub enum Query {
 
 /// The projection of world point `p` into a (width, height) map of `proj`
 /// (in f64, shared by both backends' lookups).
-pub fn query(proj: &ShadowProjection, bias: DepthBias, width: usize, height: usize, p: DVec3) -> Query {
+pub fn query(
+    proj: &ShadowProjection,
+    bias: DepthBias,
+    width: usize,
+    height: usize,
+    p: DVec3,
+) -> Query {
     let q = proj.project(p);
     if !(q.w > 0.0) || !q.u.is_finite() || !q.v.is_finite() {
         return Query::Lit;

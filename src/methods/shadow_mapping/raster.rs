@@ -163,12 +163,8 @@ impl Plane3 {
     }
     /// The f32 form of `raster/depth_plane.rs` from the centre of texel
     /// (i0, j0) on.
-    fn from_texel(&self, i0: u32, j0: u32) -> DepthPlane {
-        DepthPlane::new(
-            self.at(i0 as f64 + 0.5, j0 as f64 + 0.5),
-            self.a,
-            self.b,
-        )
+    fn at_texel(&self, i0: u32, j0: u32) -> DepthPlane {
+        DepthPlane::new(self.at(i0 as f64 + 0.5, j0 as f64 + 0.5), self.a, self.b)
     }
 }
 
@@ -312,7 +308,9 @@ fn setup(
     // little beyond by rounding; snapped they stay far inside i32.
     let lim = (MAX_SIDE as i64 + 2) * SUBPIXEL;
     let snap = |v: f64| ((v * SUBPIXEL as f64).round() as i64).clamp(-lim, lim);
-    let map: Vec<((f64, f64), (i64, i64), [f64; 3])> = poly
+    // Per vertex: map position, snapped position, (z/w, 1/w, ℓ/w).
+    type MapVertex = ((f64, f64), (i64, i64), [f64; 3]);
+    let map: Vec<MapVertex> = poly
         .iter()
         .map(|v| {
             let iw = 1.0 / v.c.w;
@@ -335,10 +333,20 @@ fn setup(
         let xs = t.map(|v| v.1 .0);
         let ys = t.map(|v| v.1 .1);
         // Texel centres i·S + S/2 inside [lo, hi].
-        let first = |lo: i64| (lo - SUBPIXEL / 2 + SUBPIXEL - 1).div_euclid(SUBPIXEL).max(0);
+        let first = |lo: i64| {
+            (lo - SUBPIXEL / 2 + SUBPIXEL - 1)
+                .div_euclid(SUBPIXEL)
+                .max(0)
+        };
         let last = |hi: i64, n: usize| (hi - SUBPIXEL / 2).div_euclid(SUBPIXEL).min(n as i64 - 1);
-        let (i0, i1) = (first(*xs.iter().min().unwrap()), last(*xs.iter().max().unwrap(), width));
-        let (j0, j1) = (first(*ys.iter().min().unwrap()), last(*ys.iter().max().unwrap(), height));
+        let (i0, i1) = (
+            first(*xs.iter().min().unwrap()),
+            last(*xs.iter().max().unwrap(), width),
+        );
+        let (j0, j1) = (
+            first(*ys.iter().min().unwrap()),
+            last(*ys.iter().max().unwrap(), height),
+        );
         if i1 < 0 || j1 < 0 {
             continue;
         }
@@ -356,9 +364,9 @@ fn setup(
             i1: i1 as u32,
             j0,
             j1: j1 as u32,
-            zh: zh.from_texel(i0, j0),
-            iw: iw.from_texel(i0, j0),
-            lw: lw.from_texel(i0, j0),
+            zh: zh.at_texel(i0, j0),
+            iw: iw.at_texel(i0, j0),
+            lw: lw.at_texel(i0, j0),
             zh_offset: (offset.slope * zh.a.abs().max(zh.b.abs()) + constant) as f32,
             slope: offset.slope as f32,
             constant: constant as f32,
