@@ -143,3 +143,49 @@ def test_gpu_refuses_what_it_cannot_run(gpu, scene, camera):
         ss.render(scene, light, camera, method="ssm", hierarchy=True, backend="gpu")
     with pytest.raises(ValueError, match="precision"):
         ss.render(scene, light, camera, method="ssm", precision="f64", backend="gpu")
+
+
+#: ShadowMapping's parts, each on the GPU against the CPU (512² maps:
+#: lavapipe rasterizes on the CPU).
+SHADOW_MAPPING = {
+    "uniform": dict(focus=False),
+    "focused": dict(),
+    "lispsm": dict(warp=ss.LiSPSM()),
+    "pcf": dict(filter=ss.PCF(size=3)),
+    "blur": dict(blur=ss.EyeSpaceBlur(iterations=3)),
+    "midpoint": dict(bias=ss.MidpointBias(), filter=ss.PCF(size=1)),
+    "linear_lispsm": dict(bias=ss.LinearDepthBias(), warp=ss.LiSPSM(vector="camera")),
+}
+
+
+@pytest.mark.parametrize("light_name", sorted(LIGHTS))
+@pytest.mark.parametrize("part", sorted(SHADOW_MAPPING))
+def test_gpu_shadow_mapping_is_the_cpu_shadow_mapping(gpu, scene, camera, light_name, part):
+    light, kw = LIGHTS[light_name], SHADOW_MAPPING[part]
+    method = ss.ShadowMapping(resolution=512, **kw)
+    if "warp" in kw and light_name == "rect":
+        # LiSPSM warps directional lights only, on every backend.
+        with pytest.raises(ValueError, match="^warp: "):
+            ss.render(scene, light, camera, method=method, backend="gpu")
+        return
+    cpu = ss.render(scene, light, camera, method=method, backend="cpu")
+    img = ss.render(scene, light, camera, method=method, backend="gpu")
+    assert img.backend == "gpu" and cpu.backend == "cpu"
+    assert img.visibility.dtype == np.float32 and np.isfinite(img.visibility).all()
+    assert img.visibility.min() >= 0 and img.visibility.max() <= 1
+    same = img.mesh_id == cpu.mesh_id
+    assert same.mean() >= 0.995
+    hit = same & cpu.mask & (img.position == cpu.position).all(axis=-1)
+    assert hit.sum() > 0.5 * hit.size
+    v = cpu.visibility[hit]
+    assert (v < 0.5).sum() > 50
+    dv = np.abs(img.visibility[hit].astype(np.float64) - cpu.visibility[hit])
+    # The same map, lookups and blur (src/gpu/shadow_mapping.rs); the
+    # G-buffers differ where a pixel centre grazes an edge, which the blur
+    # spreads a few pixels and which may move LiSPSM's depth range.
+    assert dv.mean() <= 1e-3, f"mean |dV| {dv.mean():.2e}, max {dv.max():.2e}"
+    if "blur" not in kw and "warp" not in kw:
+        assert (dv > 1e-5).mean() <= 0.005
+    assert (img.visibility[~img.mask] == 1.0).all()
+    assert repr(img.method) == repr(cpu.method)
+    assert any(k.startswith("gpu") for k in img.timings)

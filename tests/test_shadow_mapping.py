@@ -9,6 +9,7 @@ the fraction shadowed there but lit by the map.
 
 from __future__ import annotations
 
+import os
 import pickle
 
 import numpy as np
@@ -19,6 +20,12 @@ from softshadow.eye_scenes import EYE_SCENES, large_city
 from softshadow.scenes import quad, sphere
 
 RES = (160, 120)
+
+
+def _backends():
+    """The CPU, and the GPU where an adapter opens (lavapipe in CI)."""
+    gpu = ss.gpu_available() or os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1"
+    return ["cpu"] + (["gpu"] if gpu else [])
 
 
 def _hard(light):
@@ -42,20 +49,23 @@ def hard_refs():
     return out
 
 
+@pytest.mark.parametrize("backend", _backends())
 @pytest.mark.parametrize("name", list(EYE_SCENES))
-def test_every_bias_method_removes_acne_that_no_bias_leaves(hard_refs, name):
+def test_every_bias_method_removes_acne_that_no_bias_leaves(hard_refs, name, backend):
     scene, hard, cam, ref = hard_refs[name]
-    none, _ = _errors(ss.render(scene, hard, cam, method=ss.ShadowMapping(bias=ss.ConstantBias(constant=0))), ref)
+    sm = ss.ShadowMapping(bias=ss.ConstantBias(constant=0))
+    none, _ = _errors(ss.render(scene, hard, cam, method=sm, backend=backend), ref)
     # Measured at 160x120, 2048² maps: 7-48% of the pixels shadow themselves
     # without a bias; every bias method leaves at most 0.8% (midpoint on the
     # boxes' edges), most under 0.2%.
     assert none > 0.05
     for bias in [ss.SlopeScaleBias(), ss.LinearDepthBias(), ss.BackFaces(), ss.MidpointBias()]:
-        acne, pp = _errors(ss.render(scene, hard, cam, method=ss.ShadowMapping(bias=bias)), ref)
+        acne, pp = _errors(ss.render(scene, hard, cam, method=ss.ShadowMapping(bias=bias), backend=backend), ref)
         assert acne < 0.012 and pp < 0.01, (bias, acne, pp)
 
 
-def test_bias_removes_acne_on_a_sphere_and_a_tilted_plane_facing_the_light():
+@pytest.mark.parametrize("backend", _backends())
+def test_bias_removes_acne_on_a_sphere_and_a_tilted_plane_facing_the_light(backend):
     v, f = sphere((0.0, 0.0, 0.0), 1.0)
     pv, pf = quad((0.0, 0.0, 0.0), 3.0)
     tilt = np.deg2rad(50)
@@ -68,19 +78,21 @@ def test_bias_removes_acne_on_a_sphere_and_a_tilted_plane_facing_the_light():
         ref = ss.render(scene, sun, cam, method="exact")
         lit = ref.mask & (ref.visibility > 0.5)
         assert lit.mean() > 0.01
-        none = ss.render(scene, sun, cam, method=ss.ShadowMapping(resolution=512, bias=ss.ConstantBias(constant=0)))
+        sm = ss.ShadowMapping(resolution=512, bias=ss.ConstantBias(constant=0))
+        none = ss.render(scene, sun, cam, method=sm, backend=backend)
         # Measured 2-20% of the lit pixels without a bias.
         acne_none = (none.visibility[lit] < 0.5).mean()
         assert acne_none > 0.01
         for bias in [ss.SlopeScaleBias(), ss.LinearDepthBias(), ss.MidpointBias(), ss.BackFaces()]:
-            img = ss.render(scene, sun, cam, method=ss.ShadowMapping(resolution=512, bias=bias))
+            img = ss.render(scene, sun, cam, method=ss.ShadowMapping(resolution=512, bias=bias), backend=backend)
             # Measured at most 1.2% (midpoint), at the sphere's terminator
             # where the light grazes it and its two layers meet.
             acne = (img.visibility[lit] < 0.5).mean()
             assert acne < 0.016 and acne < acne_none / 3, (bias, acne, acne_none)
 
 
-def test_focus_and_lispsm_reduce_aliasing_in_a_large_city():
+@pytest.mark.parametrize("backend", _backends())
+def test_focus_and_lispsm_reduce_aliasing_in_a_large_city(backend):
     """The bar at Scherzer's resolution (2048²): focused LiSPSM misclassifies
     at most 0.7x the pixels of the focused uniform map, which misclassifies
     at most half of the unfocused one (measured 0.0050, 0.0096, 0.0195 at
@@ -90,7 +102,7 @@ def test_focus_and_lispsm_reduce_aliasing_in_a_large_city():
     ref = ss.render(scene, hard, cam, method="exact")
 
     def wrong(**kw):
-        img = ss.render(scene, hard, cam, method=ss.ShadowMapping(resolution=2048, **kw))
+        img = ss.render(scene, hard, cam, method=ss.ShadowMapping(resolution=2048, **kw), backend=backend)
         return float(np.mean(((img.visibility > 0.5) != (ref.visibility > 0.5))[ref.mask]))
 
     unfocused, focused, lispsm = wrong(focus=False), wrong(), wrong(warp=ss.LiSPSM())
@@ -98,25 +110,29 @@ def test_focus_and_lispsm_reduce_aliasing_in_a_large_city():
     assert focused <= 0.6 * unfocused, (focused, unfocused)
 
 
-def test_lispsm_with_a_huge_n_is_the_uniform_map():
+@pytest.mark.parametrize("backend", _backends())
+def test_lispsm_with_a_huge_n_is_the_uniform_map(backend):
     scene, sun, cam = large_city((160, 120))
     hard = _hard(sun)
-    a = ss.render(scene, hard, cam, method=ss.ShadowMapping(resolution=1024))
-    b = ss.render(scene, hard, cam, method=ss.ShadowMapping(resolution=1024, warp=ss.LiSPSM(n=1e9, vector="camera")))
+    a = ss.render(scene, hard, cam, method=ss.ShadowMapping(resolution=1024), backend=backend)
+    huge = ss.ShadowMapping(resolution=1024, warp=ss.LiSPSM(n=1e9, vector="camera"))
+    b = ss.render(scene, hard, cam, method=huge, backend=backend)
     np.testing.assert_array_equal(a.visibility, b.visibility)
     # A finite n changes the map, and a wrong-signed warp (n < 0) is refused.
-    c = ss.render(scene, hard, cam, method=ss.ShadowMapping(resolution=1024, warp=ss.LiSPSM(n=5.0, vector="camera")))
+    five = ss.ShadowMapping(resolution=1024, warp=ss.LiSPSM(n=5.0, vector="camera"))
+    c = ss.render(scene, hard, cam, method=five, backend=backend)
     assert not np.array_equal(a.visibility, c.visibility)
     with pytest.raises(ValueError, match="^n: "):
         ss.LiSPSM(n=-1.0)
 
 
-def test_the_eye_space_blur_softens_and_pcf_filters(hard_refs):
+@pytest.mark.parametrize("backend", _backends())
+def test_the_eye_space_blur_softens_and_pcf_filters(hard_refs, backend):
     scene, hard, cam, ref = hard_refs["bunny_on_floor"]
-    plain = ss.render(scene, hard, cam, method=ss.ShadowMapping())
+    plain = ss.render(scene, hard, cam, method=ss.ShadowMapping(), backend=backend)
     assert set(np.unique(plain.visibility[ref.mask])) <= {0.0, 1.0}
     for m in [ss.ShadowMapping(filter=ss.PCF(size=3)), ss.ShadowMapping(blur=ss.EyeSpaceBlur(iterations=4))]:
-        img = ss.render(scene, hard, cam, method=m)
+        img = ss.render(scene, hard, cam, method=m, backend=backend)
         partial = (img.visibility > 0.02) & (img.visibility < 0.98)
         assert partial[ref.mask].mean() > 0.002, m
         assert np.isfinite(img.visibility).all() and img.visibility.min() >= 0 and img.visibility.max() <= 1
@@ -209,17 +225,19 @@ def test_wrong_part_types_are_refused_by_name():
 
 def test_what_a_method_cannot_do_is_refused():
     scene, light, cam = EYE_SCENES["bunny_on_floor"](RES)
-    with pytest.raises(ValueError, match="^warp: LiSPSM warps directional lights"):
-        ss.render(scene, light, cam, method=ss.ShadowMapping(warp=ss.LiSPSM()))
+    for backend in _backends():
+        with pytest.raises(ValueError, match="^warp: LiSPSM warps directional lights"):
+            ss.render(scene, light, cam, method=ss.ShadowMapping(warp=ss.LiSPSM()), backend=backend)
     with pytest.raises(ValueError, match="^method: ShadowMapping renders the eye view"):
         ss.soft_shadow_map(scene, light, resolution=32, method=ss.ShadowMapping())
 
 
+@pytest.mark.parametrize("backend", _backends())
 @pytest.mark.parametrize(
     "case",
     ["single_triangle", "light_behind_camera", "camera_into_light", "grazing"],
 )
-def test_hard_cases_stay_finite_and_in_range(case):
+def test_hard_cases_stay_finite_and_in_range(case, backend):
     tri = (np.array([[-1.0, 0.5, -1.0], [1.0, 0.5, -1.0], [0.0, 0.5, 1.0]]), np.array([[0, 1, 2]], dtype=np.uint32))
     floor = quad((0.0, 0.0, 0.0), 3.0)
     cam = ss.Camera.look_at(eye=(0, 2, 4), target=(0, 0, 0), up=(0, 1, 0), fov_y=50, resolution=(64, 48))
@@ -240,9 +258,16 @@ def test_hard_cases_stay_finite_and_in_range(case):
         ss.ShadowMapping(resolution=256, focus=False, blur=ss.EyeSpaceBlur()),
         ss.Smoothies(),
     ]:
-        img = ss.render(scene, sun, cam, method=m)
+        if backend not in ss.capabilities()[m.name].backends:
+            continue
+        img = ss.render(scene, sun, cam, method=m, backend=backend)
         v = img.visibility
         assert np.isfinite(v).all() and v.min() >= 0 and v.max() <= 1, (case, m)
+        if backend == "gpu" and m.name == "shadow_mapping":
+            # The GPU twin: the CPU's image but where the first hits differ.
+            cpu = ss.render(scene, sun, cam, method=m, backend="cpu")
+            hit = (img.mesh_id == cpu.mesh_id) & cpu.mask & (img.position == cpu.position).all(axis=-1)
+            assert np.abs(img.visibility[hit] - cpu.visibility[hit]).mean() <= 1e-3, (case, m)
 
 
 @pytest.mark.parametrize("name", list(EYE_SCENES))

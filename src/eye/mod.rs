@@ -104,7 +104,8 @@ pub struct EyeImage {
 /// Renders the visibility image of `call` on the backend it asks for:
 /// "auto" takes the GPU where `crate::backend` would (a real, non-software
 /// adapter, a config that resolves there) and the light is not hard (the
-/// GPU has no hard shadow map kernel).
+/// GPU has no hard shadow map kernel for the map methods; ShadowMapping
+/// takes any light).
 pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
     let cap = threads::resolve(call.threads)?;
     if let Some(r) = call.map_resolution {
@@ -120,8 +121,10 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
                 depth_layers: None,
                 eye: true,
             };
+            // ShadowMapping is a hard shadow: it takes hard lights on the GPU.
+            let hard_ok = matches!(call.method, MethodConfig::ShadowMapping(_));
             if crate::backend::real_gpu()
-                && !call.light.is_hard()
+                && (hard_ok || !call.light.is_hard())
                 && call.method.resolve(&gpu).is_ok()
             {
                 Backend::Gpu
@@ -318,20 +321,8 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
     if let MethodConfig::ShadowMapping(cfg) = call.method {
         let method = resolve_at_camera(call, Backend::Cpu)?;
         let (visibility, _map) = shadow_mapping::render(call, &cfg, &scene, &g, &mut sw)?;
-        let light_space = match call.light {
-            Light::Rect(l) => LightSpace::Rect(*l),
-            Light::Sun(s) => LightSpace::Sun(SunSpace::fit(*s, scene.points())?),
-        };
-        return Ok((
-            EyeImage {
-                gbuffer: g,
-                visibility,
-                maps: None,
-                light_space,
-                timings: sw.timings,
-            },
-            method,
-        ));
+        let image = shadow_mapping::image(call, &scene, g, visibility, sw.timings)?;
+        return Ok((image, method));
     }
     let mut f = frame(call, &scene, &g)?;
     sw.lap("transform");

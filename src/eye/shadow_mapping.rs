@@ -13,16 +13,20 @@
 //! plane) gets 0: a renderer's N·L does that before any depth test.
 
 use super::gbuffer::{GBuffer, SceneTriangles};
-use super::EyeCall;
+use super::{EyeCall, EyeImage};
 use crate::error::{Error, Result};
 use crate::geom::body::{extend_toward_light, view_body, Aabb};
 use crate::geom::light_space::Light;
+use crate::geom::light_space::LightSpace;
 use crate::geom::shadow_projection::{ShadowProjection, ViewVector, MIN_SIN_GAMMA};
+use crate::geom::sun::SunSpace;
 use crate::methods::shadow_mapping::blur::blur;
 use crate::methods::shadow_mapping::config::{DepthBias, ShadowMappingConfig};
 use crate::methods::shadow_mapping::lookup::Lookup;
-use crate::methods::shadow_mapping::raster::{rasterize, DepthMap, Faces, Toward};
-use crate::pipeline::Stopwatch;
+use crate::methods::shadow_mapping::raster::{
+    scan, setup_triangles, DepthMap, Faces, SetupTri, Toward,
+};
+use crate::pipeline::{Stopwatch, Timings};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -120,14 +124,31 @@ fn projection(
     }
 }
 
-/// The visibility of every pixel of `g` (1 where no surface) and the map.
-pub(crate) fn render(
+/// What both backends share once the G-buffer is known: the per-call
+/// geometry (the projection, the clipped and set-up triangles), the image
+/// with every pixel that needs no lookup already decided, and the points to
+/// look up.
+pub(crate) struct Prepared {
+    pub projection: ShadowProjection,
+    pub triangles: Vec<SetupTri>,
+    /// 1 where no surface, 0 where the surface turns away from the light
+    /// (or lies behind a rectangle's plane); the looked-up pixels' values
+    /// are written over it.
+    pub visibility: Vec<f32>,
+    /// The pixels to look up and their world points.
+    pub lookups: Vec<(usize, DVec3)>,
+}
+
+/// The stages before the map, on the CPU for both backends: `Err(v)` when
+/// there is no map to draw (nothing in front of the rectangle), `v` the
+/// image.
+pub(crate) fn prepare(
     call: &EyeCall,
     cfg: &ShadowMappingConfig,
     scene: &SceneTriangles,
     g: &GBuffer,
     sw: &mut Stopwatch,
-) -> Result<(Vec<f32>, Option<ShadowMapInfo>)> {
+) -> Result<std::result::Result<Prepared, Vec<f32>>> {
     if let (Some(_), Light::Rect(_)) = (cfg.warp, call.light) {
         return Err(Error::invalid(
             "warp",
@@ -145,7 +166,7 @@ pub(crate) fn render(
         for &k in &hits {
             visibility[k] = 0.0;
         }
-        return Ok((visibility, None));
+        return Ok(Err(visibility));
     };
     sw.lap("focus");
     let tw = toward(call.light);
@@ -153,36 +174,66 @@ pub(crate) fn render(
         DepthBias::BackFaces => Faces::BackOnly(tw),
         _ => Faces::All,
     };
-    let map = rasterize(
+    let triangles = setup_triangles(
         &proj,
         &scene.vertices,
         &scene.faces,
         cfg.resolution,
-        cfg.bias.distribution(),
         cfg.bias.offset(),
         faces,
-        cfg.bias == DepthBias::Midpoint,
     );
-    sw.lap("raster");
-    let lookup = Lookup::new(&map, &proj, cfg.bias, cfg.filter);
+    sw.lap("setup");
     let in_front = |p: DVec3| match call.light {
         Light::Rect(l) => (p - l.center).dot(l.n) > 0.0,
         Light::Sun(_) => true,
     };
-    let v: Vec<f32> = hits
+    let mut lookups = Vec::with_capacity(hits.len());
+    for &k in &hits {
+        let p = DVec3::from_array(g.position[k]);
+        let n = glam::Vec3::from_array(g.normal[k]).as_dvec3();
+        if !in_front(p) || n.dot(tw.at(p)) <= 0.0 {
+            visibility[k] = 0.0;
+        } else {
+            lookups.push((k, p));
+        }
+    }
+    Ok(Ok(Prepared {
+        projection: proj,
+        triangles,
+        visibility,
+        lookups,
+    }))
+}
+
+/// The visibility of every pixel of `g` (1 where no surface) and the map,
+/// on the CPU.
+pub(crate) fn render(
+    call: &EyeCall,
+    cfg: &ShadowMappingConfig,
+    scene: &SceneTriangles,
+    g: &GBuffer,
+    sw: &mut Stopwatch,
+) -> Result<(Vec<f32>, Option<ShadowMapInfo>)> {
+    let p = match prepare(call, cfg, scene, g, sw)? {
+        Ok(p) => p,
+        Err(v) => return Ok((v, None)),
+    };
+    let map = scan(
+        &p.triangles,
+        cfg.resolution,
+        cfg.bias.distribution(),
+        cfg.bias == DepthBias::Midpoint,
+    );
+    sw.lap("raster");
+    let lookup = Lookup::new(&map, &p.projection, cfg.bias, cfg.filter);
+    let v: Vec<f32> = p
+        .lookups
         .par_iter()
         .with_min_len(256)
-        .map(|&k| {
-            let p = DVec3::from_array(g.position[k]);
-            let n = glam::Vec3::from_array(g.normal[k]).as_dvec3();
-            if !in_front(p) || n.dot(tw.at(p)) <= 0.0 {
-                0.0
-            } else {
-                lookup.visibility(p)
-            }
-        })
+        .map(|&(_, q)| lookup.visibility(q))
         .collect();
-    for (&k, v) in hits.iter().zip(v) {
+    let mut visibility = p.visibility;
+    for (&(k, _), v) in p.lookups.iter().zip(v) {
         visibility[k] = v;
     }
     sw.lap("shadow");
@@ -194,7 +245,29 @@ pub(crate) fn render(
         visibility,
         Some(ShadowMapInfo {
             map,
-            projection: proj,
+            projection: p.projection,
         }),
     ))
+}
+
+/// The image of a ShadowMapping call whose visibility is `visibility`
+/// (either backend): its light space is the one fitted to the whole scene.
+pub(crate) fn image(
+    call: &EyeCall,
+    scene: &SceneTriangles,
+    gbuffer: GBuffer,
+    visibility: Vec<f32>,
+    timings: Timings,
+) -> Result<EyeImage> {
+    let light_space = match call.light {
+        Light::Rect(l) => LightSpace::Rect(*l),
+        Light::Sun(s) => LightSpace::Sun(SunSpace::fit(*s, scene.points())?),
+    };
+    Ok(EyeImage {
+        gbuffer,
+        visibility,
+        maps: None,
+        light_space,
+        timings,
+    })
 }

@@ -636,6 +636,313 @@ mod eye {
             }
         }
     }
+
+    // -----------------------------------------------------------------------
+    // ShadowMapping: the device's map, lookups and blur against the CPU's on
+    // the same G-buffer, then whole renders.
+
+    mod shadow_mapping {
+        use super::*;
+        use crate::eye::shadow_mapping as sm;
+        use crate::methods::shadow_mapping::config::{
+            DepthBias, EyeSpaceBlur, LiSPSM, Pcf, Real, ShadowMappingConfig,
+        };
+        use crate::pipeline::Stopwatch;
+
+        fn configs() -> Vec<(&'static str, ShadowMappingConfig)> {
+            let base = ShadowMappingConfig {
+                resolution: (512, 384),
+                ..Default::default()
+            };
+            vec![
+                ("slope_scale", base),
+                (
+                    "unfocused",
+                    ShadowMappingConfig {
+                        focus: false,
+                        ..base
+                    },
+                ),
+                (
+                    "linear",
+                    ShadowMappingConfig {
+                        bias: DepthBias::LinearDepth {
+                            constant: Real(4.0),
+                            slope: Real(2.0),
+                        },
+                        ..base
+                    },
+                ),
+                (
+                    "constant_pcf",
+                    ShadowMappingConfig {
+                        bias: DepthBias::Constant {
+                            constant: Real(64.0),
+                        },
+                        filter: Some(Pcf { size: 3 }),
+                        ..base
+                    },
+                ),
+                (
+                    "midpoint",
+                    ShadowMappingConfig {
+                        bias: DepthBias::Midpoint,
+                        ..base
+                    },
+                ),
+                (
+                    "back_faces_pcf1",
+                    ShadowMappingConfig {
+                        bias: DepthBias::BackFaces,
+                        filter: Some(Pcf { size: 1 }),
+                        ..base
+                    },
+                ),
+                (
+                    "lispsm",
+                    ShadowMappingConfig {
+                        warp: Some(LiSPSM::new(None, None).unwrap()),
+                        ..base
+                    },
+                ),
+                (
+                    "lispsm_linear_blur",
+                    ShadowMappingConfig {
+                        warp: Some(LiSPSM::new(None, Some("camera")).unwrap()),
+                        bias: DepthBias::LinearDepth {
+                            constant: Real(4.0),
+                            slope: Real(2.0),
+                        },
+                        blur: Some(EyeSpaceBlur::new(Some(3), Some(2.0)).unwrap()),
+                        ..base
+                    },
+                ),
+            ]
+        }
+
+        /// Texels whose bits differ, and the largest difference there.
+        fn map_diff(a: &[f32], b: &[f32]) -> (usize, f64) {
+            a.iter()
+                .zip(b)
+                .filter(|(x, y)| x.to_bits() != y.to_bits())
+                .fold((0, 0f64), |(n, m), (x, y)| {
+                    (n + 1, m.max((*x as f64 - *y as f64).abs()))
+                })
+        }
+
+        #[test]
+        fn gpu_depth_maps_and_visibility_are_the_cpus() {
+            if !device_or_skip() {
+                return;
+            }
+            let g = super::super::super::context::gpu().unwrap();
+            let meshes = scene();
+            let refs: Vec<MeshRef> = meshes
+                .iter()
+                .map(|(v, f)| MeshRef {
+                    vertices: v,
+                    faces: f,
+                })
+                .collect();
+            let scene = SceneTriangles::new(&refs).unwrap();
+            let cam = camera((96, 72));
+            let gb = gbuffer::first_hits(&cam, &scene);
+            for (lname, light) in lights() {
+                for (cname, cfg) in configs() {
+                    if lname == "rect" && cfg.warp.is_some() {
+                        continue;
+                    }
+                    let call = EyeCall {
+                        meshes: &refs,
+                        light: &light,
+                        camera: &cam,
+                        method: MethodConfig::ShadowMapping(cfg),
+                        map_resolution: None,
+                        bias: DEFAULT_BIAS,
+                        backend: BackendChoice::Gpu,
+                        threads: None,
+                    };
+                    let mut sw = Stopwatch::new();
+                    let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
+                    let cmap = info.unwrap().map;
+                    let mut t = vec![];
+                    let (gv, gmap) = super::super::super::shadow_mapping::render_prepared(
+                        g, &call, &cfg, &scene, &gb, true, &mut sw, &mut t,
+                    )
+                    .unwrap();
+                    let gmap = gmap.unwrap();
+                    let written = cmap.nearest.iter().filter(|z| z.is_finite()).count();
+                    let (n, dz) = map_diff(&cmap.nearest, &gmap.nearest);
+                    let (n2, dz2) = match (&cmap.second, &gmap.second) {
+                        (Some(a), Some(b)) => map_diff(a, b),
+                        (None, None) => (0, 0.0),
+                        _ => panic!("{lname} {cname}: layers differ in presence"),
+                    };
+                    let dv: Vec<f64> = cv
+                        .iter()
+                        .zip(&gv)
+                        .map(|(a, b)| (*a as f64 - *b as f64).abs())
+                        .collect();
+                    let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+                    let mean = dv.iter().sum::<f64>() / dv.len() as f64;
+                    let shadowed = cv.iter().filter(|&&v| v < 0.5).count();
+                    eprintln!(
+                        "{lname} {cname}: {written} texels written, {n} nearest differ \
+                         (max {dz:.1e}), {n2} second differ (max {dz2:.1e}); |dV| mean \
+                         {mean:.1e} max {max:.1e}, {} pixels differ, {shadowed} shadowed",
+                        dv.iter().filter(|&&x| x > 0.0).count()
+                    );
+                    assert!(written > 1000 && shadowed > 50, "{lname} {cname}");
+                    // Bit for bit but where the linear depth's slope term
+                    // may be fused into an fma: then an ulp or two of the
+                    // depth, on at most 1% of the texels.
+                    assert!(n * 100 <= written && n2 * 100 <= written, "{lname} {cname}");
+                    assert!(dz <= 1e-6 && dz2 <= 1e-6, "{lname} {cname}");
+                    // The lookups: identical without a filter (and with the
+                    // same map), PCF's weights summed in f32 (the CPU: f64).
+                    if n == 0 && n2 == 0 && cfg.filter.is_none() && cfg.blur.is_none() {
+                        assert_eq!(max, 0.0, "{lname} {cname}");
+                    }
+                    assert!(mean <= 1e-4 && max <= 1e-3 || n > 0, "{lname} {cname}");
+                    assert!(mean <= 1e-3, "{lname} {cname}");
+                }
+            }
+        }
+
+        #[test]
+        fn gpu_shadow_mapping_renders_are_the_cpu_renders() {
+            if !device_or_skip() {
+                return;
+            }
+            let meshes = scene();
+            let cam = camera((96, 72));
+            for (lname, light) in lights() {
+                for (cname, cfg) in configs() {
+                    if lname == "rect" && cfg.warp.is_some() {
+                        let e = render(
+                            &meshes,
+                            &light,
+                            &cam,
+                            MethodConfig::ShadowMapping(cfg),
+                            BackendChoice::Gpu,
+                        )
+                        .unwrap_err()
+                        .to_string();
+                        assert!(e.starts_with("warp:"), "{e}");
+                        continue;
+                    }
+                    let m = MethodConfig::ShadowMapping(cfg);
+                    let c = render(&meshes, &light, &cam, m, BackendChoice::Cpu).unwrap();
+                    let g = render(&meshes, &light, &cam, m, BackendChoice::Gpu).unwrap();
+                    assert_eq!((c.backend, g.backend), (Backend::Cpu, Backend::Gpu));
+                    assert_eq!(c.method, g.method);
+                    let same = same_surface(&c.output, &g.output);
+                    let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+                    let idx: Vec<usize> = (0..cv.len()).filter(|&k| same[k]).collect();
+                    assert!(idx.len() * 2 > cv.len());
+                    let differ = idx.iter().filter(|&&k| cv[k] != gv[k]).count();
+                    let mean = idx
+                        .iter()
+                        .map(|&k| (cv[k] as f64 - gv[k] as f64).abs())
+                        .sum::<f64>()
+                        / idx.len() as f64;
+                    eprintln!("render {lname} {cname}: mean |dV| {mean:.1e}, {differ} differ");
+                    // The G-buffers differ where a pixel centre grazes an
+                    // edge, which may move LiSPSM's depth range a little.
+                    assert!(mean <= 1e-3, "{lname} {cname}: {mean}");
+                    assert!(g.output.timings.iter().any(|(k, _)| k.starts_with("gpu")));
+                }
+            }
+        }
+
+        #[test]
+        fn tiles_with_more_triangles_than_a_chunk_take_several_dispatches() {
+            // 20000 stacked quads over a 16x16 map: one tile whose bin
+            // holds 40000 triangles, scanned in three chunks (lavapipe's
+            // loop cap), both layers as the CPU's.
+            if !device_or_skip() {
+                return;
+            }
+            let g = super::super::super::context::gpu().unwrap();
+            let layers = 20_000;
+            let mut v = vec![];
+            let mut f = vec![];
+            for k in 0..layers {
+                let y = 0.5 + k as f64 * 1e-4;
+                let b = v.len() as u32;
+                v.extend([
+                    [-1.0, y, -1.0],
+                    [1.0, y, -1.0],
+                    [1.0, y, 1.0],
+                    [-1.0, y, 1.0],
+                ]);
+                f.extend([[b, b + 2, b + 1], [b, b + 3, b + 2]]);
+            }
+            let meshes = [(v, f), floor()];
+            let refs: Vec<MeshRef> = meshes
+                .iter()
+                .map(|(v, f)| MeshRef {
+                    vertices: v,
+                    faces: f,
+                })
+                .collect();
+            let scene = SceneTriangles::new(&refs).unwrap();
+            let cam = camera((32, 24));
+            let gb = gbuffer::first_hits(&cam, &scene);
+            let light = lights()[1].1;
+            let cfg = ShadowMappingConfig {
+                resolution: (16, 16),
+                bias: DepthBias::Midpoint,
+                focus: false,
+                ..Default::default()
+            };
+            let call = EyeCall {
+                meshes: &refs,
+                light: &light,
+                camera: &cam,
+                method: MethodConfig::ShadowMapping(cfg),
+                map_resolution: None,
+                bias: DEFAULT_BIAS,
+                backend: BackendChoice::Gpu,
+                threads: None,
+            };
+            let mut sw = Stopwatch::new();
+            let p = match sm::prepare(&call, &cfg, &scene, &gb, &mut sw).unwrap() {
+                Ok(p) => p,
+                Err(_) => panic!("no map"),
+            };
+            let b =
+                super::super::super::shadow_mapping::bins(&p.triangles, cfg.resolution).unwrap();
+            assert!(b.chunks.len() >= 4, "{} chunks", b.chunks.len() - 1);
+            let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
+            let cmap = info.unwrap().map;
+            let mut t = vec![];
+            let (gv, gmap) = super::super::super::shadow_mapping::render_prepared(
+                g, &call, &cfg, &scene, &gb, true, &mut sw, &mut t,
+            )
+            .unwrap();
+            let gmap = gmap.unwrap();
+            let written = cmap.nearest.iter().filter(|z| z.is_finite()).count();
+            let two = cmap
+                .second
+                .as_ref()
+                .unwrap()
+                .iter()
+                .filter(|z| z.is_finite())
+                .count();
+            eprintln!(
+                "{written} texels written, {two} with a second layer, {} chunks",
+                b.chunks.len() - 1
+            );
+            assert!(written > 0 && two > 0);
+            assert_eq!(map_diff(&cmap.nearest, &gmap.nearest).0, 0);
+            assert_eq!(
+                map_diff(cmap.second.as_ref().unwrap(), gmap.second.as_ref().unwrap()).0,
+                0
+            );
+            assert_eq!(cv, gv);
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------

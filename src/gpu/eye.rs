@@ -163,6 +163,10 @@ fn budget_error() -> Error {
 /// Renders `call` on the GPU: `eye::render_cpu`'s image and config, and its
 /// stage names plus the device's.
 pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
+    // ShadowMapping has its own stages (a hard shadow: any light).
+    if let MethodConfig::ShadowMapping(cfg) = call.method {
+        return super::shadow_mapping::render_eye(call, &cfg);
+    }
     // Refuse what the GPU cannot run before any GPU work: a config that does
     // not resolve there, a hard light for the map methods.
     eye::resolve_at_camera(call, Backend::Gpu)?;

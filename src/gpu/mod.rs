@@ -21,8 +21,11 @@
 //!   built on the CPU, binned to tiles, rasterized per texel with min
 //!   blending) and lookup, light and eye view; twins
 //!   `crate::methods::smoothies::{buffer, lookup}`.
-//! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl` and
-//!   `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
+//! * `shadow_mapping.wgsl` (`shadow_mapping.rs`): ShadowMapping's depth
+//!   map, lookups and eye-space blur; twin `methods::shadow_mapping`'s
+//!   `raster::scan`, `lookup::Lookup` and `blur::blur`.
+//! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl`,
+//!   `shadow_mapping.wgsl` and `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
 //! Entry points: `from_meshes` (the whole mesh pipeline), `from_depth`
 //! (the user's depth maps, shaded) and `render_gpu` (the eye view). Device, queue and pipelines are made once
@@ -42,6 +45,7 @@ mod readback;
 #[cfg(test)]
 mod shader_tests;
 mod shading;
+mod shadow_mapping;
 mod smoothies;
 mod timing;
 

@@ -9,6 +9,7 @@ use super::gather::{
     BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
+use super::shadow_mapping::{GpuBlurPixel, GpuSmPoint, GpuSmTri, SmParams, SOURCE as SM_SOURCE};
 use super::smoothies::{
     GpuSmoothie, SmoothieChunk, SmoothieParams, TentAxis, TentPoint, SOURCE as SMOOTHIES_SOURCE,
 };
@@ -24,6 +25,7 @@ fn modules() -> Vec<(&'static str, String)> {
         ("exact.wgsl + eye_hits.wgsl", HITS_SOURCE.to_string()),
         ("exact.wgsl + eye_rays.wgsl", RAYS_SOURCE.to_string()),
         ("smoothies.wgsl", SMOOTHIES_SOURCE.to_string()),
+        ("shadow_mapping.wgsl", SM_SOURCE.to_string()),
     ]
 }
 
@@ -45,6 +47,7 @@ fn every_wgsl_file_is_used_by_a_module() {
         HITS_SOURCE,
         RAYS_SOURCE,
         SMOOTHIES_SOURCE,
+        SM_SOURCE,
     ];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -363,6 +366,70 @@ fn smoothie_structs_have_the_same_layout_in_rust_and_wgsl() {
             wy,
             z,
             live
+        }),
+    );
+}
+
+#[test]
+fn shadow_mapping_structs_have_the_same_layout_in_rust_and_wgsl() {
+    assert_same(
+        SM_SOURCE,
+        "SmParams",
+        rust_layout!(SmParams {
+            width,
+            height,
+            tiles_x,
+            linear,
+            two_layers,
+            _pad0,
+            chunk_start,
+            chunk_len,
+            work_offset,
+            work_count,
+            midpoint,
+            pcf,
+            n_points,
+            img_w,
+            img_h,
+            inf_bits
+        }),
+    );
+    assert_same(
+        SM_SOURCE,
+        "SmTri",
+        rust_layout!(GpuSmTri {
+            x,
+            y,
+            i0,
+            i1,
+            j0,
+            j1,
+            planes,
+            k
+        }),
+    );
+    assert_same(
+        SM_SOURCE,
+        "SmPoint",
+        rust_layout!(GpuSmPoint {
+            pixel,
+            i,
+            j,
+            fx,
+            fy,
+            depth,
+            _pad0,
+            _pad1
+        }),
+    );
+    assert_same(
+        SM_SOURCE,
+        "BlurPixel",
+        rust_layout!(GpuBlurPixel {
+            spacing,
+            z,
+            tol,
+            surface
         }),
     );
 }

@@ -102,6 +102,7 @@ fn gpu_stage_name(name: &'static str) -> &'static str {
         "row_stats" => "gpu_row_stats",
         "shadow" => "gpu_shadow",
         "smoothie_buffer" => "gpu_smoothie_buffer",
+        "blur" => "gpu_blur",
         _ => name,
     }
 }

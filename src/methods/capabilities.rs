@@ -299,7 +299,7 @@ pub fn methods() -> Vec<MethodInfo> {
     ]
 }
 
-/// ShadowMapping's row: the eye view, the CPU, its parts as config classes.
+/// ShadowMapping's row: the eye view, every backend, its parts as config classes.
 fn shadow_mapping_row() -> MethodInfo {
     use super::shadow_mapping::config::{DEFAULT_SM_RESOLUTION, MAX_SM_SIDE};
     let part = |name, classes: Vec<&'static str>, doc| OptionInfo {
@@ -318,7 +318,7 @@ fn shadow_mapping_row() -> MethodInfo {
                   intersection body, LiSPSM (directional lights), the eye-space blur; hard \
                   shadows, the eye view only",
         reads: vec![Input::SceneTriangles, Input::Camera],
-        backends: vec![Backend::Cpu],
+        backends: Backend::built().to_vec(),
         options: vec![
             OptionInfo {
                 name: "resolution",

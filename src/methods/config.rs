@@ -673,7 +673,6 @@ impl MethodConfig {
                 MethodConfig::Exact(c)
             }
             MethodConfig::ShadowMapping(c) => {
-                cpu_only(ctx, "shadow_mapping")?;
                 if !ctx.eye {
                     return Err(Error::invalid(
                         "method",

@@ -61,15 +61,11 @@ impl<'a> Lookup<'a> {
 
     /// The visibility of world point `p`.
     pub fn visibility(&self, p: DVec3) -> f32 {
-        let q = self.proj.project(p);
-        if !(q.w > 0.0) || !q.u.is_finite() || !q.v.is_finite() {
+        let Query::At { x, y, depth: d } =
+            query(self.proj, self.bias, self.map.width, self.map.height, p)
+        else {
             return 1.0;
-        }
-        let d = match self.bias.distribution() {
-            Distribution::Hyperbolic => q.hyperbolic,
-            Distribution::Linear => q.linear,
-        } as f32;
-        let (x, y) = self.map.texel_of(q.u, q.v);
+        };
         match (self.filter, &self.grid) {
             (Some(pcf), Some(grid)) => {
                 let w = self.map.width as i64;
@@ -80,6 +76,41 @@ impl<'a> Lookup<'a> {
             }
             _ => self.pass(x.round() as i64, y.round() as i64, d),
         }
+    }
+}
+
+/// Where a point looks its map up.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Query {
+    /// Behind a perspective map's centre (or projected to no finite
+    /// position): lit.
+    Lit,
+    /// Continuous texel coordinates (texel [j, i] centred at (i, j)) and the
+    /// depth tested, in the map's distribution.
+    At { x: f64, y: f64, depth: f32 },
+}
+
+/// The projection of world point `p` into a (width, height) map of `proj`
+/// (in f64, shared by both backends' lookups).
+pub fn query(
+    proj: &ShadowProjection,
+    bias: DepthBias,
+    width: usize,
+    height: usize,
+    p: DVec3,
+) -> Query {
+    let q = proj.project(p);
+    if !(q.w > 0.0) || !q.u.is_finite() || !q.v.is_finite() {
+        return Query::Lit;
+    }
+    let depth = match bias.distribution() {
+        Distribution::Hyperbolic => q.hyperbolic,
+        Distribution::Linear => q.linear,
+    } as f32;
+    Query::At {
+        x: (q.u + 1.0) * 0.5 * width as f64 - 0.5,
+        y: (1.0 - q.v) * 0.5 * height as f64 - 0.5,
+        depth,
     }
 }
 

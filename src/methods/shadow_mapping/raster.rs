@@ -3,14 +3,17 @@
 //! methods applied as the triangles are written (as glPolygonOffset does).
 //!
 //! Each triangle goes to clip space, is clipped against `w >= w_min` and
-//! `|x|, |y| <= w` (Sutherland-Hodgman in homogeneous coordinates), and is
-//! scanned at texel centres. Over a clipped triangle in map space the
+//! `|x|, |y| <= w` (Sutherland-Hodgman in homogeneous coordinates, in f64),
+//! and is scanned at texel centres. Over a clipped triangle in map space the
 //! hyperbolic depth z/w is affine, and so are 1/w and ℓ/w, whose ratio is
-//! the linear depth ℓ (perspective-correct). Edge functions are evaluated
-//! from each edge's lexicographically first end, so two triangles sharing
-//! an edge compute exactly opposite values and a texel centre on it goes
-//! to exactly one of them (a tie goes to the edge running up, or right
-//! when horizontal).
+//! the linear depth ℓ (perspective-correct). As a hardware rasterizer (and
+//! `crate::raster`) does, the map-space vertices are snapped to 1/256 texel
+//! and the edge functions evaluated exactly in integers, so two triangles
+//! sharing an edge compute exactly opposite values and a texel centre on it
+//! goes to exactly one of them (a tie goes to the edge running up, or right
+//! when horizontal). The depths are evaluated in f32 from planes split into
+//! short limbs (`raster/depth_plane.rs`), the form the GPU twin
+//! (`gpu/shadow_mapping.wgsl`) evaluates with the same bits.
 //!
 //! The offset written with a depth d is `slope · m + constant · 2⁻²⁴`,
 //! m = max(|∂d/∂x|, |∂d/∂y|) per texel (glPolygonOffset's factor and units
@@ -19,6 +22,7 @@
 //! midpoint).
 
 use crate::geom::shadow_projection::ShadowProjection;
+use crate::raster::depth_plane::DepthPlane;
 use glam::{DVec3, DVec4};
 use rayon::prelude::*;
 
@@ -157,45 +161,123 @@ impl Plane3 {
     fn at(&self, x: f64, y: f64) -> f64 {
         self.a * x + self.b * y + self.c
     }
-}
-
-/// A triangle in map space ready to scan.
-#[derive(Debug, Clone, Copy)]
-struct Tri {
-    p: [(f64, f64); 3],
-    /// z/w, 1/w and ℓ/w.
-    zh: Plane3,
-    iw: Plane3,
-    lw: Plane3,
-    j0: usize,
-    j1: usize,
-    i0: usize,
-    i1: usize,
-}
-
-/// The edge function of edge a→b at p, computed from the edge's
-/// lexicographically first end (exactly opposite for b→a).
-#[inline]
-fn edge(a: (f64, f64), b: (f64, f64), p: (f64, f64)) -> f64 {
-    if a < b {
-        (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0)
-    } else {
-        -((a.0 - b.0) * (p.1 - b.1) - (a.1 - b.1) * (p.0 - b.0))
+    /// The f32 form of `raster/depth_plane.rs` from the centre of texel
+    /// (i0, j0) on.
+    fn at_texel(&self, i0: u32, j0: u32) -> DepthPlane {
+        DepthPlane::new(self.at(i0 as f64 + 0.5, j0 as f64 + 0.5), self.a, self.b)
     }
 }
 
-/// Whether a texel centre exactly on edge a→b belongs to this triangle.
+/// Sub-texel precision of the snapped map coordinates (as `crate::raster`).
+pub const SUBPIXEL: i64 = 256;
+
+/// A triangle in map space ready to scan, the same data for the CPU scan
+/// below and the GPU's (`gpu/shadow_mapping.wgsl`): vertices snapped to
+/// 1/SUBPIXEL texel (exact integer edge functions), counter-clockwise (edge
+/// functions >= 0 inside), and its depths as f32 planes from the centre of
+/// texel (i0, j0) on (`DepthPlane`: exact limb products, so a GPU that fuses
+/// multiply-adds gets the same bits).
+#[derive(Debug, Clone, Copy)]
+pub struct SetupTri {
+    pub x: [i32; 3],
+    pub y: [i32; 3],
+    /// Inclusive texel ranges of the bounding box, clamped to the map
+    /// (empty when i0 > i1 or j0 > j1).
+    pub i0: u32,
+    pub i1: u32,
+    pub j0: u32,
+    pub j1: u32,
+    /// z/w, 1/w and ℓ/w.
+    pub zh: DepthPlane,
+    pub iw: DepthPlane,
+    pub lw: DepthPlane,
+    /// The hyperbolic depth's whole offset (its slope is constant).
+    pub zh_offset: f32,
+    /// The linear depth's offset terms: `slope` times the per-texel slope
+    /// plus `constant` (already in depth units).
+    pub slope: f32,
+    pub constant: f32,
+    /// ∂(ℓ/w) and ∂(1/w) per texel along x and y.
+    pub lw_a: f32,
+    pub lw_b: f32,
+    pub iw_a: f32,
+    pub iw_b: f32,
+}
+
+/// `plane` at texel (i0 + di, j0 + dj): `DepthPlane::depth`'s sum, in its
+/// order, without the reciprocal.
+#[inline(always)]
+fn plane_at(p: &DepthPlane, di: f32, dj: f32) -> f32 {
+    let mut w = p.w_ref;
+    for k in 0..3 {
+        w += p.gx[k] * di;
+        w += p.gy[k] * dj;
+    }
+    w
+}
+
+impl SetupTri {
+    /// The depth (with its offset) written at texel (i, j) inside the
+    /// triangle; `None` where it is not finite (or 1/w rounds to <= 0).
+    /// The WGSL twin (`sm_depth`) does these f32 operations in this order.
+    #[inline]
+    pub fn depth(&self, i: usize, j: usize, distribution: Distribution) -> Option<f32> {
+        let (di, dj) = ((i - self.i0 as usize) as f32, (j - self.j0 as usize) as f32);
+        let z = match distribution {
+            Distribution::Hyperbolic => plane_at(&self.zh, di, dj) + self.zh_offset,
+            Distribution::Linear => {
+                let a = plane_at(&self.lw, di, dj);
+                let bw = plane_at(&self.iw, di, dj);
+                if !(bw > 0.0) {
+                    return None;
+                }
+                let d = a / bw;
+                let dx = (self.lw_a - d * self.iw_a) / bw;
+                let dy = (self.lw_b - d * self.iw_b) / bw;
+                let m = dx.abs().max(dy.abs());
+                d + (self.slope * m + self.constant)
+            }
+        };
+        z.is_finite().then_some(z)
+    }
+
+    /// Whether texel centre (i, j) is inside (edge functions in i64, exact).
+    #[inline]
+    pub fn covers(&self, i: usize, j: usize) -> bool {
+        let q = (
+            i as i64 * SUBPIXEL + SUBPIXEL / 2,
+            j as i64 * SUBPIXEL + SUBPIXEL / 2,
+        );
+        (0..3).all(|e| {
+            let a = (self.x[e] as i64, self.y[e] as i64);
+            let b = (self.x[(e + 1) % 3] as i64, self.y[(e + 1) % 3] as i64);
+            let f = edge(a, b, q);
+            f > 0 || (f == 0 && owns_tie(a, b))
+        })
+    }
+}
+
+/// The edge function of edge a→b at p (exact: integer coordinates).
 #[inline]
-fn owns_tie(a: (f64, f64), b: (f64, f64)) -> bool {
+fn edge(a: (i64, i64), b: (i64, i64), p: (i64, i64)) -> i64 {
+    (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0)
+}
+
+/// Whether a texel centre exactly on edge a→b belongs to this triangle
+/// (of an edge and its reverse exactly one owns it).
+#[inline]
+fn owns_tie(a: (i64, i64), b: (i64, i64)) -> bool {
     b.1 > a.1 || (b.1 == a.1 && b.0 > a.0)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn setup(
     proj: &ShadowProjection,
     corners: [DVec3; 3],
     width: usize,
     height: usize,
-    out: &mut Vec<Tri>,
+    offset: Offset,
+    out: &mut Vec<SetupTri>,
 ) {
     let h = |p: DVec3| {
         let q = p.extend(1.0);
@@ -222,67 +304,95 @@ fn setup(
         }
     }
     let (wf, hf) = (width as f64, height as f64);
-    let map: Vec<((f64, f64), [f64; 3])> = poly
+    // Clipped to |x|, |y| <= w: map coordinates in [0, W] x [0, H], a
+    // little beyond by rounding; snapped they stay far inside i32.
+    let lim = (MAX_SIDE as i64 + 2) * SUBPIXEL;
+    let snap = |v: f64| ((v * SUBPIXEL as f64).round() as i64).clamp(-lim, lim);
+    // Per vertex: map position, snapped position, (z/w, 1/w, ℓ/w).
+    type MapVertex = ((f64, f64), (i64, i64), [f64; 3]);
+    let map: Vec<MapVertex> = poly
         .iter()
         .map(|v| {
             let iw = 1.0 / v.c.w;
             let (x, y) = (v.c.x * iw, v.c.y * iw);
-            (
-                ((x + 1.0) * 0.5 * wf, (1.0 - y) * 0.5 * hf),
-                [v.c.z * iw, iw, v.l * iw],
-            )
+            let p = ((x + 1.0) * 0.5 * wf, (1.0 - y) * 0.5 * hf);
+            (p, (snap(p.0), snap(p.1)), [v.c.z * iw, iw, v.l * iw])
         })
         .collect();
     for k in 1..map.len() - 1 {
         let mut t = [map[0], map[k], map[k + 1]];
-        let area = edge(t[0].0, t[1].0, t[2].0);
-        if !(area.abs() > 1e-12) || !area.is_finite() {
+        let area = edge(t[0].1, t[1].1, t[2].1);
+        if area == 0 || !t.iter().all(|v| v.0 .0.is_finite() && v.0 .1.is_finite()) {
             continue;
         }
-        if area < 0.0 {
+        if area < 0 {
             t.swap(1, 2);
         }
         let p = [t[0].0, t[1].0, t[2].0];
-        let attr = |a: usize| [t[0].1[a], t[1].1[a], t[2].1[a]];
-        let (xs, ys) = (p.map(|q| q.0), p.map(|q| q.1));
-        let lo = |v: [f64; 3]| v.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = |v: [f64; 3]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        // Texel centres at i + 1/2 inside [lo, hi].
-        let first = |l: f64| (l - 0.5).ceil().max(0.0) as usize;
-        let last = |h: f64, n: usize| ((h - 0.5).floor().min(n as f64 - 1.0)).max(-1.0);
-        let (i1, j1) = (last(hi(xs), width), last(hi(ys), height));
-        if i1 < 0.0 || j1 < 0.0 {
+        let attr = |a: usize| [t[0].2[a], t[1].2[a], t[2].2[a]];
+        let xs = t.map(|v| v.1 .0);
+        let ys = t.map(|v| v.1 .1);
+        // Texel centres i·S + S/2 inside [lo, hi].
+        let first = |lo: i64| {
+            (lo - SUBPIXEL / 2 + SUBPIXEL - 1)
+                .div_euclid(SUBPIXEL)
+                .max(0)
+        };
+        let last = |hi: i64, n: usize| (hi - SUBPIXEL / 2).div_euclid(SUBPIXEL).min(n as i64 - 1);
+        let (i0, i1) = (
+            first(*xs.iter().min().unwrap()),
+            last(*xs.iter().max().unwrap(), width),
+        );
+        let (j0, j1) = (
+            first(*ys.iter().min().unwrap()),
+            last(*ys.iter().max().unwrap(), height),
+        );
+        if i1 < 0 || j1 < 0 {
             continue;
         }
-        out.push(Tri {
-            p,
-            zh: Plane3::through(p, attr(0)),
-            iw: Plane3::through(p, attr(1)),
-            lw: Plane3::through(p, attr(2)),
-            i0: first(lo(xs)),
-            i1: i1 as usize,
-            j0: first(lo(ys)),
-            j1: j1 as usize,
+        let (i0, j0) = (i0 as u32, j0 as u32);
+        let (zh, iw, lw) = (
+            Plane3::through(p, attr(0)),
+            Plane3::through(p, attr(1)),
+            Plane3::through(p, attr(2)),
+        );
+        let constant = offset.constant * DEPTH_STEP;
+        out.push(SetupTri {
+            x: xs.map(|v| v as i32),
+            y: ys.map(|v| v as i32),
+            i0,
+            i1: i1 as u32,
+            j0,
+            j1: j1 as u32,
+            zh: zh.at_texel(i0, j0),
+            iw: iw.at_texel(i0, j0),
+            lw: lw.at_texel(i0, j0),
+            zh_offset: (offset.slope * zh.a.abs().max(zh.b.abs()) + constant) as f32,
+            slope: offset.slope as f32,
+            constant: constant as f32,
+            lw_a: lw.a as f32,
+            lw_b: lw.b as f32,
+            iw_a: iw.a as f32,
+            iw_b: iw.b as f32,
         });
     }
 }
 
-/// Rows per band of the parallel scan.
-const BAND: usize = 16;
+/// The largest map side the set-up handles (`config::MAX_SM_SIDE`).
+const MAX_SIDE: usize = super::config::MAX_SM_SIDE;
 
-/// The depth map of the faces `faces` of `verts` (world) under `proj`.
-#[allow(clippy::too_many_arguments)]
-pub fn rasterize(
+/// The set-up triangles of the faces `which` of `faces` (world `verts`)
+/// under `proj` on a (width, height) map, with `offset` baked in: the
+/// per-call geometry both backends scan.
+pub fn setup_triangles(
     proj: &ShadowProjection,
     verts: &[DVec3],
     faces: &[[u32; 3]],
     (width, height): (usize, usize),
-    distribution: Distribution,
     offset: Offset,
     which: Faces,
-    two_layers: bool,
-) -> DepthMap {
-    let tris: Vec<Tri> = faces
+) -> Vec<SetupTri> {
+    faces
         .par_iter()
         .with_min_len(256)
         .fold(Vec::new, |mut out, f| {
@@ -294,20 +404,33 @@ pub fn rasterize(
                     return out;
                 }
             }
-            setup(proj, c, width, height, &mut out);
+            setup(proj, c, width, height, offset, &mut out);
             out
         })
         .reduce(Vec::new, |mut a, mut b| {
             a.append(&mut b);
             a
-        });
+        })
+}
+
+/// Rows per band of the parallel scan.
+const BAND: usize = 16;
+
+/// The depth map of set-up triangles `tris` (nearest, and the second
+/// nearest when `two_layers`): the CPU scan, bands of rows in parallel.
+pub fn scan(
+    tris: &[SetupTri],
+    (width, height): (usize, usize),
+    distribution: Distribution,
+    two_layers: bool,
+) -> DepthMap {
     let bands = height.div_ceil(BAND);
     let mut bins: Vec<Vec<u32>> = vec![vec![]; bands];
     for (k, t) in tris.iter().enumerate() {
         if t.j0 > t.j1 || t.i0 > t.i1 {
             continue;
         }
-        for bin in &mut bins[t.j0 / BAND..=t.j1 / BAND] {
+        for bin in &mut bins[t.j0 as usize / BAND..=t.j1 as usize / BAND] {
             bin.push(k as u32);
         }
     }
@@ -317,36 +440,14 @@ pub fn rasterize(
         let rows = b * BAND..((b + 1) * BAND).min(height);
         for &k in &bins[b] {
             let t = &tris[k as usize];
-            for j in t.j0.max(rows.start)..=t.j1.min(rows.end - 1) {
-                let y = j as f64 + 0.5;
-                for i in t.i0..=t.i1 {
-                    let x = i as f64 + 0.5;
-                    let q = (x, y);
-                    let mut inside = true;
-                    for e in 0..3 {
-                        let (a, bb) = (t.p[e], t.p[(e + 1) % 3]);
-                        let f = edge(a, bb, q);
-                        if f < 0.0 || (f == 0.0 && !owns_tie(a, bb)) {
-                            inside = false;
-                            break;
-                        }
-                    }
-                    if !inside {
+            for j in (t.j0 as usize).max(rows.start)..=(t.j1 as usize).min(rows.end - 1) {
+                for i in t.i0 as usize..=t.i1 as usize {
+                    if !t.covers(i, j) {
                         continue;
                     }
-                    let (d, dx, dy) = match distribution {
-                        Distribution::Hyperbolic => (t.zh.at(x, y), t.zh.a, t.zh.b),
-                        Distribution::Linear => {
-                            let (a, bw) = (t.lw.at(x, y), t.iw.at(x, y));
-                            let d = a / bw;
-                            (d, (t.lw.a - d * t.iw.a) / bw, (t.lw.b - d * t.iw.b) / bw)
-                        }
+                    let Some(z) = t.depth(i, j, distribution) else {
+                        continue;
                     };
-                    let m = dx.abs().max(dy.abs());
-                    let z = (d + offset.slope * m + offset.constant * DEPTH_STEP) as f32;
-                    if !z.is_finite() {
-                        continue;
-                    }
                     let o = (j - rows.start) * width + i;
                     if z < near[o] {
                         if let Some(s) = sec.as_deref_mut() {
@@ -380,6 +481,22 @@ pub fn rasterize(
         second,
         triangles: tris.len(),
     }
+}
+
+/// The depth map of the faces `faces` of `verts` (world) under `proj`.
+#[allow(clippy::too_many_arguments)]
+pub fn rasterize(
+    proj: &ShadowProjection,
+    verts: &[DVec3],
+    faces: &[[u32; 3]],
+    resolution: (usize, usize),
+    distribution: Distribution,
+    offset: Offset,
+    which: Faces,
+    two_layers: bool,
+) -> DepthMap {
+    let tris = setup_triangles(proj, verts, faces, resolution, offset, which);
+    scan(&tris, resolution, distribution, two_layers)
 }
 
 #[cfg(test)]
