@@ -12,6 +12,7 @@ use super::dispatch::storage;
 use super::exact::ExactShading;
 use super::from_depth::point_light_on_gpu;
 use super::gather;
+use super::pcss::PcssShading;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
@@ -50,6 +51,8 @@ pub fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
 enum Stage {
     Maps(Shading),
     Rays(ExactShading),
+    /// PCSS reads the front layer at `grid.len()` in `maps`.
+    Pcss(PcssShading),
 }
 
 /// Soft shadow map from meshes on the GPU; the same result type, maps and
@@ -62,7 +65,8 @@ pub fn from_meshes(
 ) -> Result<ShadowResult> {
     // Map methods shade occluder maps; `exact` traces the triangles.
     let traced = s.method.traces();
-    if !traced {
+    let pcss = matches!(s.method, Method::Pcss { .. });
+    if !traced && !pcss {
         gather::check_method(s.method)?;
     }
     check_side("resolution", (s.width, s.height))?;
@@ -109,6 +113,14 @@ pub fn from_meshes(
                 let t = light_space_triangles(&occ_ls, occluders.faces);
                 Stage::Rays(ExactShading::new(g, &grid, t, samples, light_size))
             }
+            Method::Pcss { max_taps } => Stage::Pcss(PcssShading::maps(
+                g,
+                &grid,
+                &occluder_grid,
+                light_size,
+                max_taps,
+                grid.len() as u32,
+            )?),
             _ => Stage::Maps(Shading::new(
                 g,
                 s.method,
@@ -144,6 +156,10 @@ pub fn from_meshes(
                 sh.record(g, &mut enc, &timer, &maps);
                 sources.push((&sh.vis, sh.vis_bytes));
                 sources.push((&sh.status, 4));
+            }
+            Stage::Pcss(sh) => {
+                sh.record(g, &mut enc, &timer, &maps);
+                sources.push((&sh.vis, sh.vis_bytes));
             }
         }
         submit_and_read(g, enc, &timer, &sources, &mut sw)

@@ -17,6 +17,9 @@
 //! * `gather.wgsl`'s points mode (`gather.rs`, `eye.rs`): the eye view's
 //!   map methods at arbitrary points; twin `methods::gather`'s
 //!   `visibility_points`.
+//! * `pcss.wgsl` (`pcss.rs`): PCSS's blocker search, penumbra estimate
+//!   and box PCF per output texel (light view) or per point (the eye view's
+//!   points mode); twin `crate::methods::pcss` (with `methods::pcf`'s box).
 //! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl` and
 //!   `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
@@ -33,6 +36,7 @@ mod eye;
 mod from_depth;
 mod from_meshes;
 mod gather;
+mod pcss;
 mod raster;
 mod readback;
 #[cfg(test)]

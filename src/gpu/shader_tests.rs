@@ -8,6 +8,7 @@ use super::gather::{
     module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, PointsParams, RowSpan,
     BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
+use super::pcss::{Coord, GpuPcssPoint, PcssChunk, PcssParams, SOURCE as PCSS_SOURCE};
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
 use std::mem::{offset_of, size_of};
 
@@ -20,6 +21,7 @@ fn modules() -> Vec<(&'static str, String)> {
         ("exact.wgsl", EXACT_SOURCE.to_string()),
         ("exact.wgsl + eye_hits.wgsl", HITS_SOURCE.to_string()),
         ("exact.wgsl + eye_rays.wgsl", RAYS_SOURCE.to_string()),
+        ("pcss.wgsl", PCSS_SOURCE.to_string()),
     ]
 }
 
@@ -40,6 +42,7 @@ fn every_wgsl_file_is_used_by_a_module() {
         EXACT_SOURCE,
         HITS_SOURCE,
         RAYS_SOURCE,
+        PCSS_SOURCE,
     ];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -287,6 +290,53 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             t1,
             ax_rec_x,
             ax_rec_y,
+            _pad0,
+            _pad1
+        }),
+    );
+}
+
+#[test]
+fn pcss_structs_have_the_same_layout_in_rust_and_wgsl() {
+    assert_same(
+        PCSS_SOURCE,
+        "PcssParams",
+        rust_layout!(PcssParams {
+            n,
+            mode,
+            out_w,
+            rec_offset,
+            occ_w,
+            occ_h,
+            front_offset,
+            front_len,
+            taps,
+            rows_per_chunk,
+            half_per_w_x,
+            half_per_w_y
+        }),
+    );
+    assert_same(
+        PCSS_SOURCE,
+        "PcssChunk",
+        rust_layout!(PcssChunk {
+            chunk,
+            _pad0,
+            _pad1,
+            _pad2
+        }),
+    );
+    assert_same(PCSS_SOURCE, "Coord", rust_layout!(Coord { base, frac }));
+    assert_same(
+        PCSS_SOURCE,
+        "PcssPoint",
+        rust_layout!(GpuPcssPoint {
+            bx,
+            fx,
+            by,
+            fy,
+            z,
+            live,
             _pad0,
             _pad1
         }),

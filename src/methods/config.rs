@@ -705,7 +705,6 @@ impl MethodConfig {
                 })
             }
             MethodConfig::Pcss(c) => {
-                cpu_only(ctx, "pcss")?;
                 // From depth maps: the front layer the user gave.
                 let (_, occ, _) = resolve_maps(
                     Some(1),
