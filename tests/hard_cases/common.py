@@ -8,14 +8,24 @@ import numpy as np
 
 import softshadow as ss
 
-__all__ = ["BACKENDS", "MAP_METHODS", "METHODS", "SAMPLES", "assert_visibility", "has_option", "options", "runs_on"]
+__all__ = [
+    "BACKENDS",
+    "MAP_METHODS",
+    "METHODS",
+    "SAMPLES",
+    "assert_visibility",
+    "has_option",
+    "layers",
+    "options",
+    "runs_on",
+]
 
 _CAPS = ss.capabilities()
 # Every light-view method that runs on every backend of this build ("auto"
 # is a rule that resolves to one of them; a method that reads a camera has
-# the eye view only). The CPU-only methods of this version (pcss,
-# smoothies) have their hard cases in tests/test_shadow_mapping.py until
-# their GPU twins join these lists.
+# the eye view only). pcss joined with its GPU twin (src/gpu/pcss.rs); a
+# CPU-only method (smoothies in this version) has its hard cases in
+# tests/test_shadow_mapping.py until its GPU twin joins these lists.
 _ALL = set(_CAPS["ssm"].backends)
 METHODS = tuple(
     name for name in _CAPS if name != "auto" and "camera" not in _CAPS[name].reads and set(_CAPS[name].backends) == _ALL
@@ -37,6 +47,12 @@ def runs_on(method: str, backend: str) -> bool:
 
 def has_option(method: str, option: str) -> bool:
     return option in _CAPS[method].options or (option == "passes" and method == "exact")
+
+
+def layers(method: str, passes: int) -> dict:
+    """``passes=passes`` for the methods that take it (pcss reads the front
+    layer only and refuses the option)."""
+    return {"passes": passes} if has_option(method, "passes") else {}
 
 
 def options(method: str, backend: str) -> dict:

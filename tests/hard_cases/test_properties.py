@@ -28,7 +28,7 @@ from hypothesis import strategies as st
 
 import softshadow as ss
 from hard_cases import plate as closed
-from hard_cases.common import BACKENDS, MAP_METHODS, METHODS, assert_visibility
+from hard_cases.common import BACKENDS, MAP_METHODS, METHODS, assert_visibility, has_option, layers
 from softshadow import scenes
 
 SETTINGS = settings(
@@ -57,7 +57,7 @@ def scene_and_light(draw):
 
 
 def _kw(method, backend):
-    return dict(method=method, backend=backend, **({} if method == "ssm" else {"samples": 64}))
+    return dict(method=method, backend=backend, **({"samples": 64} if has_option(method, "samples") else {}))
 
 
 @SETTINGS
@@ -65,7 +65,7 @@ def _kw(method, backend):
 def test_visibility_is_finite_and_in_unit_interval(sl, method, backend, passes):
     plates, light = sl
     scene = ss.Scene(occluders=plates, receivers=[scenes.floor()])
-    sm = ss.soft_shadow_map(scene, light, resolution=24, passes=passes, **_kw(method, backend))
+    sm = ss.soft_shadow_map(scene, light, resolution=24, **layers(method, passes), **_kw(method, backend))
     assert_visibility(sm.visibility)
     np.testing.assert_array_equal(sm.visibility[~np.isfinite(sm.receiver_depth)], 1.0)
 
@@ -84,8 +84,14 @@ def depth_maps(draw):
     return occ, rec, added, size, ext
 
 
+# Not pcss: an added blocker moves its mean blocker depth, and a farther mean
+# shrinks the filter box, which can let more light through (Fernando's one
+# average depth per receiver; found by this very property).
+MONOTONE_MAP_METHODS = tuple(m for m in MAP_METHODS if m != "pcss")
+
+
 @SETTINGS
-@given(depth_maps(), st.sampled_from(MAP_METHODS), st.sampled_from(BACKENDS))
+@given(depth_maps(), st.sampled_from(MONOTONE_MAP_METHODS), st.sampled_from(BACKENDS))
 def test_occluders_in_empty_texels_never_raise_visibility(maps, method, backend):
     occ, rec, added, size, ext = maps
     more = np.where(np.isfinite(occ), occ, added)  # only empty texels change

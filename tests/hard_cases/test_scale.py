@@ -16,7 +16,7 @@ import pytest
 
 import softshadow as ss
 from hard_cases import plate
-from hard_cases.common import assert_visibility, options
+from hard_cases.common import assert_visibility, layers, options
 from hard_cases.meshes import moved
 from softshadow import scenes
 
@@ -51,12 +51,14 @@ def _scaled_scene(s):
 @pytest.mark.parametrize("s", [1e-15, 1e-6, 1e6, 1e15])
 def test_meshes_at_any_scale(method, backend, s):
     scene, light = _scaled_scene(1.0)
-    kw = dict(resolution=48, passes=2, **options(method, backend))
+    kw = dict(resolution=48, **layers(method, 2), **options(method, backend))
     base = ss.soft_shadow_map(scene, light, **kw)
     scene_s, light_s = _scaled_scene(s)
     sm = ss.soft_shadow_map(scene_s, light_s, **kw)
     assert_visibility(sm.visibility)
-    assert base.visibility.min() <= 1e-6
+    # There is an umbra to lose (pcss's filter box, from the sphere's mean
+    # blocker depth, is a little wider than the true umbra: measured 0.0038).
+    assert base.visibility.min() <= (0.01 if method == "pcss" else 1e-6)
     # Not powers of two: vertices round differently, which can move a
     # rasterized edge over a texel center or a ray past a triangle's edge.
     d = np.abs(sm.visibility - base.visibility)
