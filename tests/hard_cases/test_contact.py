@@ -62,7 +62,8 @@ def _box_on_floor(gap):
 
 def _box_shadow(gap, method, backend):
     scene, light = _box_on_floor(gap)
-    return ss.soft_shadow_map(scene, light, resolution=64, extent=0.4, **layers(method, 2), **options(method, backend)).visibility
+    kw = dict(resolution=64, extent=0.4, **layers(method, 2), **options(method, backend))
+    return ss.soft_shadow_map(scene, light, **kw).visibility
 
 
 # Mean |V - V_exact| over the shadow of a box 0.5 wide near the floor (64²,
