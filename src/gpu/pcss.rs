@@ -188,6 +188,7 @@ fn check_points(g: &Gpu, arg: &str, n: usize) -> Result<()> {
 }
 
 impl PcssShading {
+    #[allow(clippy::too_many_arguments)]
     fn new(
         g: &Gpu,
         og: &MapGrid,
