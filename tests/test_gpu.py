@@ -239,3 +239,63 @@ def test_the_gpu_docs_example_runs(gpu):
     assert env["sm"].backend == "gpu"
     assert env["sm"].visibility.shape == (128, 128)
     assert any(k.startswith("gpu") for k in env["sm"].timings)
+
+
+def assert_pcss_agrees(c, g, name: str) -> None:
+    """PCSS on both backends: its depth tests compare the maps' own f32
+    depths, so where the maps are bit for bit the same (lavapipe) no test
+    flips and |dV| stays within the usual tolerances; where a real GPU rounds
+    a silhouette texel differently (assert_depth_maps_agree allows it), a
+    box reading that texel may flip a blocker: at most 0.5% of the texels
+    (and no more than 8) then exceed 2e-3, and the rest agree as usual."""
+    dv = np.abs(c.visibility.astype(np.float64) - g.visibility)
+    assert np.isfinite(g.visibility).all(), name
+    flips = dv > 2e-3
+    same_maps = all(
+        (a.view(np.uint32) == b.view(np.uint32)).all()
+        for a, b in [(c.receiver_depth, g.receiver_depth), (c.occluder_depth, g.occluder_depth)]
+    )
+    if same_maps:
+        assert not flips.any(), f"{name}: {flips.sum()} texels differ by more than 2e-3 on the same maps"
+    assert flips.sum() <= max(8, flips.size // 200), f"{name}: {flips.sum()} flipped texels"
+    rest = dv[~flips]
+    assert rest.mean() <= 1e-4, f"{name}: mean {rest.mean():.2e}"
+
+
+@pytest.mark.parametrize("max_taps", [32, 4, 1])
+@pytest.mark.parametrize("name", SCENES)
+def test_gpu_pcss_matches_cpu_on_the_scenes(gpu, name, max_taps):
+    scene, light = getattr(scenes, name)()
+    method = ss.Pcss(max_taps=max_taps)
+    c = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=method, backend="cpu")
+    g = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=method, backend="gpu")
+    assert g.backend == "gpu" and repr(g.method) == repr(c.method)
+    assert g.extent == c.extent
+    assert_depth_maps_agree(c.receiver_depth, g.receiver_depth, f"{name} receiver")
+    assert_depth_maps_agree(c.occluder_depth, g.occluder_depth, f"{name} front")
+    assert g.occluder_depth_back is None and not g.occluder_depth_middle
+    assert_pcss_agrees(c, g, name)
+    assert "gpu_shadow" in g.timings or "gpu" in g.timings
+
+
+def test_gpu_pcss_with_coarser_and_finer_occluder_maps(gpu):
+    scene, light = scenes.torus_floating()
+    for occ in (32, (160, 128)):
+        method = ss.Pcss(max_taps=12, occluder_resolution=occ)
+        kw = dict(resolution=(80, 64), extent=(0.6, 0.5), method=method)
+        c = ss.soft_shadow_map(scene, light, backend="cpu", **kw)
+        g = ss.soft_shadow_map(scene, light, backend="gpu", **kw)
+        assert g.occluder_depth.shape == c.occluder_depth.shape
+        assert_pcss_agrees(c, g, f"torus {occ}")
+        assert ((c.visibility > 0.02) & (c.visibility < 0.98)).sum() > 50
+
+
+def test_gpu_pcss_from_depth_maps_matches_cpu(gpu):
+    scene, light = scenes.bunny_floating()
+    sm = ss.soft_shadow_map(scene, light, resolution=(48, 40), occluder_resolution=64, passes=1)
+    for method in (ss.Pcss(), ss.Pcss(max_taps=3)):
+        kw = dict(light_size=light.size, extent=sm.extent, method=method)
+        c = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="cpu", **kw)
+        g = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="gpu", **kw)
+        assert_visibility_agrees(c.visibility, g.visibility, repr(method))
+        assert (c.visibility < 0.5).sum() > 20

@@ -943,6 +943,64 @@ mod eye {
             assert_eq!(cv, gv);
         }
     }
+
+    #[test]
+    fn gpu_pcss_renders_are_the_cpu_renders() {
+        // PCSS at the visible points: the front layer rasterized on the
+        // device (bit for bit), the points biased on the CPU (shared), the
+        // search and filter in pcss.wgsl's points mode.
+        if !device_or_skip() {
+            return;
+        }
+        use crate::methods::config::PcssConfig;
+        let meshes = scene();
+        let cam = camera((96, 72));
+        for (lname, light) in lights() {
+            for taps in [32, 5] {
+                let method = MethodConfig::Pcss(PcssConfig {
+                    max_taps: taps,
+                    ..Default::default()
+                });
+                let c = render(&meshes, &light, &cam, method, BackendChoice::Cpu).unwrap();
+                let g = render(&meshes, &light, &cam, method, BackendChoice::Gpu).unwrap();
+                assert_eq!((c.backend, g.backend), (Backend::Cpu, Backend::Gpu));
+                assert_eq!(c.method, g.method, "{lname} pcss");
+                let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+                let same = same_surface(&c.output, &g.output);
+                let dv: Vec<f64> = (0..cv.len())
+                    .filter(|&k| same[k])
+                    .map(|k| (cv[k] as f64 - gv[k] as f64).abs())
+                    .collect();
+                let mean = dv.iter().sum::<f64>() / dv.len() as f64;
+                let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+                let flips = dv.iter().filter(|&&x| x > 1e-3).count();
+                let penumbra = cv.iter().filter(|&&v| v > 0.02 && v < 0.98).count();
+                let shadowed = cv.iter().filter(|&&v| v < 0.5).count();
+                eprintln!(
+                    "{lname} pcss {taps}: mean |dV| {mean:.2e}, max {max:.2e}, {flips} > 1e-3, \
+                     penumbra {penumbra}, shadowed {shadowed}"
+                );
+                assert!(penumbra > 20 && shadowed > 50, "{lname} pcss");
+                assert!(mean <= 1e-4, "{lname} pcss {taps}: mean |dV| {mean}");
+                // Where a box end falls within f32 rounding of a texel
+                // edge, the texel count and so exact against stratified
+                // weights may differ: a handful of points at most.
+                assert!(
+                    flips * 500 <= dv.len(),
+                    "{lname} pcss {taps}: {flips} flips"
+                );
+                let (a, b) = (c.output.maps.unwrap(), g.output.maps.unwrap());
+                assert_eq!(a.grid, b.grid);
+                assert_eq!((a.layers.len(), b.layers.len()), (1, 1));
+                let diff = a.layers[0]
+                    .iter()
+                    .zip(&b.layers[0])
+                    .filter(|(x, y)| x.to_bits() != y.to_bits())
+                    .count();
+                assert_eq!(diff, 0, "{lname} pcss: front layer");
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -1087,5 +1145,256 @@ mod smoothies {
             assert!(mean <= 1e-4, "mean {mean}");
             assert!(over * 200 <= penumbra, "{over} texels differ");
         }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// PCSS (pcss.wgsl) against methods/pcss.rs: maps and points.
+
+mod pcss {
+    use super::{device_or_skip, run_at, same_bits};
+    use crate::geom::light::MapGrid;
+    use crate::gpu::context::gpu;
+    use crate::gpu::dispatch::upload;
+    use crate::gpu::pcss::{chunking, PcssShading};
+    use crate::gpu::readback::{submit_and_read, visibility, with_error_scopes};
+    use crate::gpu::timing::StageTimer;
+    use crate::methods::pcss::{Pcss, MAX_TAPS};
+    use crate::methods::{LightPoint, Method, ShadowInputs, ShadowMethod};
+    use crate::pipeline::{self, Stopwatch};
+
+    fn lcg(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// max |dV|, mean |dV|, and the values differing by more than 1e-3.
+    fn compare(c: &[f32], g: &[f32]) -> (f64, f64, usize) {
+        assert_eq!(c.len(), g.len());
+        let dv: Vec<f64> = c
+            .iter()
+            .zip(g)
+            .map(|(a, b)| (*a as f64 - *b as f64).abs())
+            .collect();
+        let max = dv.iter().fold(0f64, |m, &x| m.max(x));
+        let mean = dv.iter().sum::<f64>() / dv.len().max(1) as f64;
+        (max, mean, dv.iter().filter(|&&x| x > 1e-3).count())
+    }
+
+    #[test]
+    fn gpu_pcss_maps_are_the_cpu_maps() {
+        if !device_or_skip() {
+            return;
+        }
+        // The default taps (exact weights: every box is under 32 texels at
+        // this size, or stratified where wider), few taps (stratified), and
+        // one tap. The depth tests compare the same f32 depths on both
+        // sides (the maps are bit for bit the CPU's); what remains is f32
+        // against f64 in the box ends, weights and sums: ~1e-6.
+        for (taps, res) in [(32, (64, 48)), (4, (64, 48)), (1, (64, 48)), (6, (97, 61))] {
+            let method = Method::Pcss { max_taps: taps };
+            let c = run_at(false, 1, method, res);
+            let g = run_at(true, 1, method, res);
+            assert_eq!(same_bits(&c.receiver, &g.receiver), 0, "receiver");
+            let (cf, gf) = (c.occluder_front.unwrap(), g.occluder_front.unwrap());
+            assert_eq!(same_bits(&cf, &gf), 0, "front");
+            let penumbra = c
+                .visibility
+                .iter()
+                .filter(|&&v| v > 0.01 && v < 0.99)
+                .count();
+            assert!(penumbra > 30, "{taps}: penumbra {penumbra}");
+            let (max, mean, flips) = compare(&c.visibility, &g.visibility);
+            eprintln!("pcss {taps} taps {res:?}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
+            assert!(
+                max <= 2e-3 && mean <= 1e-4,
+                "{taps}: max {max}, mean {mean}"
+            );
+        }
+    }
+
+    /// Random rectangles of depth 1.2-1.8 over receivers at 2.5-3.5.
+    fn depth_maps(grid: &MapGrid, og: &MapGrid, seed: &mut u64) -> (Vec<f32>, Vec<f32>) {
+        let rects: Vec<[f64; 5]> = (0..12)
+            .map(|_| {
+                let (x, y) = (lcg(seed) - 0.5, lcg(seed) - 0.5);
+                let (w, h) = (0.05 + 0.2 * lcg(seed), 0.05 + 0.2 * lcg(seed));
+                [x, y, x + w, y + h, 1.2 + 0.6 * lcg(seed)]
+            })
+            .collect();
+        let front = (0..og.len())
+            .map(|k| {
+                let (x, y) = (og.x_of(k % og.width), og.y_of(k / og.width));
+                rects
+                    .iter()
+                    .filter(|r| (r[0]..r[2]).contains(&x) && (r[1]..r[3]).contains(&y))
+                    .map(|r| r[4] as f32)
+                    .fold(f32::INFINITY, f32::min)
+            })
+            .collect();
+        let receiver = (0..grid.len()).map(|_| (2.5 + lcg(seed)) as f32).collect();
+        (front, receiver)
+    }
+
+    #[test]
+    fn wide_boxes_on_fine_maps_take_many_chunks() {
+        if !device_or_skip() {
+            return;
+        }
+        // A 640² occluder map under a 24x20 output: boxes of hundreds of
+        // texels, stratified; with MAX_TAPS taps each stage takes several
+        // dispatches (an invocation's y entries are cut into chunks).
+        let grid = MapGrid::new(24, 20, [0.5, 0.5]).unwrap();
+        let og = MapGrid::new(640, 640, [0.5, 0.5]).unwrap();
+        assert!(chunking(MAX_TAPS).1 > 1);
+        let mut seed = 3u64;
+        let (front, receiver) = depth_maps(&grid, &og, &mut seed);
+        for (taps, light) in [
+            (MAX_TAPS, [1.5, 1.2]),
+            (12, [1.5, 1.2]),
+            (32, [0.2, 1e-3]),
+            (32, [1e4, 1e4]),
+            (7, [1e30, 0.5]),
+        ] {
+            let method = Method::Pcss { max_taps: taps };
+            let (c, _) =
+                pipeline::from_depth(&grid, &og, light, &front, None, &receiver, method).unwrap();
+            let (g, _) =
+                super::super::from_depth(&grid, &og, light, &front, None, &receiver, method)
+                    .unwrap();
+            let (max, mean, flips) = compare(&c, &g);
+            eprintln!("wide {taps} {light:?}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
+            assert!(
+                max <= 2e-3 && mean <= 1e-4,
+                "{taps}: max {max}, mean {mean}"
+            );
+            if taps == MAX_TAPS {
+                assert!(c.iter().any(|v| *v > 0.01 && *v < 0.99));
+            }
+        }
+    }
+
+    /// `points` shaded by the GPU's points mode from `front` on `og`.
+    fn gpu_points(
+        og: &MapGrid,
+        light: [f64; 2],
+        taps: u32,
+        front: &[f32],
+        points: &[LightPoint],
+    ) -> Vec<f32> {
+        let g = gpu().unwrap();
+        let out = with_error_scopes(g, || {
+            let maps = upload(&g.device, "maps", front);
+            let sh = PcssShading::points(g, og, light, taps, 0, points)?;
+            let timer = StageTimer::new(g, 1);
+            let mut enc = g
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            sh.record(g, &mut enc, &timer, &maps);
+            submit_and_read(
+                g,
+                enc,
+                &timer,
+                &[(&sh.vis, sh.vis_bytes)],
+                &mut Stopwatch::new(),
+            )
+        })
+        .unwrap();
+        visibility(&out.buffers[0]).unwrap()
+    }
+
+    #[test]
+    fn points_mode_is_visibility_points_odd_points_included() {
+        if !device_or_skip() {
+            return;
+        }
+        let og = MapGrid::new(96, 80, [0.6, 0.5]).unwrap();
+        let mut seed = 11u64;
+        let (mut front, _) = depth_maps(&og, &og, &mut seed);
+        // Odd texels: NaN, negative, 0 (never occluders).
+        for (k, v) in [(5, f32::NAN), (700, -1.0), (1400, 0.0)] {
+            front[k] = v;
+        }
+        let mut pts: Vec<LightPoint> = (0..3000)
+            .map(|_| LightPoint {
+                x: (1.4 * lcg(&mut seed) - 0.7) as f32,
+                y: (1.2 * lcg(&mut seed) - 0.6) as f32,
+                z: (1.0 + 2.5 * lcg(&mut seed)) as f32,
+            })
+            .collect();
+        for (x, y, z) in [
+            (0.0, 0.0, f32::NAN),
+            (0.0, 0.0, -2.0),
+            (0.0, 0.0, 0.0),
+            (0.0, 0.0, f32::INFINITY),
+            (f32::NAN, 0.0, 3.0),
+            (f32::INFINITY, -f32::INFINITY, 3.0),
+            (1e30, 0.0, 3.0),
+            (-1e30, 1e30, 3.0),
+            (0.6, -0.5, 3.0),
+            (0.1, 0.1, 1e-30),
+            (0.1, 0.1, 1e30),
+            (0.1, 0.1, 1.2),
+        ] {
+            pts.push(LightPoint { x, y, z });
+        }
+        for (taps, light) in [
+            (32, [1.0, 0.7]),
+            (3, [1.0, 0.7]),
+            (MAX_TAPS, [2.0, 2.0]),
+            (32, [1.0, 0.0]),
+        ] {
+            let inputs = ShadowInputs {
+                grid: og,
+                occluder_grid: og,
+                light_size: light,
+                receiver: &[],
+                occluder_layers: vec![&front],
+                occluder_triangles: None,
+            };
+            let c = Pcss { max_taps: taps }.visibility_points(&inputs, &pts);
+            let g = gpu_points(&og, light, taps, &front, &pts);
+            let (max, mean, flips) = compare(&c, &g);
+            eprintln!("points {taps} {light:?}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
+            assert!(
+                max <= 2e-3 && mean <= 1e-4,
+                "{taps}: max {max}, mean {mean}"
+            );
+            // The odd points: lit on both (pcss.rs's early returns).
+            let n = pts.len();
+            assert!(
+                g[n - 12..n - 4].iter().all(|v| *v == 1.0),
+                "{:?}",
+                &g[n - 12..]
+            );
+            assert!(c.iter().filter(|v| **v < 0.9).count() > 100);
+        }
+        // Points mode over a fine map: stratified boxes of hundreds of
+        // texels, MAX_TAPS taps, several dispatches per stage.
+        let fine = MapGrid::new(640, 640, [0.6, 0.5]).unwrap();
+        let (front, _) = depth_maps(&fine, &fine, &mut seed);
+        let pts: Vec<LightPoint> = (0..300)
+            .map(|_| LightPoint {
+                x: (1.2 * lcg(&mut seed) - 0.6) as f32,
+                y: (lcg(&mut seed) - 0.5) as f32,
+                z: (2.5 + lcg(&mut seed)) as f32,
+            })
+            .collect();
+        let inputs = ShadowInputs {
+            grid: fine,
+            occluder_grid: fine,
+            light_size: [1.5, 1.2],
+            receiver: &[],
+            occluder_layers: vec![&front],
+            occluder_triangles: None,
+        };
+        let c = Pcss { max_taps: MAX_TAPS }.visibility_points(&inputs, &pts);
+        let g = gpu_points(&fine, [1.5, 1.2], MAX_TAPS, &front, &pts);
+        let (max, mean, flips) = compare(&c, &g);
+        eprintln!("points fine {MAX_TAPS}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
+        assert!(max <= 2e-3 && mean <= 1e-4, "fine: max {max}, mean {mean}");
+        assert!(c.iter().any(|v| *v > 0.01 && *v < 0.99));
     }
 }

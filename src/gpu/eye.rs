@@ -175,7 +175,10 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         if call.light.is_hard() {
             return Err(point_light_on_gpu("size"));
         }
-        gather::check_method(eye::resolve_at_camera(call, Backend::Gpu)?.kernel())?;
+        let kernel = eye::resolve_at_camera(call, Backend::Gpu)?.kernel();
+        if !matches!(kernel, Method::Pcss { .. }) {
+            gather::check_method(kernel)?;
+        }
     }
     let g = gpu()?;
     let mut sw = Stopwatch::new();
@@ -210,16 +213,22 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         check_side("map_resolution", (grid.width, grid.height))?;
         sw.lap("extent");
         let tris = eye::light_triangles(&mut f, &scene);
-        let (v, m, t) = shade_maps(
-            g,
-            &f,
-            &tris,
-            grid,
-            method.passes(),
-            method.kernel(),
-            &call.bias,
-            &mut sw,
-        )?;
+        let (v, m, t) = match method.kernel() {
+            // PCSS's own kernel (pcss.rs), on the front layer.
+            Method::Pcss { max_taps } => {
+                super::pcss::shade_points(g, &f, &tris, grid, max_taps, &call.bias, &mut sw)?
+            }
+            kernel => shade_maps(
+                g,
+                &f,
+                &tris,
+                grid,
+                method.passes(),
+                kernel,
+                &call.bias,
+                &mut sw,
+            )?,
+        };
         device_timings.extend(t);
         for (&k, v) in f.hits.iter().zip(v) {
             vis[k] = v;

@@ -6,6 +6,7 @@ use super::context::gpu;
 use super::dispatch::upload;
 use super::from_meshes::check_side;
 use super::gather;
+use super::pcss::PcssShading;
 use super::readback::{submit_and_read, visibility, with_error_scopes};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
@@ -44,7 +45,9 @@ pub fn from_depth(
         receiver,
         method,
     )?;
-    gather::check_method(method)?;
+    if !matches!(method, Method::Pcss { .. }) {
+        gather::check_method(method)?;
+    }
     // The kernels' depth unit, as on the CPU (see units.rs).
     let d = DepthInUnit::new(
         depth_unit(farthest(receiver)),
@@ -84,6 +87,20 @@ pub fn from_depth(
         .fold(0f64, |m, &z| m.max(1.0 / z as f64));
     let out = with_error_scopes(g, || {
         let maps = upload(&g.device, "maps", &words);
+        if let Method::Pcss { max_taps } = method {
+            // The front layer follows the receiver map.
+            let off = grid.len() as u32;
+            let sh = PcssShading::maps(g, grid, occluder_grid, light_size, max_taps, off)?;
+            sw.lap("upload");
+            let timer = StageTimer::new(g, 1);
+            let mut enc = g
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("softshadow from depth pcss"),
+                });
+            sh.record(g, &mut enc, &timer, &maps);
+            return submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], &mut sw);
+        }
         let shading = Shading::new(g, method, grid, occluder_grid, light_size, n_layers, w_max);
         sw.lap("upload");
         let timer = StageTimer::new(g, 2);

@@ -12,6 +12,7 @@ use super::dispatch::storage;
 use super::exact::ExactShading;
 use super::from_depth::point_light_on_gpu;
 use super::gather;
+use super::pcss::PcssShading;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
@@ -52,6 +53,8 @@ enum Stage {
     Maps(Shading),
     Rays(ExactShading),
     Smoothies(SmoothieShading),
+    /// PCSS reads the front layer at `grid.len()` in `maps`.
+    Pcss(PcssShading),
 }
 
 /// Soft shadow map from meshes on the GPU; the same result type, maps and
@@ -64,7 +67,8 @@ pub fn from_meshes(
 ) -> Result<ShadowResult> {
     // Map methods shade occluder maps; `exact` traces the triangles.
     let traced = s.method.traces();
-    if !traced {
+    let pcss = matches!(s.method, Method::Pcss { .. });
+    if !traced && !pcss {
         gather::check_method(s.method)?;
     }
     check_side("resolution", (s.width, s.height))?;
@@ -133,6 +137,14 @@ pub fn from_meshes(
                 let t = light_space_triangles(&occ_ls, occluders.faces);
                 Stage::Rays(ExactShading::new(g, &grid, t, samples, light_size))
             }
+            (Method::Pcss { max_taps }, _) => Stage::Pcss(PcssShading::maps(
+                g,
+                &grid,
+                &occluder_grid,
+                light_size,
+                max_taps,
+                grid.len() as u32,
+            )?),
             _ => Stage::Maps(Shading::new(
                 g,
                 s.method,
@@ -170,6 +182,10 @@ pub fn from_meshes(
                 sources.push((&sh.status, 4));
             }
             Stage::Smoothies(sh) => {
+                sh.record(g, &mut enc, &timer, &maps);
+                sources.push((&sh.vis, sh.vis_bytes));
+            }
+            Stage::Pcss(sh) => {
                 sh.record(g, &mut enc, &timer, &maps);
                 sources.push((&sh.vis, sh.vis_bytes));
             }

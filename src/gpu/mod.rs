@@ -24,6 +24,9 @@
 //! * `shadow_mapping.wgsl` (`shadow_mapping.rs`): ShadowMapping's depth
 //!   map, lookups and eye-space blur; twin `methods::shadow_mapping`'s
 //!   `raster::scan`, `lookup::Lookup` and `blur::blur`.
+//! * `pcss.wgsl` (`pcss.rs`): PCSS's blocker search, penumbra estimate
+//!   and box PCF per output texel (light view) or per point (the eye view's
+//!   points mode); twin `crate::methods::pcss` (with `methods::pcf`'s box).
 //! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl`,
 //!   `shadow_mapping.wgsl` and `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
@@ -40,6 +43,7 @@ mod eye;
 mod from_depth;
 mod from_meshes;
 mod gather;
+mod pcss;
 mod raster;
 mod readback;
 #[cfg(test)]

@@ -8,6 +8,7 @@ use super::gather::{
     module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, PointsParams, RowSpan,
     BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
+use super::pcss::{Coord, GpuPcssPoint, PcssChunk, PcssParams, SOURCE as PCSS_SOURCE};
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
 use super::shadow_mapping::{GpuBlurPixel, GpuSmPoint, GpuSmTri, SmParams, SOURCE as SM_SOURCE};
 use super::smoothies::{
@@ -26,6 +27,7 @@ fn modules() -> Vec<(&'static str, String)> {
         ("exact.wgsl + eye_rays.wgsl", RAYS_SOURCE.to_string()),
         ("smoothies.wgsl", SMOOTHIES_SOURCE.to_string()),
         ("shadow_mapping.wgsl", SM_SOURCE.to_string()),
+        ("pcss.wgsl", PCSS_SOURCE.to_string()),
     ]
 }
 
@@ -48,6 +50,7 @@ fn every_wgsl_file_is_used_by_a_module() {
         RAYS_SOURCE,
         SMOOTHIES_SOURCE,
         SM_SOURCE,
+        PCSS_SOURCE,
     ];
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -430,6 +433,53 @@ fn shadow_mapping_structs_have_the_same_layout_in_rust_and_wgsl() {
             z,
             tol,
             surface
+        }),
+    );
+}
+
+#[test]
+fn pcss_structs_have_the_same_layout_in_rust_and_wgsl() {
+    assert_same(
+        PCSS_SOURCE,
+        "PcssParams",
+        rust_layout!(PcssParams {
+            n,
+            mode,
+            out_w,
+            rec_offset,
+            occ_w,
+            occ_h,
+            front_offset,
+            front_len,
+            taps,
+            rows_per_chunk,
+            half_per_w_x,
+            half_per_w_y
+        }),
+    );
+    assert_same(
+        PCSS_SOURCE,
+        "PcssChunk",
+        rust_layout!(PcssChunk {
+            chunk,
+            _pad0,
+            _pad1,
+            _pad2
+        }),
+    );
+    assert_same(PCSS_SOURCE, "Coord", rust_layout!(Coord { base, frac }));
+    assert_same(
+        PCSS_SOURCE,
+        "PcssPoint",
+        rust_layout!(GpuPcssPoint {
+            bx,
+            fx,
+            by,
+            fy,
+            z,
+            live,
+            _pad0,
+            _pad1
         }),
     );
 }

@@ -221,9 +221,9 @@ pub fn methods() -> Vec<MethodInfo> {
             config: "Pcss",
             summary: "Percentage-closer soft shadows (Fernando 2005), what real-time engines \
                       ship: a blocker search on the shadow map, the penumbra estimated from the \
-                      mean blocker depth, a box PCF of that width; CPU only in this version",
+                      mean blocker depth, a box PCF of that width",
             reads: vec![Input::OccluderLayers],
-            backends: vec![Backend::Cpu],
+            backends: backends.clone(),
             options: vec![
                 OptionInfo {
                     name: "max_taps",

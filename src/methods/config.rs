@@ -406,19 +406,6 @@ pub fn auto_rule(resolution: (usize, usize)) -> SsmConfig {
     }
 }
 
-/// The methods the GPU backend has no kernels for yet.
-fn cpu_only(ctx: &CallContext, name: &str) -> Result<()> {
-    if ctx.backend == Backend::Gpu {
-        return Err(Error::invalid(
-            "backend",
-            format!(
-                "{name:?} runs on the CPU only in this version; use backend=\"cpu\" (or \"auto\")"
-            ),
-        ));
-    }
-    Ok(())
-}
-
 /// Options shared by the occluder-map methods, resolved for a call.
 fn resolve_maps(
     passes: Option<u32>,
@@ -703,7 +690,6 @@ impl MethodConfig {
                 })
             }
             MethodConfig::Pcss(c) => {
-                cpu_only(ctx, "pcss")?;
                 // From depth maps: the front layer the user gave.
                 let (_, occ, _) = resolve_maps(
                     Some(1),

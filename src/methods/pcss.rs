@@ -118,6 +118,26 @@ fn size_component(l: f64) -> f64 {
     }
 }
 
+/// L/2 per axis divided by the texel's tangent width on `grid`, light sizes
+/// as the kernel reads them (`size_component`): (1/z - 1/z_r) times this is
+/// a box's half-width in texels. The GPU twin (src/gpu/pcss.rs) reads the same.
+pub(crate) fn half_per_w(grid: &MapGrid, light_size: [f64; 2]) -> [f64; 2] {
+    let (hx, hy) = grid.half_texel();
+    let [lu, lv] = light_size.map(size_component);
+    // (L/2) / (2 half-texel)
+    [0.25 * lu / hx, 0.25 * lv / hy]
+}
+
+/// The nearest occluder depth of a front layer (inf when it holds none):
+/// the search box's reach. The GPU twin reduces the same f32 minimum.
+pub(crate) fn nearest_depth(front: &[f32]) -> f32 {
+    front
+        .par_iter()
+        .copied()
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .reduce(|| f32::INFINITY, f32::min)
+}
+
 impl<'a> Kernel<'a> {
     /// None when the map is missing or does not fit its grid: nothing occludes.
     fn new(inputs: &'a ShadowInputs, max_taps: u32) -> Option<Kernel<'a>> {
@@ -126,19 +146,12 @@ impl<'a> Kernel<'a> {
         if front.len() != grid.len() || grid.is_empty() {
             return None;
         }
-        let z_near = front
-            .par_iter()
-            .copied()
-            .filter(|d| d.is_finite() && *d > 0.0)
-            .reduce(|| f32::INFINITY, f32::min);
-        let (hx, hy) = grid.half_texel();
-        let [lu, lv] = inputs.light_size.map(size_component);
+        let z_near = nearest_depth(front);
         Some(Kernel {
             grid,
             front,
             z_near,
-            // (L/2) / (2 half-texel)
-            half_per_w: [0.25 * lu / hx, 0.25 * lv / hy],
+            half_per_w: half_per_w(&grid, inputs.light_size),
             max_taps,
         })
     }

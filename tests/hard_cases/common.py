@@ -23,7 +23,8 @@ __all__ = [
 _CAPS = ss.capabilities()
 # Every light-view method that runs on every backend of this build ("auto"
 # is a rule that resolves to one of them; a method that reads a camera has
-# the eye view only). A CPU-only method has its hard cases in
+# the eye view only). Its GPU twin is what lets a method join these lists; a
+# CPU-only method has its hard cases in
 # tests/test_shadow_mapping.py until its GPU twin joins these lists.
 _ALL = set(_CAPS["ssm"].backends)
 METHODS = tuple(

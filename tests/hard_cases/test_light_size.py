@@ -136,5 +136,7 @@ def test_huge_light_from_meshes_follows_the_closed_form(method, backend):
         return
     # exact: the back-projection (0.04 of the light's side) meets at most 2 x 2
     # of its 16 x 16 strata, so at most 4 of 256 samples are wrong.
-    tol = {"ssm": 1e-4, "bitmask": 0.01, "exact": 4 / 256}[method]
+    # pcss: one plate at one depth, its filter box the back-projection
+    # (measured 2.7e-8).
+    tol = {"ssm": 1e-4, "bitmask": 0.01, "exact": 4 / 256, "pcss": 1e-6}[method]
     assert np.abs(sm.visibility - want).max() <= tol

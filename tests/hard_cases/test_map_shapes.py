@@ -97,7 +97,7 @@ def test_thin_maps_from_meshes(method, backend, resolution):
         hw, hh = 0.5 / w, 0.5 / h
         xs, ys = x[np.abs(x) < 0.25], y[np.abs(y) < 0.25]
         rect = (xs.min() - hw, xs.max() + hw, ys.min() - hh, ys.max() + hh)
-        bound = plate.bound(method)
+        bound = plate.bound(method, plate.box_texels(1.0, 2.0, 4.0, 1.0 / max(w, h)))
     want = plate.visibility(x[None, :], y[:, None], rect, 2.0, 4.0, 1.0, 1.0)
     assert np.abs(sm.visibility - want).max() <= bound
     if resolution == 1:  # its one texel looks at the plate's center: umbra

