@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     for name in a.scenes:
         scene, light = scenes.SCENES[name]()
         fns = {
-            t: (lambda t=t, s=scene, li=light: ss.soft_shadow_map(s, li, resolution=256, method=ss.Pcss(max_taps=t)))
+            t: (lambda t=t, s=scene, li=light: ss.soft_shadow_map(s, li, resolution=256, method=ss.PCSS(max_taps=t)))
             for t in a.taps
         }
         sec, outs = alternate(fns, a.repeats)
@@ -71,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
         scene, light, cam = make((320, 240))
         ref = ss.render(scene, light, cam, method=ss.Exact(samples=256))
         fns = {
-            t: (lambda t=t, s=scene, li=light, c=cam: ss.render(s, li, c, method=ss.Pcss(max_taps=t))) for t in a.taps
+            t: (lambda t=t, s=scene, li=light, c=cam: ss.render(s, li, c, method=ss.PCSS(max_taps=t))) for t in a.taps
         }
         sec, outs = alternate(fns, a.repeats)
         cells = [
@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
         report.write(
             a.out,
             intro=(
-                f"`ss.Pcss(max_taps=m)`: at most m × m taps per stage per point. Medians of {runs(a.repeats)}, "
+                f"`ss.PCSS(max_taps=m)`: at most m × m taps per stage per point. Medians of {runs(a.repeats)}, "
                 "end to end from the meshes, the tap counts taken alternately in one run. Light-view errors: "
                 "the paper's §4.2.1 metric against 1024-sample Mitsuba maps; eye-view errors: mean |V - V_ref| "
                 "over the visible pixels against 256-sample `exact`."

@@ -72,7 +72,7 @@ METHODS = {
     "exact": ss.Exact(samples=256),
     "ssm": ss.Ssm(),
     "bitmask": ss.Bitmask(samples=256),
-    "pcss": ss.Pcss(),
+    "pcss": ss.PCSS(),
     "smoothies": ss.Smoothies(),
     "shadow_mapping": ss.ShadowMapping(),
     "shadow_mapping_pcf": ss.ShadowMapping(filter=ss.PCF(size=3), bias=ss.SlopeScaleBias(slope=4)),
@@ -149,7 +149,7 @@ def test_pcss_penumbrae_are_what_brings_it_near_mitsuba(references):
     on the torus, whose penumbrae are wide, that at least doubles its error
     against Mitsuba (measured: 0.0218, four times MEASURED)."""
     scene, light, cam, ref = references["torus"]
-    one = compare_images(ss.render(scene, light, cam, method=ss.Pcss(max_taps=1)), ref).mean_abs
+    one = compare_images(ss.render(scene, light, cam, method=ss.PCSS(max_taps=1)), ref).mean_abs
     assert one > 2 * MEASURED["torus"]["pcss"]
 
 

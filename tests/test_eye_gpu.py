@@ -200,7 +200,7 @@ def test_gpu_pcss_render_is_the_cpu_render(gpu, scene, camera, light_name, max_t
     where f32 rounding moves a box end across a texel edge (at most 0.2% of
     the matching pixels)."""
     light = LIGHTS[light_name]
-    method = ss.Pcss(max_taps=max_taps)
+    method = ss.PCSS(max_taps=max_taps)
     cpu = ss.render(scene, light, camera, method=method, backend="cpu")
     img = ss.render(scene, light, camera, method=method, backend="gpu")
     assert img.backend == "gpu" and cpu.backend == "cpu"

@@ -266,7 +266,7 @@ def assert_pcss_agrees(c, g, name: str) -> None:
 @pytest.mark.parametrize("name", SCENES)
 def test_gpu_pcss_matches_cpu_on_the_scenes(gpu, name, max_taps):
     scene, light = getattr(scenes, name)()
-    method = ss.Pcss(max_taps=max_taps)
+    method = ss.PCSS(max_taps=max_taps)
     c = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=method, backend="cpu")
     g = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=method, backend="gpu")
     assert g.backend == "gpu" and repr(g.method) == repr(c.method)
@@ -281,7 +281,7 @@ def test_gpu_pcss_matches_cpu_on_the_scenes(gpu, name, max_taps):
 def test_gpu_pcss_with_coarser_and_finer_occluder_maps(gpu):
     scene, light = scenes.torus_floating()
     for occ in (32, (160, 128)):
-        method = ss.Pcss(max_taps=12, occluder_resolution=occ)
+        method = ss.PCSS(max_taps=12, occluder_resolution=occ)
         kw = dict(resolution=(80, 64), extent=(0.6, 0.5), method=method)
         c = ss.soft_shadow_map(scene, light, backend="cpu", **kw)
         g = ss.soft_shadow_map(scene, light, backend="gpu", **kw)
@@ -293,7 +293,7 @@ def test_gpu_pcss_with_coarser_and_finer_occluder_maps(gpu):
 def test_gpu_pcss_from_depth_maps_matches_cpu(gpu):
     scene, light = scenes.bunny_floating()
     sm = ss.soft_shadow_map(scene, light, resolution=(48, 40), occluder_resolution=64, passes=1)
-    for method in (ss.Pcss(), ss.Pcss(max_taps=3)):
+    for method in (ss.PCSS(), ss.PCSS(max_taps=3)):
         kw = dict(light_size=light.size, extent=sm.extent, method=method)
         c = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="cpu", **kw)
         g = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="gpu", **kw)

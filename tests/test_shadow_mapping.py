@@ -278,7 +278,7 @@ def test_pcss_and_smoothies_stay_near_the_soft_shadow(name):
     scene, light, cam = EYE_SCENES[name](RES)
     ref = ss.render(scene, light, cam, method=ss.Exact(samples=256))
     m = ref.mask
-    for meth in [ss.Pcss(), ss.Smoothies()]:
+    for meth in [ss.PCSS(), ss.Smoothies()]:
         img = ss.render(scene, light, cam, method=meth)
         err = float(np.abs(img.visibility - ref.visibility)[m].mean())
         assert err < 4 / 3 * MEASURED_SOFT[name][meth.name], (name, meth, err)
@@ -293,7 +293,7 @@ MEASURED_SOFT: dict[str, dict[str, float]] = {
 }
 
 
-@pytest.mark.parametrize("method", [ss.Pcss(), ss.Smoothies(), ss.Pcss(max_taps=2), ss.Smoothies(width=16.0)])
+@pytest.mark.parametrize("method", [ss.PCSS(), ss.Smoothies(), ss.PCSS(max_taps=2), ss.Smoothies(width=16.0)])
 def test_light_view_hard_cases_of_pcss_and_smoothies(method):
     """Degenerate, open and non-manifold occluders, a point light, a huge
     light, a grazing one and occluders touching the floor: finite, in [0, 1],

@@ -15,6 +15,7 @@ from .errors import GpuUnavailableError, TooLargeError
 from .light import DirectionalLight, RectLight
 from .methods import (
     PCF,
+    PCSS,
     Auto,
     BackFaces,
     Bitmask,
@@ -27,7 +28,6 @@ from .methods import (
     MethodInfo,
     MidpointBias,
     OptionInfo,
-    Pcss,
     ShadowMapping,
     SlopeScaleBias,
     Smoothies,
@@ -60,7 +60,7 @@ __all__ = [
     "MethodConfig",
     "MethodInfo",
     "OptionInfo",
-    "Pcss",
+    "PCSS",
     "RectLight",
     "Scene",
     "ShadowMap",

@@ -18,7 +18,7 @@ __all__ = [
     "Bitmask",
     "Exact",
     "Auto",
-    "Pcss",
+    "PCSS",
     "Smoothies",
     "ShadowMapping",
     "ConstantBias",
@@ -214,10 +214,10 @@ class EyeSpaceBlur:
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
 
 @final
-class Pcss:
+class PCSS:
     """Percentage-closer soft shadows (Fernando 2005)."""
 
-    def __new__(cls, *, max_taps: int | None = None, occluder_resolution: _Resolution | None = None) -> Pcss: ...
+    def __new__(cls, *, max_taps: int | None = None, occluder_resolution: _Resolution | None = None) -> PCSS: ...
     @property
     def name(self) -> str: ...
     @property
@@ -297,7 +297,7 @@ class Auto:
         """The ``Ssm`` the rule picks for an output resolution, from meshes."""
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
 
-_MethodArg = str | Ssm | Bitmask | Exact | Auto | Pcss | Smoothies | ShadowMapping
+_MethodArg = str | Ssm | Bitmask | Exact | Auto | PCSS | Smoothies | ShadowMapping
 
 @final
 class Camera:
@@ -411,7 +411,7 @@ class MeshShadowResult:
     @property
     def timings(self) -> dict[str, float]: ...
     @property
-    def method(self) -> Ssm | Bitmask | Exact | Pcss | Smoothies | ShadowMapping: ...
+    def method(self) -> Ssm | Bitmask | Exact | PCSS | Smoothies | ShadowMapping: ...
     @property
     def backend(self) -> str: ...
     @property
@@ -442,7 +442,7 @@ class EyeResult:
     @property
     def timings(self) -> dict[str, float]: ...
     @property
-    def method(self) -> Ssm | Bitmask | Exact | Pcss | Smoothies | ShadowMapping: ...
+    def method(self) -> Ssm | Bitmask | Exact | PCSS | Smoothies | ShadowMapping: ...
     @property
     def backend(self) -> str: ...
     @property
@@ -479,7 +479,7 @@ class DepthShadowResult:
     @property
     def timings(self) -> dict[str, float]: ...
     @property
-    def method(self) -> Ssm | Bitmask | Exact | Pcss | Smoothies | ShadowMapping: ...
+    def method(self) -> Ssm | Bitmask | Exact | PCSS | Smoothies | ShadowMapping: ...
     @property
     def backend(self) -> str: ...
     @property

@@ -14,6 +14,7 @@ from typing import Any
 from . import _core
 from ._core import (
     PCF,
+    PCSS,
     Auto,
     BackFaces,
     Bitmask,
@@ -25,14 +26,13 @@ from ._core import (
     MethodInfo,
     MidpointBias,
     OptionInfo,
-    Pcss,
     ShadowMapping,
     SlopeScaleBias,
     Smoothies,
     Ssm,
 )
 
-MethodConfig = Ssm | Bitmask | Exact | Auto | Pcss | ShadowMapping | Smoothies
+MethodConfig = Ssm | Bitmask | Exact | Auto | PCSS | ShadowMapping | Smoothies
 """Any method config."""
 
 
@@ -66,7 +66,7 @@ __all__ = [
     "MethodInfo",
     "MidpointBias",
     "OptionInfo",
-    "Pcss",
+    "PCSS",
     "ShadowMapping",
     "SlopeScaleBias",
     "Smoothies",

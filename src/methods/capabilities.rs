@@ -218,7 +218,7 @@ pub fn methods() -> Vec<MethodInfo> {
         },
         MethodInfo {
             name: "pcss",
-            config: "Pcss",
+            config: "PCSS",
             summary: "Percentage-closer soft shadows (Fernando 2005), what real-time engines \
                       ship: a blocker search on the shadow map, the penumbra estimated from the \
                       mean blocker depth, a box PCF of that width",

@@ -532,7 +532,7 @@ impl MethodConfig {
             }
             "pcss" => {
                 if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
-                    return refuse(opt, "other methods; give Pcss(...) its own options");
+                    return refuse(opt, "other methods; give PCSS(...) its own options");
                 }
                 MethodConfig::Pcss(PcssConfig::new(None, o.occluder_resolution)?)
             }

@@ -314,7 +314,7 @@ pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<Meth
     }
     if method.extract::<String>().is_err() {
         return Err(PyTypeError::new_err(format!(
-            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, Pcss, Smoothies, ShadowMapping), got {}",
+            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, PCSS, Smoothies, ShadowMapping), got {}",
             method.get_type().name()?
         )));
     }

@@ -564,7 +564,7 @@ impl PySmoothies {
 }
 
 /// PCSS (Fernando 2005). See ``capabilities()["pcss"]``.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Pcss")]
+#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "PCSS")]
 #[derive(Clone, PartialEq, Eq, Hash)]
 pub struct PyPcss(pub PcssConfig);
 
@@ -613,7 +613,7 @@ impl PyPcss {
             .map(|(w, h)| format!("({w}, {h})"))
             .unwrap_or_else(|| "None".into());
         format!(
-            "Pcss(max_taps={}, occluder_resolution={r})",
+            "PCSS(max_taps={}, occluder_resolution={r})",
             self.0.max_taps
         )
     }

@@ -29,10 +29,10 @@ import numpy as np
 
 from .. import (
     PCF,
+    PCSS,
     Bitmask,
     Exact,
     EyeSpaceBlur,
-    Pcss,
     ShadowMapping,
     SlopeScaleBias,
     Smoothies,
@@ -55,8 +55,8 @@ CALLS: list[tuple[str, str, Any]] = [
     ("bitmask", "bitmask 256", Bitmask(samples=256)),
     ("exact", "exact 16", Exact(samples=16)),
     ("exact", "exact 64", Exact(samples=64)),
-    ("pcss", "pcss", Pcss()),
-    ("pcss", "pcss, 8 taps", Pcss(max_taps=8)),
+    ("pcss", "pcss", PCSS()),
+    ("pcss", "pcss, 8 taps", PCSS(max_taps=8)),
     ("smoothies", "smoothies", Smoothies()),
     ("shadow map", "shadow map", ShadowMapping()),
     ("shadow map, PCF", "shadow map, PCF 3", ShadowMapping(filter=PCF(size=3), bias=SlopeScaleBias(slope=4))),

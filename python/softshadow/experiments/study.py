@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import Auto, Pcss, Smoothies, metrics, scenes
+from .. import PCSS, Auto, Smoothies, metrics, scenes
 from ..light import RectLight
 from ..scene import Scene
 from ..shadow_map import ShadowMap, soft_shadow_map
@@ -126,7 +126,7 @@ class Study:
         # The other two papers' light-view methods (ShadowMapping has no
         # light view: it is focused, warped and blurred for a camera).
         for occ in occ_levels:
-            measure("pcss", f"occluders {occ}²", method=Pcss(occluder_resolution=occ))
+            measure("pcss", f"occluders {occ}²", method=PCSS(occluder_resolution=occ))
         for w in (0.5, 1.0) if not self.quick else (0.5,):
             measure("smoothies", f"width {w}, occluders {res}²", method=Smoothies(width=w))
         rscene = self.reference.ReferenceScene(scene.occluders)
