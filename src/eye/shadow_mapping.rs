@@ -68,7 +68,7 @@ fn projection(
         );
     let body = if cfg.focus {
         // Just past the farthest seen surface (f32 depths, rounded down).
-        view_body(cam, bounds, zn.is_finite().then(|| zf * (1.0 + 1e-5)))
+        view_body(cam, bounds, zn.is_finite().then_some(zf * (1.0 + 1e-5)))
     } else {
         vec![]
     };
