@@ -289,7 +289,7 @@ mod tests {
         // context: ssm is held to 1e-5 (f32 sums), the 256-sample bitmask to
         // 0.25 (its pattern's resolution).
         for n in [64, 128] {
-            let max = plate_case::max_error(&Pcss::default(), n);
+            let max = plate_case::max_error(&Pcss { max_taps: 32 }, n);
             assert!(max < 1e-6, "{n}²: max error {max}");
         }
         // Fewer taps than the box's texels: stratified, an error of the
@@ -371,7 +371,7 @@ mod tests {
             assert!(max < 1e-4, "zr {zr}, every texel: {max}");
             // 32 taps: exact at zr 3; at zr 6 (43 texels) stratified, a
             // fraction of a stratum's share 1/32 (measured 0.00375).
-            let (v, max) = error(Pcss::default());
+            let (v, max) = error(Pcss { max_taps: 32 });
             assert!(max < 0.25 / 32.0, "zr {zr}, 32 taps: {max}");
             let partial: Vec<f64> = ts
                 .iter()

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+import softshadow as ss
+
 # The bitmask places each of a rectangle's 4 edges to one fine stratum of its
 # multi-jittered pattern: at most 4 x 16 of 256 samples (as in bitmask.rs).
 BITMASK_BOUND = 4 * 16 / 256
@@ -21,11 +23,14 @@ SSM_BOUND = 2e-5
 # PCSS over one plate: every blocker has its depth, so the filter box is the
 # back-projection and, the plate on texel edges, the box filter is exact to
 # rounding (measured <= 2.4e-7 on both backends) while a box spans at most
-# max_taps (32) texels per axis. A wider box is sampled by 32 strata per
-# axis (pcss.rs): an error of the order of a stratum's share at an edge
-# (measured 0.0038 for a plate at 0.5 from the light, 0.0145 on a 2000x1 map).
+# max_taps (the default, PCSS_TAPS) texels per axis. A wider box is sampled by
+# that many strata per axis, one tap at each stratum's centre (pcss.rs): a
+# step inside a stratum is off by at most half the stratum's share, 0.5/m
+# (measured with 32 taps: 0.0038 for a plate at 0.5 from the light, 0.0145
+# on a 2000x1 map; with 16: 0.030 there).
 PCSS_BOUND = 1e-6
-PCSS_WIDE_BOUND = 0.5 / 32
+PCSS_TAPS = int(ss.capabilities()["pcss"].options["max_taps"].default)
+PCSS_WIDE_BOUND = 0.5 / PCSS_TAPS
 
 
 def visibility(x, y, rect, zo, zr, lx, ly):
@@ -62,8 +67,8 @@ def maps(w: int, h: int, ext, rect, zo, zr):
 
 def bound(method: str, box_texels: float = 0.0) -> float:
     """The method's bound on a plate; ``box_texels``: the widest penumbra,
-    in texels (pcss samples boxes wider than 32 texels by strata)."""
-    if method == "pcss" and box_texels > 32:
+    in texels (pcss samples boxes wider than PCSS_TAPS texels by strata)."""
+    if method == "pcss" and box_texels > PCSS_TAPS:
         return PCSS_WIDE_BOUND
     return {"ssm": SSM_BOUND, "bitmask": BITMASK_BOUND, "pcss": PCSS_BOUND}[method]
 

@@ -70,7 +70,8 @@ def test_thin_maps_from_depth(map_method, backend, shape):
     x0 = x[cols].min() - ext[0] / w if cols.any() else 0.0
     x1 = x[cols].max() + ext[0] / w if cols.any() else 0.0
     want = plate.visibility(x[None, :], y[:, None], (x0, x1, -ext[1], ext[1]), 2.5, 4.0, 0.5, 0.5)
-    assert np.abs(v - want).max() <= plate.bound(map_method)
+    box = plate.box_texels(0.5, 2.5, 4.0, 2 * min(ext[0] / w, ext[1] / h))
+    assert np.abs(v - want).max() <= plate.bound(map_method, box)
 
 
 @pytest.mark.parametrize("resolution", [1, (1, 40), (40, 1), (2000, 1)])
