@@ -213,12 +213,17 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         check_side("map_resolution", (grid.width, grid.height))?;
         sw.lap("extent");
         let tris = eye::light_triangles(&mut f, &scene);
-        let (v, m, t) = match method.kernel() {
-            // PCSS's own kernel (pcss.rs), on the front layer.
-            Method::Pcss { max_taps } => {
+        let kernel = method.kernel();
+        let (v, m, t) = match (kernel, super::smoothies::options(kernel)) {
+            // The one-layer methods' own kernels after the front layer
+            // (front_layer.rs).
+            (Method::Pcss { max_taps }, _) => {
                 super::pcss::shade_points(g, &f, &tris, grid, max_taps, &call.bias, &mut sw)?
             }
-            kernel => shade_maps(
+            (_, Some(s)) => {
+                super::smoothies::shade_eye(g, &f, &tris, grid, &s, &call.bias, &mut sw)?
+            }
+            (kernel, None) => shade_maps(
                 g,
                 &f,
                 &tris,
@@ -604,10 +609,6 @@ fn shade_maps(
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    // Smoothies: their own buffer and lookup (smoothies.rs).
-    if let Some(s) = super::smoothies::options(method) {
-        return super::smoothies::shade_eye(g, f, tris, grid, &s, bias, sw);
-    }
     let layer_len = grid.len();
     let texels = passes as u64 * layer_len as u64;
     if texels >= u32::MAX as u64 {

@@ -42,6 +42,7 @@ mod exact;
 mod eye;
 mod from_depth;
 mod from_meshes;
+mod front_layer;
 mod gather;
 mod pcss;
 mod raster;

@@ -17,17 +17,15 @@
 
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, upload};
-use super::raster::{GpuTri, RasterInput};
-use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::front_layer::{AfterFront, FrontLayer};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::maps::{self, LightTriangles};
+use crate::eye::maps::LightTriangles;
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
 use crate::methods::pcss::{half_per_w, MAX_TAPS};
 use crate::methods::LightPoint;
 use crate::pipeline::{Stopwatch, Timings};
-use crate::raster::setup_triangles;
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -394,68 +392,30 @@ pub(crate) fn shade_points(
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let layer_len = grid.len();
-    let maps_bytes = layer_len as u64 * 4;
-    if layer_len as u64 >= u32::MAX as u64 || maps_bytes > g.max_storage_binding {
-        return Err(Error::too_large(
-            "map_resolution",
-            format!(
-                "the front layer needs {maps_bytes} bytes in one GPU buffer; the device binds \
-                 at most {}; use backend=\"cpu\"",
-                g.max_storage_binding
-            ),
-        ));
-    }
-    // maps::occluder_layers' near plane and front layer.
-    let near = crate::pipeline::near_plane(&tris.verts);
-    let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, tris.faces, near)
-        .iter()
-        .map(GpuTri::from_setup)
-        .collect();
-    let sp = maps::shading_points(
-        &f.space,
-        f.unit,
-        f.light_size,
-        &grid,
-        &f.points,
-        &f.pts_ls,
-        &f.normals,
-        bias,
-    );
+    let front = FrontLayer::new(g, f, tris, grid, bias)?;
     sw.lap("setup");
-    let out = with_error_scopes(g, || {
-        let device = &g.device;
-        let maps_buf = storage(device, "maps", maps_bytes, wgpu::BufferUsages::COPY_SRC);
-        let raster = RasterInput::upload(g, &[], &occ_tris);
-        let sh = PcssShading::points(g, &grid, f.light_size, max_taps, 0, &sp.points)?;
-        sw.lap("upload");
-        let timer = StageTimer::new(g, 2);
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("softshadow eye pcss"),
-        });
-        raster.record_occluders(g, &mut enc, &timer, &maps_buf, 0, &grid, 1);
-        sh.record(g, &mut enc, &timer, &maps_buf);
-        submit_and_read(
-            g,
-            enc,
-            &timer,
-            &[(&maps_buf, maps_bytes), (&sh.vis, sh.vis_bytes)],
-            sw,
-        )
-    })?;
-    let mut v = visibility(&out.buffers[1])?;
-    // As maps::shade.
-    maps::finish(&mut v, &sp.bound);
-    let front = words(&out.buffers[0])
-        .par_iter()
-        .map(|&b| maps::user_depth(&f.space, f.unit, f32::from_bits(b)))
-        .collect();
-    Ok((
-        v,
-        EyeMaps {
-            grid,
-            layers: vec![front],
-        },
-        out.device_timings,
-    ))
+    let (grid, points) = (front.grid, front.points.points.clone());
+    front.shade(
+        g,
+        f,
+        "softshadow eye pcss",
+        2,
+        || PcssShading::points(g, &grid, f.light_size, max_taps, 0, &points),
+        sw,
+    )
+}
+
+impl AfterFront for PcssShading {
+    fn record(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+    ) {
+        PcssShading::record(self, g, enc, timer, maps)
+    }
+    fn visibility(&self) -> (&wgpu::Buffer, u64) {
+        (&self.vis, self.vis_bytes)
+    }
 }

@@ -67,15 +67,7 @@ const GROUP: u32 = 64u;
 @group(0) @binding(3) var<uniform> fill_params: FillParams;
 @group(0) @binding(4) var<storage, read> tiles: array<Tile>;
 
-// The exact product of two i32 as a signed 64-bit integer (vec2(lo, hi),
-// two's complement; add64, neg64 and mul32 come from u64.wgsl).
-fn mul64(a: i32, b: i32) -> vec2<u32> {
-    let r = mul32(u32(abs(a)), u32(abs(b)));
-    if (a < 0) != (b < 0) {
-        return neg64(r);
-    }
-    return r;
-}
+// add64, neg64 and imul64 (the exact signed product) come from u64.wgsl.
 
 // e + bias > 0 for bias in {0, 1}: e > 0, or e == 0 when the edge owns ties.
 fn inside64(e: vec2<u32>, owns_ties: bool) -> bool {
@@ -138,7 +130,7 @@ fn raster(@builtin(global_invocation_id) gid: vec3<u32>,
         dx[k] = t.x[e] - t.x[s];
         dy[k] = t.y[e] - t.y[s];
         owns[k] = owns_ties(dx[k], dy[k]);
-        step[k] = mul64(-dy[k], ONE);
+        step[k] = imul64(-dy[k], ONE);
     }
     let cx0 = i32(tile.i0) * ONE + ONE / 2;
     for (var j = tile.j0; j <= tile.j1; j++) {
@@ -146,7 +138,7 @@ fn raster(@builtin(global_invocation_id) gid: vec3<u32>,
         var e: array<vec2<u32>, 3>;
         for (var k = 0u; k < 3u; k++) {
             let s = (k + 1u) % 3u;
-            e[k] = add64(mul64(dx[k], cy - t.y[s]), neg64(mul64(dy[k], cx0 - t.x[s])));
+            e[k] = add64(imul64(dx[k], cy - t.y[s]), neg64(imul64(dy[k], cx0 - t.x[s])));
         }
         let row = j * params.width;
         for (var i = tile.i0; i <= tile.i1; i++) {

@@ -99,18 +99,9 @@ fn is_finite(x: f32) -> bool {
     return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
 }
 
-// The exact product of two i32 as a signed 64-bit integer (vec2(lo, hi)).
-fn smul64(a: i32, b: i32) -> vec2<u32> {
-    let r = mul32(u32(abs(a)), u32(abs(b)));
-    if (a < 0) != (b < 0) {
-        return neg64(r);
-    }
-    return r;
-}
-
 // raster.rs's edge(a, b, q) > 0, or == 0 where the edge owns ties.
 fn inside_edge(ax: i32, ay: i32, bx: i32, by: i32, qx: i32, qy: i32) -> bool {
-    let e = add64(smul64(bx - ax, qy - ay), neg64(smul64(by - ay, qx - ax)));
+    let e = add64(imul64(bx - ax, qy - ay), neg64(imul64(by - ay, qx - ax)));
     let hi = bitcast<i32>(e.y);
     if hi != 0 {
         return hi > 0;

@@ -26,18 +26,19 @@
 
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
-use super::raster::{GpuTri, RasterInput, NONE};
-use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::front_layer::{AfterFront, FrontLayer};
+use super::raster::NONE;
+#[cfg(test)]
+use super::readback::{submit_and_read, with_error_scopes};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::maps::{self, LightTriangles};
+use crate::eye::maps::LightTriangles;
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
 use crate::methods::smoothies::method::soup;
 use crate::methods::smoothies::{Falloff, Shape, Smoothies};
 use crate::methods::{LightPoint, Method};
 use crate::pipeline::{light_space_triangles, Stopwatch, Timings};
-use crate::raster::setup_triangles;
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -600,22 +601,6 @@ pub fn prepare_light_view(
     Ok(p)
 }
 
-/// Refuses a shadow map that one binding cannot hold.
-fn check_fits(g: &Gpu, og: &MapGrid) -> Result<()> {
-    let bytes = og.len() as u64 * 4;
-    if og.len() as u64 >= u32::MAX as u64 || bytes > g.max_storage_binding {
-        return Err(Error::too_large(
-            "map_resolution",
-            format!(
-                "the shadow map needs {bytes} bytes in one GPU buffer; the device binds at most {}; \
-                 use backend=\"cpu\"",
-                g.max_storage_binding
-            ),
-        ));
-    }
-    Ok(())
-}
-
 /// The eye view's Smoothies on the device (`maps::shade`'s Smoothies arm):
 /// the front layer of every mesh on `grid` (raster.wgsl), the smoothies of
 /// the scene's silhouette (CPU), the buffer and the lookup at the biased
@@ -629,65 +614,42 @@ pub(super) fn shade_eye(
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    check_fits(g, &grid)?;
-    // maps::occluder_layers' near plane and set-up: one front layer.
-    let near = crate::pipeline::near_plane(&tris.verts);
-    let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, tris.faces, near)
-        .iter()
-        .map(GpuTri::from_setup)
-        .collect();
-    let sp = maps::shading_points(
-        &f.space,
-        f.unit,
-        f.light_size,
-        &grid,
-        &f.points,
-        &f.pts_ls,
-        &f.normals,
-        bias,
-    );
+    let front = FrontLayer::new(g, f, tris, grid, bias)?;
     // Every mesh is an occluder: the silhouette straight from the mesh.
     let prepared = Prepared::new(s, &grid, f.light_size, &tris.verts, tris.faces, PER_CHUNK);
     prepared.check_fits(g)?;
-    let tents = point_tents(&grid, &sp.points);
+    let tents = point_tents(&grid, &front.points.points);
     sw.lap("setup");
-    let map_bytes = grid.len() as u64 * 4;
-    let out = with_error_scopes(g, || {
-        let maps_buf = storage(&g.device, "maps", map_bytes, wgpu::BufferUsages::COPY_SRC);
-        let raster = RasterInput::upload(g, &[], &occ_tris);
-        let shading = SmoothieShading::new(g, &prepared, 0, Receivers::Points(&tents));
-        sw.lap("upload");
-        let timer = StageTimer::new(g, 3);
-        let mut enc = g
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("softshadow eye smoothies"),
-            });
-        raster.record_occluders(g, &mut enc, &timer, &maps_buf, 0, &grid, 1);
-        shading.record(g, &mut enc, &timer, &maps_buf);
-        submit_and_read(
-            g,
-            enc,
-            &timer,
-            &[(&maps_buf, map_bytes), (&shading.vis, shading.vis_bytes)],
-            sw,
-        )
-    })?;
-    let mut v = visibility(&out.buffers[1])?;
-    // As maps::shade.
-    maps::finish(&mut v, &sp.bound);
-    let front = words(&out.buffers[0])
-        .par_iter()
-        .map(|&b| maps::user_depth(&f.space, f.unit, f32::from_bits(b)))
-        .collect();
-    Ok((
-        v,
-        EyeMaps {
-            grid,
-            layers: vec![front],
+    front.shade(
+        g,
+        f,
+        "softshadow eye smoothies",
+        3,
+        || {
+            Ok(SmoothieShading::new(
+                g,
+                &prepared,
+                0,
+                Receivers::Points(&tents),
+            ))
         },
-        out.device_timings,
-    ))
+        sw,
+    )
+}
+
+impl AfterFront for SmoothieShading {
+    fn record(
+        &self,
+        g: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        timer: &StageTimer,
+        maps: &wgpu::Buffer,
+    ) {
+        SmoothieShading::record(self, g, enc, timer, maps)
+    }
+    fn visibility(&self) -> (&wgpu::Buffer, u64) {
+        (&self.vis, self.vis_bytes)
+    }
 }
 
 /// Steps 1-4 alone on the device, from a shadow map the caller gives: the

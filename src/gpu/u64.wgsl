@@ -1,7 +1,8 @@
 // 64-bit integers as vec2(lo, hi) of u32 (WGSL has no 64-bit types),
-// shared by raster.wgsl (exact edge functions, signed, two's complement) and
-// exact.wgsl (exact.rs's u64 hash). Each of those modules is this file
-// followed by its own (see SOURCE in raster.rs and exact.rs).
+// shared by raster.wgsl and shadow_mapping.wgsl (exact edge functions,
+// signed, two's complement) and exact.wgsl (exact.rs's u64 hash). Each of
+// those modules is this file followed by its own (see SOURCE in raster.rs,
+// shadow_mapping.rs and exact.rs).
 
 // Wrapping sum.
 fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
@@ -29,4 +30,13 @@ fn mul32(a: u32, b: u32) -> vec2<u32> {
     let lo = p00 + (mid << 16u);
     let hi = p11 + (mid >> 16u) + mid_carry + select(0u, 1u, lo < p00);
     return vec2<u32>(lo, hi);
+}
+
+// The exact product of two i32 as a signed 64-bit integer.
+fn imul64(a: i32, b: i32) -> vec2<u32> {
+    let r = mul32(u32(abs(a)), u32(abs(b)));
+    if (a < 0) != (b < 0) {
+        return neg64(r);
+    }
+    return r;
 }
