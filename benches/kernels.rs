@@ -24,6 +24,7 @@ use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
 use softshadow::backend::{shadow_map, MeshCall};
 use softshadow::geom::mesh::MeshRef;
+use softshadow::methods::bitmask::Gaps;
 use softshadow::methods::ssm::Precision;
 use softshadow::methods::{Method, ShadowInputs};
 use softshadow::pipeline::{light_space_triangles, ShadowResult};
@@ -140,7 +141,7 @@ fn call<'a>(s: &'a Scene, method: MethodConfig) -> MeshCall<'a> {
 }
 
 fn bitmask(hierarchy: bool) -> MethodConfig {
-    MethodConfig::Bitmask(BitmaskConfig::new(Some(256), None, None, Some(hierarchy)).unwrap())
+    MethodConfig::Bitmask(BitmaskConfig::new(Some(256), None, None, Some(hierarchy), None).unwrap())
 }
 
 /// The methods the end-to-end group runs, by bench name.
@@ -234,6 +235,15 @@ fn bench_kernels(c: &mut Criterion) {
             Method::Bitmask {
                 samples: 256,
                 hierarchy: false,
+                gaps: Gaps::Closed,
+            },
+        ),
+        (
+            "bitmask256_open",
+            Method::Bitmask {
+                samples: 256,
+                hierarchy: false,
+                gaps: Gaps::Open,
             },
         ),
         (
@@ -241,6 +251,7 @@ fn bench_kernels(c: &mut Criterion) {
             Method::Bitmask {
                 samples: 256,
                 hierarchy: true,
+                gaps: Gaps::Closed,
             },
         ),
         ("exact64", Method::Exact { samples: 64 }),

@@ -119,10 +119,12 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
         Method::Bitmask {
             samples: 16,
             hierarchy: false,
+            gaps: crate::methods::bitmask::Gaps::Open,
         },
         Method::Bitmask {
             samples: 256,
             hierarchy: false,
+            gaps: crate::methods::bitmask::Gaps::Open,
         },
         Method::Exact { samples: 16 },
     ];

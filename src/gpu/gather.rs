@@ -293,9 +293,9 @@ pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
 /// tables), or None.
 pub fn method_tables(method: Method) -> Option<Vec<u32>> {
     match method {
-        Method::Bitmask { samples, .. } => {
-            Some(crate::methods::bitmask::Bitmask::new(samples, None).rank_tables())
-        }
+        Method::Bitmask { samples, .. } => Some(
+            crate::methods::bitmask::Bitmask::new(samples, Default::default(), None).rank_tables(),
+        ),
         _ => None,
     }
 }

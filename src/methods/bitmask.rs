@@ -5,45 +5,84 @@
 //! overlap the light counts once (the published SSM adds them: too dark in the
 //! outer penumbra, §4.1.2); both occluder layers OR into the same mask.
 //!
-//! The samples form a multi-jittered pattern of n x n points (n = 4, 8 or 16):
-//! one point per cell of an n x n grid, and one per each of the n^2 columns
-//! and n^2 rows of a fine grid. Back-projected micro-patches are axis-aligned
-//! rectangles, so the samples inside [a, b] x [c, d] are those whose x-rank
-//! lies in one range and y-rank in another: four table lookups of
-//! "samples with rank >= k" and three ANDs, and a rectangle's edge is placed
-//! to within 1/n^2 of the light's width. The pattern is the same for every
-//! receiver (deterministic, no noise; its error is structured but small).
+//! The samples form a multi-jittered pattern of n x n points (n = 4, 8, 16
+//! or 32): one point per cell of an n x n grid, and one per each of the n^2
+//! columns and n^2 rows of a fine grid. Back-projected micro-patches are
+//! axis-aligned rectangles, so the samples inside [a, b] x [c, d] are those
+//! whose x-rank lies in one range and y-rank in another: four table lookups
+//! of "samples with rank >= k" and three ANDs, and a rectangle's edge is
+//! placed to within 1/n^2 of the light's width. The pattern is the same for
+//! every receiver (deterministic, no noise; its error is structured but small).
 //!
-//! Not done yet: closing the gaps between neighbouring micro-patches at
-//! different depths (they leak light inside the penumbra, §4.1.2).
+//! Gaps (`Gaps`): with `Closed` (the default) each texel is a micro-quad
+//! whose corners carry the depths that connect it to its neighbours
+//! (`gather/corners.rs`), back-projected as the bounding rectangle of its
+//! four projected corners: no light passes between connected neighbours.
+//! `Open` keeps the flat per-texel micro-patches, whose gaps between
+//! neighbours at different depths leak light inside the penumbra (§4.1.2).
 
 use super::gather::{
     self, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 
-/// A 256-bit set of light samples.
-type Mask = [u64; 4];
+/// A set of up to 64 W light samples.
+type Mask<const W: usize> = [u64; W];
+
+/// Sample counts the method accepts.
+pub const SAMPLE_COUNTS: [u32; 4] = [16, 64, 256, 1024];
+
+/// How neighbouring micro-patches meet (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Gaps {
+    /// Connected micro-quads: no light between connected neighbours.
+    #[default]
+    Closed,
+    /// Flat per-texel micro-patches, as the SSM has them.
+    Open,
+}
+
+impl Gaps {
+    pub const ALL: [Gaps; 2] = [Gaps::Closed, Gaps::Open];
+
+    /// The name a user passes as `gaps=`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Gaps::Closed => "closed",
+            Gaps::Open => "open",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Gaps> {
+        Gaps::ALL.into_iter().find(|g| g.name() == name)
+    }
+}
 
 /// The bitmask method with n x n light samples.
 pub struct Bitmask {
-    pattern: Pattern,
+    pattern: Patterns,
+    gaps: Gaps,
     hierarchy: Option<Hierarchy>,
 }
 
+/// The pattern in the narrowest mask that holds it.
+enum Patterns {
+    /// Up to 256 samples.
+    Small(Pattern<4>),
+    /// 1024 samples.
+    Large(Pattern<16>),
+}
+
 /// The sample pattern as lookup tables of rank prefixes.
-struct Pattern {
+struct Pattern<const W: usize> {
     /// Samples per axis of the coarse grid; n^2 samples in all.
     n: usize,
     /// `x_ge[k]`: the samples whose x-rank is >= k, k in 0..=n^2.
-    x_ge: Vec<Mask>,
-    y_ge: Vec<Mask>,
+    x_ge: Vec<Mask<W>>,
+    y_ge: Vec<Mask<W>>,
 }
 
-/// Sample counts the method accepts.
-pub const SAMPLE_COUNTS: [u32; 3] = [16, 64, 256];
-
-fn set(m: &mut Mask, bit: usize) {
+fn set<const W: usize>(m: &mut Mask<W>, bit: usize) {
     m[bit / 64] |= 1 << (bit % 64);
 }
 
@@ -60,15 +99,16 @@ fn permutation(n: usize, seed: &mut u64) -> Vec<usize> {
     p
 }
 
-impl Pattern {
-    fn new(n: usize) -> Pattern {
+impl<const W: usize> Pattern<W> {
+    fn new(n: usize) -> Pattern<W> {
         let s = n * n;
+        assert!(s <= 64 * W, "{s} samples do not fit {W} words");
         let mut seed = 0x5eed_u64 ^ n as u64;
         // Cell (i, j): x-rank i n + sigma_i(j), y-rank j n + tau_j(i).
         let sigma: Vec<Vec<usize>> = (0..n).map(|_| permutation(n, &mut seed)).collect();
         let tau: Vec<Vec<usize>> = (0..n).map(|_| permutation(n, &mut seed)).collect();
-        let mut x_ge = vec![[0u64; 4]; s + 1];
-        let mut y_ge = vec![[0u64; 4]; s + 1];
+        let mut x_ge = vec![[0u64; W]; s + 1];
+        let mut y_ge = vec![[0u64; W]; s + 1];
         for j in 0..n {
             for i in 0..n {
                 let bit = j * n + i;
@@ -91,17 +131,23 @@ impl Pattern {
     }
 
     /// The full mask (every sample set).
-    fn all(&self) -> Mask {
+    fn all(&self) -> Mask<W> {
         self.x_ge[0]
     }
 
     /// The rank bounds for a micro-patch at d = wO - wR from its receiver.
     #[inline(always)]
     fn bounds(&self, d: f32) -> RankBounds {
+        // For d <= 0 (inv = 0) every bound is S/2 - 1/2: an empty range.
+        self.scaled(if d > 0.0 { 1.0 / d } else { 0.0 })
+    }
+
+    /// Rank bounds of light coordinates already divided by d (inv = 1).
+    #[inline(always)]
+    fn scaled(&self, inv: f32) -> RankBounds {
         let s = self.count() as f32;
         RankBounds {
-            // For d <= 0 (inv = 0) every bound is S/2 - 1/2: an empty range.
-            inv: if d > 0.0 { 1.0 / d } else { 0.0 },
+            inv,
             half: 0.5 * s,
             s,
         }
@@ -111,20 +157,20 @@ impl Pattern {
     /// with kb <= ka, x_ge[ka] is a subset of x_ge[kb] and the band is empty
     /// anyway (and the branch mispredicts).
     #[inline(always)]
-    fn x_band(&self, ka: u16, kb: u16) -> Mask {
+    fn x_band(&self, ka: u16, kb: u16) -> Mask<W> {
         let (a, b) = (&self.x_ge[ka as usize], &self.x_ge[kb as usize]);
         std::array::from_fn(|q| a[q] & !b[q])
     }
 
     #[inline(always)]
-    fn y_band(&self, kc: u16, kd: u16) -> Mask {
+    fn y_band(&self, kc: u16, kd: u16) -> Mask<W> {
         let (c, d) = (&self.y_ge[kc as usize], &self.y_ge[kd as usize]);
         std::array::from_fn(|q| c[q] & !d[q])
     }
 }
 
 #[inline(always)]
-fn and(a: Mask, b: Mask) -> Mask {
+fn and<const W: usize>(a: Mask<W>, b: Mask<W>) -> Mask<W> {
     std::array::from_fn(|q| a[q] & b[q])
 }
 
@@ -156,36 +202,72 @@ impl RankBounds {
     }
 }
 
-impl Bitmask {
-    /// The rank tables as the GPU twin (`gpu/bitmask.wgsl`) reads them: x_ge
-    /// then y_ge, each entry 8 u32 words (bit b of the mask is bit b % 32 of
-    /// word b / 32, as in the u64 words here).
-    #[cfg(feature = "gpu")]
-    pub(crate) fn rank_tables(&self) -> Vec<u32> {
-        let p = &self.pattern;
-        p.x_ge
-            .iter()
-            .chain(&p.y_ge)
-            .flat_map(|m| m.iter().flat_map(|w| [*w as u32, (*w >> 32) as u32]))
-            .collect()
+/// 1/(wc - wR) for a quad corner at 1/depth wc seen from a receiver at wR,
+/// given d = w - wR of the quad's centre: 0 when the centre is not in front
+/// of the receiver (the quad then covers nothing: every bound is the empty
+/// range), the centre's 1/d for a corner at or behind the receiver (the
+/// quad is not stretched toward the receiver's own depth).
+#[inline(always)]
+fn corner_inv(wc: f32, wr: f32, d: f32) -> f32 {
+    let dc = wc - wr;
+    if d > 0.0 {
+        1.0 / if dc > 0.0 { dc } else { d }
+    } else {
+        0.0
+    }
+}
+
+/// The bounding interval of a quad's projected corners along one axis: the
+/// corners' coordinates (relative to the receiver) times their 1/d.
+#[inline(always)]
+fn span(t: [f32; 4]) -> (f32, f32) {
+    let lo = gather::min(gather::min(t[0], t[1]), gather::min(t[2], t[3]));
+    let hi = gather::max(gather::max(t[0], t[1]), gather::max(t[2], t[3]));
+    (lo, hi)
+}
+
+/// The accumulator: masks of W words, flat micro-patches or (QUADS) quads.
+struct MaskKernel<'a, const W: usize, const QUADS: bool> {
+    p: &'a Pattern<W>,
+}
+
+impl<const W: usize, const QUADS: bool> MaskKernel<'_, W, QUADS> {
+    /// ORs the sample rectangle of ranks [ka, kb) x [kc, kd) into `m`.
+    #[inline(always)]
+    fn mark(&self, m: &mut Mask<W>, [ka, kb, kc, kd]: [u16; 4]) {
+        let band = and(self.p.x_band(ka, kb), self.p.y_band(kc, kd));
+        for q in 0..W {
+            m[q] |= band[q];
+        }
     }
 
-    /// `samples` must be one of SAMPLE_COUNTS (checked by `Method::parse`).
-    pub fn new(samples: u32, hierarchy: Option<Hierarchy>) -> Bitmask {
-        let n = (samples as f64).sqrt().round() as usize;
-        Bitmask {
-            pattern: Pattern::new(n),
-            hierarchy,
+    /// ORs the per-column x-bands and per-row y-bands of a whole tile.
+    #[inline(always)]
+    fn mark_tile(
+        &self,
+        acc: &mut [Mask<W>; LANES],
+        xb: &[Mask<W>; TILE_W],
+        yb: &[Mask<W>; ROWS_PER_GROUP],
+    ) {
+        for (row, y) in yb.iter().enumerate() {
+            for (c, x) in xb.iter().enumerate() {
+                let band = and(*x, *y);
+                let m = &mut acc[row * TILE_W + c];
+                for q in 0..W {
+                    m[q] |= band[q];
+                }
+            }
         }
     }
 }
 
-impl Accumulator for Bitmask {
-    type State = [Mask; LANES];
+impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS> {
+    type State = [Mask<W>; LANES];
     const LAYERS_SHARE_STATE: bool = true;
+    const CORNERS: bool = QUADS;
 
     fn empty(&self) -> Self::State {
-        [[0; 4]; LANES]
+        [[0; W]; LANES]
     }
 
     /// Ranks covered by the back-projection of [x0, x1] (half-light units
@@ -194,7 +276,7 @@ impl Accumulator for Bitmask {
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // one index over several lane arrays
     fn add_texel(&self, acc: &mut Self::State, w: f32, x0: f32, x1: f32, r: &RowLanes, g: &Group) {
-        let p = &self.pattern;
+        let p = self.p;
         // Index arithmetic for all lanes first (vectorizes), lookups after.
         let mut k = [[0u16; 4]; LANES];
         for l in 0..LANES {
@@ -206,12 +288,8 @@ impl Accumulator for Bitmask {
                 b.hi(r.ay1[l]),
             ];
         }
-        for l in 0..LANES {
-            let [ka, kb, kc, kd] = k[l];
-            let band = and(p.x_band(ka, kb), p.y_band(kc, kd));
-            for q in 0..4 {
-                acc[l][q] |= band[q];
-            }
+        for (m, k) in acc.iter_mut().zip(&k) {
+            self.mark(m, *k);
         }
     }
 
@@ -228,34 +306,91 @@ impl Accumulator for Bitmask {
         r: &RowLanes,
         g: &Group,
     ) {
-        let p = &self.pattern;
+        let p = self.p;
         let b = p.bounds(w - g.wr[0]);
-        let xb: [Mask; TILE_W] =
+        let xb: [Mask<W>; TILE_W] =
             std::array::from_fn(|c| p.x_band(b.lo(x0 - r.xr[c]), b.hi(x1 - r.xr[c])));
-        let yb: [Mask; ROWS_PER_GROUP] = std::array::from_fn(|row| {
+        let yb: [Mask<W>; ROWS_PER_GROUP] = std::array::from_fn(|row| {
             let l = row * TILE_W;
             p.y_band(b.lo(-r.nay0[l]), b.hi(r.ay1[l]))
         });
-        for (row, y) in yb.iter().enumerate() {
-            for (c, x) in xb.iter().enumerate() {
-                let band = and(*x, *y);
-                let m = &mut acc[row * TILE_W + c];
-                for q in 0..4 {
-                    m[q] |= band[q];
-                }
-            }
+        self.mark_tile(acc, &xb, &yb);
+    }
+
+    /// The quad [x0, x1] x (row) with corner 1/depths `c` ([top-left,
+    /// top-right, bottom-left, bottom-right]) and centre 1/depth w: the
+    /// bounding rectangle of its four corners projected from each lane's
+    /// receiver.
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // one index over several lane arrays
+    fn add_quad(
+        &self,
+        acc: &mut Self::State,
+        w: f32,
+        c: &[f32; 4],
+        x0: f32,
+        x1: f32,
+        r: &RowLanes,
+        g: &Group,
+    ) {
+        let b = self.p.scaled(1.0);
+        let mut k = [[0u16; 4]; LANES];
+        for l in 0..LANES {
+            let wr = g.wr[l];
+            let d = w - wr;
+            let i: [f32; 4] = std::array::from_fn(|q| corner_inv(c[q], wr, d));
+            let (a, e) = (x0 - r.xr[l], x1 - r.xr[l]);
+            let (bottom, top) = (-r.nay0[l], r.ay1[l]);
+            let (xa, xb) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
+            let (ya, yb) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
+            k[l] = [b.lo(xa), b.hi(xb), b.lo(ya), b.hi(yb)];
+        }
+        for (m, k) in acc.iter_mut().zip(&k) {
+            self.mark(m, *k);
         }
     }
 
+    /// `add_quad` for a tile on one depth: the corners' 1/d are shared, the
+    /// x-span depends on the column only and the y-span on the row only
+    /// (the same bits).
+    #[inline(always)]
+    fn add_quad_tile(
+        &self,
+        acc: &mut Self::State,
+        w: f32,
+        c: &[f32; 4],
+        x0: f32,
+        x1: f32,
+        r: &RowLanes,
+        g: &Group,
+    ) {
+        let p = self.p;
+        let b = p.scaled(1.0);
+        let wr = g.wr[0];
+        let i: [f32; 4] = std::array::from_fn(|q| corner_inv(c[q], wr, w - wr));
+        let xb: [Mask<W>; TILE_W] = std::array::from_fn(|col| {
+            let (a, e) = (x0 - r.xr[col], x1 - r.xr[col]);
+            let (xa, xb) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
+            p.x_band(b.lo(xa), b.hi(xb))
+        });
+        let yb: [Mask<W>; ROWS_PER_GROUP] = std::array::from_fn(|row| {
+            let l = row * TILE_W;
+            let (bottom, top) = (-r.nay0[l], r.ay1[l]);
+            let (ya, yb) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
+            p.y_band(b.lo(ya), b.hi(yb))
+        });
+        self.mark_tile(acc, &xb, &yb);
+    }
+
     fn full(&self, acc: &Self::State, g: &Group) -> bool {
-        let all = self.pattern.all();
+        let all = self.p.all();
         acc.iter()
             .zip(&g.wr)
             .all(|(m, wr)| !wr.is_finite() || *m == all)
     }
 
     fn occlusion(&self, acc: &Self::State) -> Lanes {
-        let s = self.pattern.count() as f32;
+        let s = self.p.count() as f32;
         let mut o = [0f32; LANES];
         for (o, m) in o.iter_mut().zip(acc) {
             *o = m.iter().map(|w| w.count_ones()).sum::<u32>() as f32 / s;
@@ -264,13 +399,77 @@ impl Accumulator for Bitmask {
     }
 }
 
+impl Bitmask {
+    /// The rank tables as the GPU twin (`gpu/bitmask.wgsl`) reads them: x_ge
+    /// then y_ge, each entry 2 W u32 words (bit b of the mask is bit b % 32
+    /// of word b / 32, as in the u64 words here).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn rank_tables(&self) -> Vec<u32> {
+        fn flat<const W: usize>(p: &Pattern<W>) -> Vec<u32> {
+            p.x_ge
+                .iter()
+                .chain(&p.y_ge)
+                .flat_map(|m| m.iter().flat_map(|w| [*w as u32, (*w >> 32) as u32]))
+                .collect()
+        }
+        match &self.pattern {
+            Patterns::Small(p) => flat(p),
+            Patterns::Large(p) => flat(p),
+        }
+    }
+
+    /// `samples` must be one of SAMPLE_COUNTS (checked by `Method::parse`).
+    pub fn new(samples: u32, gaps: Gaps, hierarchy: Option<Hierarchy>) -> Bitmask {
+        let n = (samples as f64).sqrt().round() as usize;
+        let pattern = if n * n <= 256 {
+            Patterns::Small(Pattern::new(n))
+        } else {
+            Patterns::Large(Pattern::new(n))
+        };
+        Bitmask {
+            pattern,
+            gaps,
+            hierarchy,
+        }
+    }
+}
+
+/// Calls `$f` with the accumulator for the method's pattern and gaps.
+macro_rules! with_kernel {
+    ($m:expr, |$k:ident| $body:expr) => {
+        match (&$m.pattern, $m.gaps) {
+            (Patterns::Small(p), Gaps::Closed) => {
+                let $k = &MaskKernel::<4, true> { p };
+                $body
+            }
+            (Patterns::Small(p), Gaps::Open) => {
+                let $k = &MaskKernel::<4, false> { p };
+                $body
+            }
+            (Patterns::Large(p), Gaps::Closed) => {
+                let $k = &MaskKernel::<16, true> { p };
+                $body
+            }
+            (Patterns::Large(p), Gaps::Open) => {
+                let $k = &MaskKernel::<16, false> { p };
+                $body
+            }
+        }
+    };
+}
+
 impl ShadowMethod for Bitmask {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
-        gather::visibility_map(self, inputs, self.hierarchy)
+        with_kernel!(self, |k| gather::visibility_map(k, inputs, self.hierarchy))
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        gather::visibility_points(self, inputs, points, self.hierarchy)
+        with_kernel!(self, |k| gather::visibility_points(
+            k,
+            inputs,
+            points,
+            self.hierarchy
+        ))
     }
 }
 
@@ -282,9 +481,16 @@ mod tests {
     #[test]
     fn pattern_is_multi_jittered() {
         for n in [4, 8, 16] {
-            let p = Pattern::new(n);
+            check_pattern(Pattern::<4>::new(n));
+        }
+        check_pattern(Pattern::<16>::new(32));
+    }
+
+    fn check_pattern<const W: usize>(p: Pattern<W>) {
+        let n = p.n;
+        {
             let s = n * n;
-            let pop = |m: &Mask| m.iter().map(|w| w.count_ones()).sum::<u32>() as usize;
+            let pop = |m: &Mask<W>| m.iter().map(|w| w.count_ones()).sum::<u32>() as usize;
             // Prefix masks shrink by exactly one sample per rank.
             for k in 0..=s {
                 assert_eq!(pop(&p.x_ge[k]), s - k);
@@ -292,14 +498,14 @@ mod tests {
             }
             // One sample per coarse cell: the x-ranks of cell column i are i n..(i+1) n.
             for i in 0..n {
-                let col: Mask = {
-                    let mut m = [0; 4];
+                let col: Mask<W> = {
+                    let mut m = [0; W];
                     for j in 0..n {
                         set(&mut m, j * n + i);
                     }
                     m
                 };
-                let band: Mask =
+                let band: Mask<W> =
                     std::array::from_fn(|q| p.x_ge[i * n][q] & !p.x_ge[(i + 1) * n][q]);
                 assert_eq!(band, col);
             }
@@ -312,7 +518,7 @@ mod tests {
         // back-projection, and the pattern places each of its 4 edges to one
         // fine stratum: 4 x 16 samples of 256 in the worst case (a stratum's
         // samples lie in one coarse row or column).
-        let max = crate::methods::plate_case::max_error(&Bitmask::new(256, None), 48);
+        let max = crate::methods::plate_case::max_error(&Bitmask::new(256, Gaps::Open, None), 48);
         assert!(max <= 4.0 * 16.0 / 256.0 + 1e-6, "max error {max}");
     }
 
@@ -354,10 +560,13 @@ mod tests {
             })
             .collect();
         for samples in SAMPLE_COUNTS {
-            let m = Bitmask::new(samples, None);
-            let map = m.visibility_map(&inputs);
-            assert!(map.iter().any(|&v| v > 0.0 && v < 1.0));
-            assert_eq!(map, m.visibility_points(&inputs, &pts), "{samples} samples");
+            for gaps in Gaps::ALL {
+                let m = Bitmask::new(samples, gaps, None);
+                let map = m.visibility_map(&inputs);
+                assert!(map.iter().any(|&v| v > 0.0 && v < 1.0));
+                let pts = m.visibility_points(&inputs, &pts);
+                assert_eq!(map, pts, "{samples} samples, {gaps:?}");
+            }
         }
     }
 
@@ -376,7 +585,9 @@ mod tests {
             occluder_layers: vec![&front, &front],
             occluder_triangles: None,
         };
-        let v = Bitmask::new(64, None).visibility_map(&inputs);
-        assert!(v.iter().all(|&x| x == 0.0), "{v:?}");
+        for gaps in Gaps::ALL {
+            let v = Bitmask::new(64, gaps, None).visibility_map(&inputs);
+            assert!(v.iter().all(|&x| x == 0.0), "{v:?}");
+        }
     }
 }

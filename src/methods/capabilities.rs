@@ -195,6 +195,17 @@ pub fn methods() -> Vec<MethodInfo> {
                 passes(),
                 occluder_resolution(),
                 hierarchy(HIERARCHY_DEFAULT_BITMASK),
+                OptionInfo {
+                    name: "gaps",
+                    kind: Kind::Choice(bitmask::Gaps::ALL.iter().map(|g| g.name()).collect()),
+                    default: Value::Str(bitmask::Gaps::default().name()),
+                    default_doc: "closed",
+                    doc: "how neighbouring micro-patches meet: closed, connected micro-quads \
+                          (no light between neighbours on one surface; a depth step steeper \
+                          than 76° from the light's direction stays open); open, the flat \
+                          per-texel micro-patches of the paper, whose gaps leak light (§4.1.2)",
+                    restricted_on: vec![],
+                },
             ],
         },
         MethodInfo {

@@ -54,6 +54,8 @@ pub struct BitmaskConfig {
     pub occluder_resolution: Option<(usize, usize)>,
     /// `None`: on where the backend has a hierarchy (the CPU), else off.
     pub hierarchy: Option<bool>,
+    /// How neighbouring micro-patches meet.
+    pub gaps: bitmask::Gaps,
 }
 
 /// Ray casting through a BVH of the occluder triangles.
@@ -327,8 +329,17 @@ impl BitmaskConfig {
         passes: Option<i64>,
         occluder_resolution: Option<(i64, i64)>,
         hierarchy: Option<bool>,
+        gaps: Option<&str>,
     ) -> Result<Self> {
+        let gaps = match gaps {
+            None => bitmask::Gaps::default(),
+            Some(g) => bitmask::Gaps::parse(g).ok_or_else(|| {
+                let names: Vec<&str> = bitmask::Gaps::ALL.iter().map(|g| g.name()).collect();
+                Error::invalid("gaps", format!("must be one of {names:?}, got {g:?}"))
+            })?,
+        };
         Ok(BitmaskConfig {
+            gaps,
             samples: samples
                 .map(check_bitmask_samples)
                 .transpose()?
@@ -349,6 +360,7 @@ impl Default for BitmaskConfig {
             passes: None,
             occluder_resolution: None,
             hierarchy: None,
+            gaps: Default::default(),
         }
     }
 }
@@ -490,6 +502,7 @@ impl MethodConfig {
                     o.passes,
                     o.occluder_resolution,
                     o.hierarchy,
+                    None,
                 )?)
             }
             "exact" => {
@@ -644,6 +657,7 @@ impl MethodConfig {
                 )?;
                 MethodConfig::Bitmask(BitmaskConfig {
                     samples: c.samples,
+                    gaps: c.gaps,
                     passes: Some(passes),
                     occluder_resolution: Some(occ),
                     hierarchy: Some(hierarchy),
@@ -719,6 +733,7 @@ impl MethodConfig {
             MethodConfig::Bitmask(c) => Method::Bitmask {
                 samples: c.samples,
                 hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
+                gaps: c.gaps,
             },
             MethodConfig::Exact(c) => Method::Exact { samples: c.samples },
             // What "auto" always resolves to.
@@ -794,7 +809,8 @@ mod tests {
             b.resolve(&cpu((8, 8))).unwrap().kernel(),
             Method::Bitmask {
                 samples: 256,
-                hierarchy: true
+                hierarchy: true,
+                gaps: bitmask::Gaps::Closed,
             }
         );
         let gpu = CallContext {
@@ -805,7 +821,8 @@ mod tests {
             b.resolve(&gpu).unwrap().kernel(),
             Method::Bitmask {
                 samples: 256,
-                hierarchy: false
+                hierarchy: false,
+                gaps: bitmask::Gaps::Closed,
             }
         );
         let depth = CallContext {
@@ -814,7 +831,8 @@ mod tests {
         };
         let r = b.resolve(&depth).unwrap();
         assert_eq!((r.passes(), r.occluder_resolution()), (1, Some((4, 4))));
-        let three = MethodConfig::Bitmask(BitmaskConfig::new(None, Some(3), None, None).unwrap());
+        let three =
+            MethodConfig::Bitmask(BitmaskConfig::new(None, Some(3), None, None, None).unwrap());
         assert!(
             matches!(three.resolve(&depth), Err(Error::InvalidArgument { ref arg, .. }) if arg == "passes")
         );

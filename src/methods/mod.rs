@@ -99,8 +99,13 @@ pub enum Method {
     /// Ray casting against the occluder triangles with stratified light samples.
     Exact { samples: u32 },
     /// Micro-patches marking light samples in a bit mask per receiver (OR);
-    /// `hierarchy` as for Ssm (on by default).
-    Bitmask { samples: u32, hierarchy: bool },
+    /// `hierarchy` as for Ssm (on by default); `gaps` how neighbouring
+    /// micro-patches meet (closed: connected micro-quads).
+    Bitmask {
+        samples: u32,
+        hierarchy: bool,
+        gaps: bitmask::Gaps,
+    },
     /// Scherzer 2005's shadow mapping: its own map and depth test
     /// (`shadow_mapping/`, the eye view only).
     ShadowMapping(shadow_mapping::config::ShadowMappingConfig),
@@ -176,8 +181,13 @@ impl Method {
                 precision,
             }),
             Method::Exact { samples } => Box::new(exact::Exact { samples }),
-            Method::Bitmask { samples, hierarchy } => Box::new(bitmask::Bitmask::new(
+            Method::Bitmask {
                 samples,
+                hierarchy,
+                gaps,
+            } => Box::new(bitmask::Bitmask::new(
+                samples,
+                gaps,
                 hierarchy.then_some(HIERARCHY),
             )),
             // Refused outside the eye view when the config is resolved.

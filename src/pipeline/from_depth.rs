@@ -171,6 +171,7 @@ mod tests {
         let bitmask = Method::Bitmask {
             samples: 64,
             hierarchy: true,
+            gaps: Default::default(),
         };
         for method in [ssm, bitmask] {
             let (f, r) = plate_maps(n, 1.0);

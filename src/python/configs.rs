@@ -108,18 +108,21 @@ pub struct PyBitmask(pub BitmaskConfig);
 #[pymethods]
 impl PyBitmask {
     #[new]
-    #[pyo3(signature = (*, samples=None, passes=None, occluder_resolution=None, hierarchy=None))]
+    #[pyo3(signature = (*, samples=None, passes=None, occluder_resolution=None, hierarchy=None, gaps=None))]
     fn new(
         samples: Option<&Bound<'_, PyAny>>,
         passes: Option<&Bound<'_, PyAny>>,
         occluder_resolution: Option<&Bound<'_, PyAny>>,
         hierarchy: Option<&Bound<'_, PyAny>>,
+        gaps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let gaps = opt_string("gaps", gaps)?;
         Ok(PyBitmask(BitmaskConfig::new(
             opt_int("samples", samples)?,
             opt_int("passes", passes)?,
             opt_resolution("occluder_resolution", occluder_resolution)?,
             opt_bool("hierarchy", hierarchy)?,
+            gaps.as_deref(),
         )?))
     }
     /// "bitmask", the name given as ``method=``.
@@ -143,6 +146,10 @@ impl PyBitmask {
     fn hierarchy(&self) -> Option<bool> {
         self.0.hierarchy
     }
+    #[getter]
+    fn gaps(&self) -> &'static str {
+        self.0.gaps.name()
+    }
     /// The options as keyword arguments: ``Bitmask(**c.to_dict()) == c``.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -150,6 +157,7 @@ impl PyBitmask {
         d.set_item("passes", self.0.passes)?;
         d.set_item("occluder_resolution", self.0.occluder_resolution)?;
         d.set_item("hierarchy", self.0.hierarchy)?;
+        d.set_item("gaps", self.0.gaps.name())?;
         Ok(d)
     }
     fn __getnewargs_ex__<'py>(
@@ -161,11 +169,12 @@ impl PyBitmask {
     fn __repr__(&self) -> String {
         let c = self.0;
         format!(
-            "Bitmask(samples={}, passes={}, occluder_resolution={}, hierarchy={})",
+            "Bitmask(samples={}, passes={}, occluder_resolution={}, hierarchy={}, gaps='{}')",
             c.samples,
             opt(c.passes, |p| p.to_string()),
             opt(c.occluder_resolution, res),
             opt(c.hierarchy, |h| py_bool(h).into()),
+            c.gaps.name(),
         )
     }
 }

@@ -27,6 +27,9 @@ pub(super) struct Layer {
     /// occupied texels each (Appendix A's workaround for FP16 blending; the
     /// batches end at row boundaries here).
     pub(super) row_batch: Vec<u32>,
+    /// Corner 1/depths of the connected micro-quads (`corners.rs`), when the
+    /// method reads them; empty otherwise.
+    pub(super) corners: Vec<[f32; 4]>,
 }
 
 #[derive(Clone, Copy)]
@@ -143,6 +146,7 @@ impl Layer {
             .collect();
         Layer {
             row_batch,
+            corners: vec![],
             w,
             w_far,
             w_near,
@@ -150,6 +154,32 @@ impl Layer {
             rows,
             w_max,
         }
+    }
+}
+
+impl Layer {
+    /// Connects the texels into micro-quads (`corners.rs`; `dx`, `dy`: a
+    /// texel's tangent size) and widens the pruning bounds to the corners:
+    /// a quad reaches as far as its nearest corner does.
+    fn connect(&mut self, width: usize, height: usize, dx: f32, dy: f32) {
+        self.corners = super::corners::corners(&self.w, width, height, dx, dy);
+        let reach: Vec<f32> = self
+            .w
+            .par_iter()
+            .zip(&self.corners)
+            .map(|(&w, c)| c.iter().fold(w, |m, &x| m.max(x)))
+            .collect();
+        self.block_w_max = reach
+            .par_chunks(width)
+            .flat_map_iter(|row| {
+                row.chunks(BLOCK)
+                    .map(|b| b.iter().fold(0f32, |m, &x| m.max(x)))
+            })
+            .collect();
+        for (span, row) in self.rows.iter_mut().zip(reach.chunks(width)) {
+            span.w_max = row.iter().fold(0f32, |m, &x| m.max(x));
+        }
+        self.w_max = self.rows.iter().fold(0f32, |m, r| m.max(r.w_max));
     }
 }
 
@@ -197,7 +227,13 @@ fn same_bits(a: &[f32], b: &[f32]) -> bool {
 }
 
 impl Kernel {
-    pub(super) fn new(inputs: &ShadowInputs, hierarchy: Option<Hierarchy>) -> Kernel {
+    /// `corners`: connect each layer's texels into micro-quads (what an
+    /// accumulator with `CORNERS` reads).
+    pub(super) fn new(
+        inputs: &ShadowInputs,
+        hierarchy: Option<Hierarchy>,
+        corners: bool,
+    ) -> Kernel {
         // Occluder texels live on the occluder grid; receivers on the output grid.
         let g = &inputs.occluder_grid;
         let r = &inputs.grid;
@@ -248,6 +284,12 @@ impl Kernel {
                     }
                 })
                 .collect();
+            if corners {
+                let (dx, dy) = ((2.0 * hw * f) as f32, (2.0 * hh * f) as f32);
+                layers
+                    .iter_mut()
+                    .for_each(|l| l.connect(width, height, dx, dy));
+            }
             levels.push(Level {
                 width,
                 height,
@@ -376,7 +418,7 @@ mod tests {
             occluder_layers: layers,
             occluder_triangles: None,
         };
-        Kernel::new(&inputs, None).levels[0].layers.len()
+        Kernel::new(&inputs, None, false).levels[0].layers.len()
     }
 
     #[test]

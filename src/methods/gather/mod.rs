@@ -19,6 +19,7 @@
 //! traversal over occluder texels for one group; `simd.rs`: the runtime
 //! dispatch.
 
+pub mod corners;
 mod group;
 mod hierarchy;
 mod simd;
@@ -73,6 +74,41 @@ pub(super) trait Accumulator: Sync {
         g: &Group,
     ) {
         self.add_texel(acc, w, x0, x1, row, g)
+    }
+    /// Whether the micro-patches are connected quads (`corners.rs`): the
+    /// traversal then calls `add_quad` with each texel's corner 1/depths
+    /// instead of `add_texel`.
+    const CORNERS: bool = false;
+    /// Adds the quad [x0, x1] x (row) at centre 1/depth w with corner
+    /// 1/depths `c` ([top-left, top-right, bottom-left, bottom-right]).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn add_quad(
+        &self,
+        acc: &mut Self::State,
+        w: f32,
+        _c: &[f32; 4],
+        x0: f32,
+        x1: f32,
+        row: &RowLanes,
+        g: &Group,
+    ) {
+        self.add_texel(acc, w, x0, x1, row, g)
+    }
+    /// `add_quad` for a whole tile on one depth (as `add_texel_tile`).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn add_quad_tile(
+        &self,
+        acc: &mut Self::State,
+        w: f32,
+        c: &[f32; 4],
+        x0: f32,
+        x1: f32,
+        row: &RowLanes,
+        g: &Group,
+    ) {
+        self.add_quad(acc, w, c, x0, x1, row, g)
     }
 }
 
@@ -153,7 +189,7 @@ pub(super) fn visibility_map<A: Accumulator>(
     inputs: &ShadowInputs,
     hierarchy: Option<Hierarchy>,
 ) -> Vec<f32> {
-    let k = Kernel::new(inputs, hierarchy);
+    let k = Kernel::new(inputs, hierarchy, A::CORNERS);
     let w = k.rec_width;
     let mut out = vec![1f32; inputs.grid.len()];
     out.par_chunks_mut(w * ROWS_PER_GROUP)
@@ -251,7 +287,7 @@ pub(super) fn visibility_points<A: Accumulator>(
     points: &[LightPoint],
     hierarchy: Option<Hierarchy>,
 ) -> Vec<f32> {
-    let k = Kernel::new(inputs, hierarchy);
+    let k = Kernel::new(inputs, hierarchy, A::CORNERS);
     // Shade neighbours together: sort the points by the texel they fall in,
     // so that each group's union of extents stays small.
     let order = point_order(&inputs.occluder_grid, points);

@@ -126,8 +126,26 @@ impl Kernel {
             return true;
         }
         let (s, e) = ((b_lo * BLOCK).max(i_lo), (b_hi * BLOCK).min(i_hi));
-        let texels = row[s..e].iter().zip(&lv.col_x0_scaled[s..e]);
         // w <= wr_min: empty, or behind every lane's receiver.
+        if A::CORNERS {
+            let corners = &layer.corners[j * lv.width + s..j * lv.width + e];
+            let quads = row[s..e]
+                .iter()
+                .zip(&lv.col_x0_scaled[s..e])
+                .zip(corners)
+                .filter(|((&w, _), _)| w > g.wr_min);
+            if g.uniform_tile {
+                for ((&w, &x0), c) in quads {
+                    a.add_quad_tile(acc, w, c, x0, x0 + wx, &rl, g);
+                }
+            } else {
+                for ((&w, &x0), c) in quads {
+                    a.add_quad(acc, w, c, x0, x0 + wx, &rl, g);
+                }
+            }
+            return true;
+        }
+        let texels = row[s..e].iter().zip(&lv.col_x0_scaled[s..e]);
         if g.uniform_tile {
             for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
                 a.add_texel_tile(acc, w, x0, x0 + wx, &rl, g);
