@@ -115,6 +115,8 @@ pub struct Run<T> {
     pub backend: Backend,
     /// Worker threads the CPU stages could use.
     pub threads: usize,
+    /// What `Auto` with a target decided (light-view maps from meshes).
+    pub plan: Option<crate::methods::plan::Plan>,
 }
 
 /// A shadow map of meshes: what to compute and where.
@@ -146,33 +148,105 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
     let backend = call
         .backend
         .pick(&call.method, ctx, call.light.kernel_size());
-    let method = call.method.resolve(&CallContext { backend, ..ctx })?;
-    let (output, threads) = threads::run_capped(cap, || {
+    let ctx = CallContext { backend, ..ctx };
+    let target = match call.method {
+        MethodConfig::Auto(_, t) if !t.is_none() => Some(t),
+        _ => None,
+    };
+    let method = call.method.resolve(&ctx)?;
+    let ((output, method, plan), threads) = threads::run_capped(cap, || {
         let space = mesh_space(
             call.light,
             &[("occluders", call.occluders), ("receivers", call.receivers)],
         )?;
         // A sun's map extent is given in world units; the kernels' in tangents.
         let extent = call.extent.map(|e| space.kernel_extent(e));
-        let settings = MapSettings::new(w, h, extent, &method);
-        match backend {
-            Backend::Cpu => {
-                pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
+        let run = |method: &MethodConfig, hard: bool| {
+            let mut settings = MapSettings::new(w, h, extent, method);
+            settings.hard = hard;
+            match backend {
+                Backend::Cpu => {
+                    pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
+                }
+                #[cfg(feature = "gpu")]
+                Backend::Gpu => {
+                    crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
+                }
+                #[cfg(not(feature = "gpu"))]
+                Backend::Gpu => Err(not_built()),
             }
-            #[cfg(feature = "gpu")]
-            Backend::Gpu => {
-                crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
-            }
-            #[cfg(not(feature = "gpu"))]
-            Backend::Gpu => Err(not_built()),
-        }
+        };
+        let Some(target) = target else {
+            return Ok((run(&method, false)?, method, None));
+        };
+        planned(call, &space, extent, &ctx, &target, run)
     })?;
     Ok(Run {
         output,
         method,
         backend,
         threads,
+        plan,
     })
+}
+
+/// A mesh call planned for `target` (`methods/plan.rs`): the scene's stats,
+/// the plan (after a timed probe for a time budget), the planned config
+/// resolved for the backend and run. The planning time is the result's
+/// "plan" stage.
+fn planned(
+    call: &MeshCall,
+    space: &LightSpace,
+    extent: Option<[f64; 2]>,
+    ctx: &CallContext,
+    target: &crate::methods::plan::Target,
+    run: impl Fn(&MethodConfig, bool) -> Result<ShadowResult>,
+) -> Result<(
+    ShadowResult,
+    MethodConfig,
+    Option<crate::methods::plan::Plan>,
+)> {
+    use crate::methods::plan::plan;
+    let t0 = std::time::Instant::now();
+    let stats = pipeline::scene_stats(
+        &call.occluders,
+        &call.receivers,
+        space,
+        ctx.resolution,
+        extent,
+    )?;
+    let mut p = plan(&stats, target, None);
+    let mut planning = t0.elapsed().as_secs_f64();
+    let mut probe = None;
+    if target.time.is_some() && !p.hard {
+        // The probe: the cheapest soft setting, timed; kept when nothing
+        // better fits the budget.
+        let cfg = p.config.resolve(ctx)?;
+        let t = std::time::Instant::now();
+        let out = run(&cfg, false)?;
+        let seconds = t.elapsed().as_secs_f64();
+        let t1 = std::time::Instant::now();
+        p = plan(&stats, target, Some(seconds + planning));
+        planning += t1.elapsed().as_secs_f64();
+        probe = Some((cfg, out));
+    }
+    // The GPU has no hard shadow map: the soft setting runs there.
+    if p.hard && ctx.backend == Backend::Gpu {
+        p.hard = false;
+        if let Some(d) = p.decisions.iter_mut().find(|d| d.name == "hard") {
+            d.taken = false;
+            d.why
+                .push_str("; the GPU backend has no hard shadow map, the soft setting runs");
+        }
+    }
+    let cfg = p.config.resolve(ctx)?;
+    let mut out = match probe {
+        Some((probe_cfg, out)) if probe_cfg == cfg => out,
+        _ => run(&cfg, p.hard)?,
+    };
+    out.timings.insert(0, ("plan", planning));
+    p.config = cfg;
+    Ok((out, cfg, Some(p)))
 }
 
 /// A shadow map of a scene where every mesh casts and receives shadows.
@@ -221,6 +295,7 @@ pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
         method,
         backend: Backend::Cpu,
         threads,
+        plan: None,
     })
 }
 
@@ -369,6 +444,7 @@ pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
         method,
         backend,
         threads,
+        plan: None,
     })
 }
 

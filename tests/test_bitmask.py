@@ -72,5 +72,5 @@ def test_bitmask_from_depth_and_points():
 
 def test_bitmask_sample_counts():
     scene, light = scenes.square_plate()
-    with pytest.raises(ValueError, match="samples.*16, 64, 256"):
+    with pytest.raises(ValueError, match="samples.*16, 64, 256, 1024"):
         ss.soft_shadow_map(scene, light, resolution=8, method="bitmask", samples=100)

@@ -37,7 +37,7 @@ from .methods import (
 )
 from .render import Image, render
 from .scene import Scene
-from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
+from .shadow_map import Decision, Plan, ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
 __all__ = [
     "SlopeScaleBias",
@@ -53,6 +53,7 @@ __all__ = [
     "Auto",
     "Bitmask",
     "Camera",
+    "Decision",
     "DirectionalLight",
     "Exact",
     "GpuUnavailableError",
@@ -61,6 +62,7 @@ __all__ = [
     "MethodInfo",
     "OptionInfo",
     "PCSS",
+    "Plan",
     "RectLight",
     "Scene",
     "ShadowMap",

@@ -117,6 +117,78 @@ def two_spheres(light_size: float = 1.0) -> tuple[Scene, RectLight]:
     return Scene(occluders=occ, receivers=[floor()]), default_light(light_size)
 
 
+def box(center: tuple[float, float, float], size: tuple[float, float, float]) -> Mesh:
+    """An axis-aligned box (12 triangles, outward normals)."""
+    c, h = np.asarray(center, dtype=np.float64), 0.5 * np.asarray(size, dtype=np.float64)
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+    faces = [
+        [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5],  # x = -1, x = +1
+        [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],  # y = -1, y = +1
+        [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],  # z = -1, z = +1
+    ]  # fmt: skip
+    return corners * h + c, np.asarray(faces, dtype=np.uint32)
+
+
+def rotated(mesh: Mesh, degrees: float, axis: str, about: tuple[float, float, float] | None = None) -> Mesh:
+    """``mesh`` turned by ``degrees`` about the ``axis`` ("x", "y" or "z")
+    through ``about`` (default: the centre of its bounding box)."""
+    v, f = mesh
+    t = np.deg2rad(degrees)
+    c, s = np.cos(t), np.sin(t)
+    i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
+    r = np.eye(3)
+    r[i, i], r[i, j], r[j, i], r[j, j] = c, -s, s, c
+    o = 0.5 * (v.min(axis=0) + v.max(axis=0)) if about is None else np.asarray(about, dtype=np.float64)
+    return (v - o) @ r.T + o, f
+
+
+# The hard surfaces of the accuracy goal (issue 12): planes tilted against
+# the light, slanted receivers, thin bars, contact, a near light. Each keeps
+# the shared setup (floor y = 0, light at height 4 facing down).
+
+
+def tilted_plate(degrees: float = 30.0, light_size: float = 0.5) -> tuple[Scene, RectLight]:
+    """A 1 x 1 plate at height 2 tilted ``degrees`` about z: neighbouring
+    texels at different depths (the gaps of the SSM's §4.1.2)."""
+    plate = rotated(quad((0.0, 2.0, 0.0), 0.5), degrees, "z")
+    return Scene(occluders=[plate], receivers=[floor()]), default_light(light_size)
+
+
+def slanted_receiver(degrees: float = 30.0, light_size: float = 1.0) -> tuple[Scene, RectLight]:
+    """A 0.8 x 0.8 plate parallel to the light at height 2 over a floor
+    tilted ``degrees`` about x (the receivers' depth varies)."""
+    ground = rotated(floor(2.0), degrees, "x", about=(0.0, 0.0, 0.0))
+    return Scene(occluders=[quad((0.0, 2.0, 0.0), 0.4)], receivers=[ground]), default_light(light_size)
+
+
+def fence(light_size: float = 1.0) -> tuple[Scene, RectLight]:
+    """Seven thin bars (0.03 wide, 0.15 apart) at height 1.2: features a few
+    texels wide whose penumbrae overlap."""
+    bars = [box((x, 1.2, 0.0), (0.03, 0.03, 1.2)) for x in np.linspace(-0.45, 0.45, 7)]
+    return Scene(occluders=bars, receivers=[floor()]), default_light(light_size)
+
+
+def contact_box(light_size: float = 1.0) -> tuple[Scene, RectLight]:
+    """A 0.6 cube resting on the floor: the shadow hardens to the contact."""
+    return Scene(occluders=[box((0.0, 0.3, 0.0), (0.6, 0.6, 0.6))], receivers=[floor()]), default_light(light_size)
+
+
+def near_light(light_size: float = 1.0) -> tuple[Scene, RectLight]:
+    """A sphere of radius 0.25 at height 3.4, 0.6 below the light: the
+    penumbra is wider than the shadow."""
+    return Scene(occluders=[sphere((0.0, 3.4, 0.0), 0.25)], receivers=[floor()]), default_light(light_size)
+
+
+#: The hard surfaces by name; each call builds ``(scene, light)`` afresh.
+HARD_SURFACES: dict[str, Callable[[], tuple[Scene, RectLight]]] = {
+    "tilted_plate": tilted_plate,
+    "slanted_receiver": slanted_receiver,
+    "fence": fence,
+    "contact_box": contact_box,
+    "near_light": near_light,
+}
+
+
 #: The built-in scenes by name; each call builds ``(scene, light)`` afresh.
 SCENES: dict[str, Callable[[], tuple[Scene, RectLight]]] = {
     "bunny_floating": bunny_floating,

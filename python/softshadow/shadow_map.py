@@ -22,6 +22,29 @@ from .methods import MethodConfig
 from .scene import Scene
 
 
+@dataclass(frozen=True)
+class Decision:
+    """One decision of a plan: its name, whether it was taken, and why (the
+    number that decided)."""
+
+    name: str
+    taken: bool
+    why: str
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What ``Auto(error=...)`` or ``Auto(time=...)`` decided for a scene, and
+    the config that ran. ``print(sm.plan)`` lists the decisions."""
+
+    decisions: tuple[Decision, ...]
+    method: MethodConfig
+
+    def __str__(self) -> str:
+        lines = [f"[{'x' if d.taken else ' '}] {d.name}: {d.why}" for d in self.decisions]
+        return "\n".join([*lines, f"ran: {self.method!r}"])
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class ShadowMap:
     """A soft shadow map and the light-view maps it was computed from.
@@ -67,6 +90,9 @@ class ShadowMap:
     """For a DirectionalLight: the scene's depth range along the light."""
     self_shadowing: bool = False
     """True for the map of a ``Scene(meshes=...)``: every mesh casts and receives."""
+    plan: Plan | None = None
+    """What ``Auto(error=...)`` or ``Auto(time=...)`` decided (light-view maps
+    of a split scene); None for every other method."""
 
     def _light_args(self) -> tuple[Any, ...]:
         if isinstance(self.light, DirectionalLight):
@@ -241,7 +267,7 @@ def soft_shadow_map(
         and where they do not apply): ``passes``, the occluder depth layers
         (1, the front; 2, front and back, §3.5; 3 to 8 adds layers found by
         depth peeling; default 2); ``samples``, light samples per receiver
-        (``bitmask``: 16, 64 or 256; ``exact``: up to
+        (``bitmask``: 16, 64, 256 or 1024; ``exact``: up to
         ``limits()["max_samples"]``; default 256);
         ``occluder_resolution``, the occluder maps' resolution (default: the
         output's; coarser maps cost much less, their error is §4.1.1's);
@@ -323,6 +349,7 @@ def soft_shadow_map(
         self_shadowing=not scene.split,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
+        plan=None if r.plan is None else Plan(tuple(Decision(*d) for d in r.plan), r.method),
     )
 
 

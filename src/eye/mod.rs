@@ -145,6 +145,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         method,
         backend,
         threads,
+        plan: None,
     })
 }
 

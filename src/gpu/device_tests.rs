@@ -77,6 +77,7 @@ fn run_at(gpu: bool, passes: u32, method: Method, (width, height): (usize, usize
         occluder_resolution: None,
         passes,
         method,
+        hard: false,
     };
     let occ = MeshRef {
         vertices: &ov,

@@ -300,12 +300,33 @@ pub fn methods() -> Vec<MethodInfo> {
         MethodInfo {
             name: "auto",
             config: "Auto",
-            summary: "A rule, not a method: \"ssm\" with two passes and occluder maps at a \
-                      quarter of the output's resolution (at least 64, at most the output's), \
-                      the point of the study's accuracy-time plane furthest ahead of ray tracing",
+            summary: "A plan, not a method: without a target, \"ssm\" with two passes and \
+                      occluder maps at a quarter of the output's resolution (at least 64, at \
+                      most the output's), the point of the study's accuracy-time plane furthest \
+                      ahead of ray tracing; with error= or time=, the setting planned from the \
+                      scene (light-view maps from meshes; sm.plan says why)",
             reads: vec![Input::OccluderLayers],
             backends,
-            options: vec![],
+            options: vec![
+                OptionInfo {
+                    name: "error",
+                    kind: Kind::Float,
+                    default: Value::Resolved,
+                    default_doc: "None (no target)",
+                    doc: "the error to reach (the paper's §4.2.1 metric, mean |V - V_ref| over \
+                          the shadow), in [1e-4, 1]: the cheapest setting measured within it",
+                    restricted_on: vec![],
+                },
+                OptionInfo {
+                    name: "time",
+                    kind: Kind::Float,
+                    default: Value::Resolved,
+                    default_doc: "None (no budget)",
+                    doc: "a time budget in seconds, in [1e-6, 1e6]: a timed probe, then the most \
+                          accurate setting predicted to fit; not with error",
+                    restricted_on: vec![],
+                },
+            ],
         },
     ]
 }

@@ -64,12 +64,14 @@ pub struct ExactConfig {
     pub samples: u32,
 }
 
-/// What a user picks: a method with its options, or `Auto` (a rule that
-/// resolves to `Ssm`; the `SsmConfig` it holds are options given beside
-/// `method="auto"`, which override the rule's: `ss.Auto()` holds none).
+/// What a user picks: a method with its options, or `Auto`: without a
+/// target a rule that resolves to `Ssm` (the `SsmConfig` it holds are
+/// options given beside `method="auto"`, which override the rule's:
+/// `ss.Auto()` holds none); with a target (`ss.Auto(error=...)`) a plan made
+/// from the scene (`plan.rs`, light-view maps from meshes), elsewhere the rule.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MethodConfig {
-    Auto(SsmConfig),
+    Auto(SsmConfig, super::plan::Target),
     Ssm(SsmConfig),
     Bitmask(BitmaskConfig),
     Exact(ExactConfig),
@@ -536,12 +538,10 @@ impl MethodConfig {
                 if o.samples.is_some() {
                     return refuse("samples", "the sampling methods (\"bitmask\", \"exact\")");
                 }
-                MethodConfig::Auto(SsmConfig::new(
-                    o.passes,
-                    o.occluder_resolution,
-                    o.hierarchy,
-                    o.precision,
-                )?)
+                MethodConfig::Auto(
+                    SsmConfig::new(o.passes, o.occluder_resolution, o.hierarchy, o.precision)?,
+                    Default::default(),
+                )
             }
             "pcss" => {
                 if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
@@ -595,7 +595,7 @@ impl MethodConfig {
     /// The name a user passes as `method=`.
     pub fn name(&self) -> &'static str {
         match self {
-            MethodConfig::Auto(_) => "auto",
+            MethodConfig::Auto(..) => "auto",
             MethodConfig::Ssm(_) => "ssm",
             MethodConfig::Bitmask(_) => "bitmask",
             MethodConfig::Exact(_) => "exact",
@@ -609,7 +609,7 @@ impl MethodConfig {
     /// call-dependent default filled in, backend restrictions checked.
     pub fn resolve(&self, ctx: &CallContext) -> Result<MethodConfig> {
         Ok(match *self {
-            MethodConfig::Auto(given) => {
+            MethodConfig::Auto(given, _) => {
                 let rule = match ctx.depth_layers {
                     // From depth maps the layers and their resolution are given.
                     Some(_) => SsmConfig::default(),
@@ -737,7 +737,7 @@ impl MethodConfig {
             },
             MethodConfig::Exact(c) => Method::Exact { samples: c.samples },
             // What "auto" always resolves to.
-            MethodConfig::Auto(c) => Method::Ssm {
+            MethodConfig::Auto(c, _) => Method::Ssm {
                 hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
                 precision: c.precision,
             },
@@ -759,7 +759,7 @@ impl MethodConfig {
             MethodConfig::Bitmask(c) => c.passes.unwrap_or(DEFAULT_PASSES),
             // The shadow map: the front layer.
             MethodConfig::Smoothies(_) | MethodConfig::Pcss(_) => 1,
-            MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => 0,
+            MethodConfig::Exact(_) | MethodConfig::Auto(..) | MethodConfig::ShadowMapping(_) => 0,
         }
     }
 
@@ -771,7 +771,9 @@ impl MethodConfig {
             MethodConfig::Bitmask(c) => c.occluder_resolution,
             MethodConfig::Smoothies(c) => c.occluder_resolution,
             MethodConfig::Pcss(c) => c.occluder_resolution,
-            MethodConfig::Exact(_) | MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => None,
+            MethodConfig::Exact(_) | MethodConfig::Auto(..) | MethodConfig::ShadowMapping(_) => {
+                None
+            }
         }
     }
 }
@@ -791,12 +793,12 @@ mod tests {
 
     #[test]
     fn auto_is_ssm_with_quarter_occluder_maps_at_least_64() {
-        let r = MethodConfig::Auto(SsmConfig::default())
+        let r = MethodConfig::Auto(SsmConfig::default(), Default::default())
             .resolve(&cpu((512, 100)))
             .unwrap();
         assert_eq!(r.occluder_resolution(), Some((128, 64)));
         assert_eq!(r.passes(), 2);
-        let r = MethodConfig::Auto(SsmConfig::default())
+        let r = MethodConfig::Auto(SsmConfig::default(), Default::default())
             .resolve(&cpu((40, 40)))
             .unwrap();
         assert_eq!(r.occluder_resolution(), Some((40, 40)));

@@ -11,6 +11,7 @@ pub mod exact;
 pub(crate) mod gather;
 pub mod pcf;
 pub mod pcss;
+pub mod plan;
 pub mod point_light;
 pub mod shadow_mapping;
 pub mod smoothies;

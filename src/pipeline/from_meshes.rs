@@ -109,7 +109,9 @@ pub fn from_meshes(
     let inputs = ShadowInputs {
         grid,
         occluder_grid,
-        light_size,
+        // The hard shadow map where a plan says every penumbra is under
+        // half a texel (the point-light path of shade_map).
+        light_size: if s.hard { [0.0; 2] } else { light_size },
         receiver: &receiver,
         occluder_layers: layers,
         occluder_triangles: triangles.as_deref(),

@@ -14,7 +14,7 @@ mod points;
 pub use frame::Timings;
 #[cfg(feature = "gpu")]
 pub(crate) use frame::{frame_scene, FramedScene};
-pub(crate) use frame::{near_plane, Stopwatch};
+pub(crate) use frame::{near_plane, scene_stats, Stopwatch};
 pub use from_depth::{check_depth, from_depth};
 #[cfg(feature = "gpu")]
 pub(crate) use from_depth::{check_depth_inputs, DepthInUnit};
@@ -36,6 +36,10 @@ pub struct MapSettings {
     pub occluder_resolution: Option<(usize, usize)>,
     pub passes: u32,
     pub method: Method,
+    /// Shade the map methods' layers as for a point light (hard shadows),
+    /// whatever the light's size: what a plan decides where every penumbra
+    /// is under half a texel (`methods/plan.rs`).
+    pub hard: bool,
 }
 
 impl MapSettings {
@@ -53,6 +57,7 @@ impl MapSettings {
             occluder_resolution: method.occluder_resolution(),
             passes: method.passes(),
             method: method.kernel(),
+            hard: false,
         }
     }
 }

@@ -4,8 +4,9 @@
 //! The values are checked by the core's constructors (`methods/config.rs`);
 //! `None` means "resolved when the config runs".
 
-use super::convert::{opt_bool, opt_int, opt_resolution, opt_string, string};
+use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string, string};
 use crate::methods::config::{auto_rule, check_resolution, LooseOptions};
+use crate::methods::plan::Target;
 use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -221,22 +222,39 @@ impl PyExact {
 /// (the result's ``method`` says which). See `capabilities()["auto"]`.
 #[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Auto")]
 #[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyAuto;
+pub struct PyAuto(pub Target);
 
 #[pymethods]
 impl PyAuto {
     #[new]
-    fn new() -> Self {
-        PyAuto
+    #[pyo3(signature = (*, error=None, time=None))]
+    fn new(error: Option<&Bound<'_, PyAny>>, time: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        Ok(PyAuto(Target::new(
+            opt_float("error", error)?,
+            opt_float("time", time)?,
+        )?))
+    }
+    /// The error target (the paper's §4.2.1 metric), or None.
+    #[getter]
+    fn error(&self) -> Option<f64> {
+        self.0.error.map(|r| r.0)
+    }
+    /// The time budget in seconds, or None.
+    #[getter]
+    fn time(&self) -> Option<f64> {
+        self.0.time.map(|r| r.0)
     }
     /// "auto", the name given as ``method=``.
     #[getter]
     fn name(&self) -> &'static str {
         "auto"
     }
-    /// No options: ``{}``.
-    fn to_dict<'py>(&self, py: Python<'py>) -> Bound<'py, PyDict> {
-        PyDict::new(py)
+    /// The options as keyword arguments: ``Auto(**a.to_dict()) == a``.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("error", self.error())?;
+        d.set_item("time", self.time())?;
+        Ok(d)
     }
     /// The ``Ssm`` the rule picks for an output ``resolution`` (an int or
     /// (W, H)) from meshes.
@@ -247,11 +265,18 @@ impl PyAuto {
         )?;
         Ok(PySsm(auto_rule(r)))
     }
-    fn __getnewargs_ex__<'py>(&self, py: Python<'py>) -> (Bound<'py, PyTuple>, Bound<'py, PyDict>) {
-        (PyTuple::empty(py), PyDict::new(py))
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        Ok((PyTuple::empty(py), self.to_dict(py)?))
     }
-    fn __repr__(&self) -> &'static str {
-        "Auto()"
+    fn __repr__(&self) -> String {
+        match (self.error(), self.time()) {
+            (Some(e), _) => format!("Auto(error={e})"),
+            (_, Some(t)) => format!("Auto(time={t})"),
+            _ => "Auto()".into(),
+        }
     }
 }
 
@@ -266,8 +291,8 @@ fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
     if let Ok(c) = v.cast::<PyExact>() {
         return Some(MethodConfig::Exact(c.get().0));
     }
-    if v.cast::<PyAuto>().is_ok() {
-        return Some(MethodConfig::Auto(SsmConfig::default()));
+    if let Ok(a) = v.cast::<PyAuto>() {
+        return Some(MethodConfig::Auto(SsmConfig::default(), a.get().0));
     }
     if let Ok(c) = v.cast::<super::shadow_configs::PyPcss>() {
         return Some(MethodConfig::Pcss(c.get().0));
@@ -336,7 +361,7 @@ pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
         MethodConfig::Ssm(c) => Py::new(py, PySsm(c))?.into_any(),
         MethodConfig::Bitmask(c) => Py::new(py, PyBitmask(c))?.into_any(),
         MethodConfig::Exact(c) => Py::new(py, PyExact(c))?.into_any(),
-        MethodConfig::Auto(_) => Py::new(py, PyAuto)?.into_any(),
+        MethodConfig::Auto(_, t) => Py::new(py, PyAuto(t))?.into_any(),
         MethodConfig::ShadowMapping(c) => {
             Py::new(py, super::shadow_configs::PyShadowMapping(c))?.into_any()
         }

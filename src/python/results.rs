@@ -73,6 +73,9 @@ pub struct MeshShadowResult {
     /// Worker threads the CPU stages could use.
     #[pyo3(get)]
     threads: usize,
+    /// What `Auto` with a target decided: (name, taken, why) per decision.
+    #[pyo3(get)]
+    plan: Option<Vec<(&'static str, bool, String)>>,
 }
 
 #[pymethods]
@@ -107,6 +110,12 @@ impl MeshShadowResult {
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),
             threads: run.threads,
+            plan: run.plan.map(|p| {
+                p.decisions
+                    .into_iter()
+                    .map(|d| (d.name, d.taken, d.why))
+                    .collect()
+            }),
         })
     }
 }

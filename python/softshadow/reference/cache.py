@@ -31,13 +31,19 @@ def key(*parts: object) -> str:
     return h.hexdigest()[:24]
 
 
-def cached_reference_map(name: str, sm: Any, occluders: list[Any], *, samples: int, cache: Path) -> np.ndarray:
-    """``reference_map(sm, occluders, samples=samples)``, from ``cache`` when
-    it holds one for the same inputs; ``name`` labels the file."""
-    path = cache / f"{name}-{key(name, sm.light, sm.extent, sm.receiver_depth, samples, [m[0] for m in occluders])}.npy"
+def cached_reference_map(
+    name: str, sm: Any, occluders: list[Any], *, samples: int, cache: Path, seed: int = 0
+) -> np.ndarray:
+    """``reference_map(sm, occluders, samples=samples, seed=seed)``, from
+    ``cache`` when it holds one for the same inputs; ``name`` labels the file.
+    A second seed measures the reference's own noise."""
+    parts: list[object] = [name, sm.light, sm.extent, sm.receiver_depth, samples, [m[0] for m in occluders]]
+    if seed:
+        parts.append(("seed", seed))  # seed 0 keeps the keys it always had
+    path = cache / f"{name}-{key(*parts)}.npy"
     if path.exists():
         return np.load(path)
-    ref = reference_map(sm, occluders, samples=samples)
+    ref = reference_map(sm, occluders, samples=samples, seed=seed)
     cache.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(f".{os.getpid()}.tmp.npy")
     np.save(tmp, ref)

@@ -1,0 +1,449 @@
+//! `ss.Auto(error=..., time=...)`: the computation planned from the scene
+//! and the target, each decision with the number that made it.
+//!
+//! The planner reads what the framed scene says cheaply (light-space depth
+//! ranges of occluders and receivers, the light's size, the map's texel) and
+//! takes, in order:
+//!
+//! 1. *Hard shadows*: where every penumbra is under half a texel of the
+//!    output (the widest, L (w_near - w_far) with w = 1/depth, from the
+//!    nearest occluder to the farthest receiver, §3.3 of Atty et al. 2005),
+//!    the light is treated as a point: the hard shadow map.
+//! 2. *Receivers out of reach*: the part of the map no occluder's penumbra
+//!    can reach is lit without shading (the gather skips it); the plan says
+//!    how much.
+//! 3. *Sum or union*: where the occluders are one plane parallel to the
+//!    light, no two back-projections overlap and the SSM's sum is exact
+//!    (§3.4); elsewhere they overlap and the sum counts light twice, so the
+//!    bitmask's union runs unless the target allows the sum's error.
+//! 4. *Samples, hierarchy and occluder resolution from the target*: the
+//!    cheapest setting whose error, measured on the study's scenes and the
+//!    hard surfaces at 256² against Mitsuba (`benchmarks/bench_gaps.py`,
+//!    docs/benchmarks/gaps.md), is within the target; for a loose target
+//!    the occluder maps are coarsened while the narrowest penumbra still
+//!    spans `COARSE_TEXELS` occluder texels.
+//!
+//! `time=` plans by a probe: the cheapest soft setting runs first (its result
+//! is kept when nothing better fits), and each more accurate setting's time
+//! is predicted from it by the largest ratio measured on the study's scenes.
+
+use super::config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
+use super::shadow_mapping::config::Real;
+use crate::error::{Error, Result};
+
+/// What `ss.Auto` aims at: an error (the paper's §4.2.1 metric), a time
+/// budget in seconds, or neither (the fixed rule).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Target {
+    pub error: Option<Real>,
+    pub time: Option<Real>,
+}
+
+/// Smallest error target accepted: below it only many samples of `exact`
+/// help, which the plan can still give but not promise.
+pub const MIN_ERROR: f64 = 1e-4;
+
+impl Target {
+    pub fn new(error: Option<f64>, time: Option<f64>) -> Result<Target> {
+        let check = |arg: &str, v: Option<f64>, lo: f64, hi: f64, what: &str| {
+            v.map(|v| {
+                if v.is_finite() && v >= lo && v <= hi {
+                    Ok(Real(v))
+                } else {
+                    Err(Error::invalid(arg, format!("must be {what}, got {v}")))
+                }
+            })
+            .transpose()
+        };
+        let error = check("error", error, MIN_ERROR, 1.0, "in [1e-4, 1]")?;
+        let time = check("time", time, 1e-6, 1e6, "a time in seconds in [1e-6, 1e6]")?;
+        if error.is_some() && time.is_some() {
+            return Err(Error::invalid(
+                "time",
+                "give an error target or a time budget, not both",
+            ));
+        }
+        Ok(Target { error, time })
+    }
+
+    pub fn is_none(&self) -> bool {
+        self.error.is_none() && self.time.is_none()
+    }
+}
+
+/// What the planner reads of a framed scene (kernel units).
+#[derive(Debug, Clone, Copy)]
+pub struct SceneStats {
+    /// Output (W, H) and tangent half-extents.
+    pub resolution: (usize, usize),
+    pub extent: [f64; 2],
+    pub light_size: [f64; 2],
+    /// 1/depth of the nearest and farthest occluder vertex.
+    pub occ_w_near: f64,
+    pub occ_w_far: f64,
+    /// 1/depth of the nearest and farthest receiver vertex.
+    pub rec_w_near: f64,
+    pub rec_w_far: f64,
+    /// Tangent bounds of the occluders [x_lo, x_hi, y_lo, y_hi].
+    pub occ_bounds: [f64; 4],
+    /// Whether every occluder vertex shares one depth (a plane parallel to
+    /// the light, or several at one depth).
+    pub occ_flat: bool,
+}
+
+impl SceneStats {
+    /// The output's texel (the larger side), tangent units.
+    fn texel(&self) -> f64 {
+        (2.0 * self.extent[0] / self.resolution.0 as f64)
+            .max(2.0 * self.extent[1] / self.resolution.1 as f64)
+    }
+
+    fn light(&self) -> f64 {
+        self.light_size[0].max(self.light_size[1])
+    }
+
+    /// The widest penumbra, in output texels.
+    pub fn widest_penumbra(&self) -> f64 {
+        self.light() * (self.occ_w_near - self.rec_w_far).max(0.0) / self.texel()
+    }
+
+    /// The narrowest penumbra, in output texels: 0 where occluders and
+    /// receivers share depths (contact).
+    pub fn narrowest_penumbra(&self) -> f64 {
+        self.light() * (self.occ_w_far - self.rec_w_near).max(0.0) / self.texel()
+    }
+
+    /// The fraction of the map no occluder's penumbra reaches.
+    pub fn out_of_reach(&self) -> f64 {
+        let reach = 0.5 * self.light() * (self.occ_w_near - self.rec_w_far).max(0.0);
+        let [x0, x1, y0, y1] = self.occ_bounds;
+        let [tx, ty] = self.extent;
+        let w = ((x1 + reach).min(tx) - (x0 - reach).max(-tx)).max(0.0);
+        let h = ((y1 + reach).min(ty) - (y0 - reach).max(-ty)).max(0.0);
+        (1.0 - w * h / (4.0 * tx * ty)).clamp(0.0, 1.0)
+    }
+}
+
+/// One decision of a plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Decision {
+    /// A short name: "hard", "out_of_reach", "union", "setting".
+    pub name: &'static str,
+    pub taken: bool,
+    /// Why, with the number that decided.
+    pub why: String,
+}
+
+/// What the planner decided, and the config it chose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    pub decisions: Vec<Decision>,
+    /// Run the hard shadow map (the light as a point).
+    pub hard: bool,
+    pub config: MethodConfig,
+}
+
+/// A setting the planner can choose, with its measured worst error and
+/// the largest time ratio to the probe (`PROBE`) measured on the study's
+/// scenes at 256² (docs/benchmarks/gaps.md, docs/methods/auto.md).
+struct Candidate {
+    label: &'static str,
+    worst_error: f64,
+    time_ratio: f64,
+    config: fn((usize, usize)) -> MethodConfig,
+}
+
+/// Occluder texels the narrowest penumbra must span before the occluder
+/// maps are coarsened for a loose target.
+pub const COARSE_TEXELS: f64 = 16.0;
+
+fn bitmask(samples: u32, hierarchy: bool) -> MethodConfig {
+    MethodConfig::Bitmask(BitmaskConfig {
+        samples,
+        hierarchy: Some(hierarchy),
+        ..BitmaskConfig::default()
+    })
+}
+
+/// The settings in order of cost, the cheapest (the probe) first.
+const CANDIDATES: [Candidate; 4] = [
+    Candidate {
+        label: "ssm, 2 passes, quarter-resolution occluder maps (the sum)",
+        worst_error: 0.038,
+        time_ratio: 1.0,
+        config: |r| MethodConfig::Ssm(super::config::auto_rule(r)),
+    },
+    Candidate {
+        label: "bitmask, 256 samples, gaps closed, hierarchy",
+        worst_error: 0.008,
+        time_ratio: 120.0,
+        config: |_| bitmask(256, true),
+    },
+    Candidate {
+        label: "bitmask, 256 samples, gaps closed, no hierarchy",
+        worst_error: 0.0066,
+        time_ratio: 160.0,
+        config: |_| bitmask(256, false),
+    },
+    Candidate {
+        label: "bitmask, 1024 samples, gaps closed, no hierarchy",
+        worst_error: 0.005,
+        time_ratio: 500.0,
+        config: |_| bitmask(1024, false),
+    },
+];
+
+/// exact's error at `samples` per receiver, measured: about 0.05 / sqrt(n)
+/// (1024 samples: 0.0012-0.0019 against 4096 on the test scenes).
+fn exact_samples_for(error: f64) -> u32 {
+    let n = (0.05 / error).powi(2).ceil();
+    n.clamp(16.0, super::config::MAX_SAMPLES as f64) as u32
+}
+
+/// The plan for `stats` and `target`; `probe_seconds` is the probe's time
+/// when planning for a budget (None: not run yet, the caller runs the probe
+/// config and asks again).
+pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> Plan {
+    let res = stats.resolution;
+    let mut d = vec![];
+    let widest = stats.widest_penumbra();
+    let hard = widest < 0.5;
+    d.push(Decision {
+        name: "hard",
+        taken: hard,
+        why: format!(
+            "the widest penumbra spans {widest:.2} texels of the output ({}half a texel)",
+            if hard { "under " } else { "at least " }
+        ),
+    });
+    let out = stats.out_of_reach();
+    d.push(Decision {
+        name: "out_of_reach",
+        taken: out > 0.0,
+        why: format!(
+            "{:.0}% of the map lies beyond every occluder's penumbra and is lit without shading",
+            100.0 * out
+        ),
+    });
+    if hard {
+        return Plan {
+            decisions: d,
+            hard: true,
+            config: (CANDIDATES[0].config)(res),
+        };
+    }
+    let flat = stats.occ_flat;
+    d.push(Decision {
+        name: "union",
+        taken: !flat,
+        why: if flat {
+            "the occluders are one plane parallel to the light: no back-projections overlap, \
+             the sum is exact"
+                .into()
+        } else {
+            "the occluders span depths: back-projections overlap, the sum counts them twice".into()
+        },
+    });
+    let config = if flat {
+        // The sum at the output's resolution: what remains is the texels'
+        // discretization, whatever the target.
+        MethodConfig::Ssm(SsmConfig {
+            passes: Some(1),
+            ..SsmConfig::default()
+        })
+    } else if let Some(Real(e)) = target.error {
+        match CANDIDATES.iter().find(|c| c.worst_error <= e) {
+            Some(c) => {
+                d.push(Decision {
+                    name: "setting",
+                    taken: true,
+                    why: format!(
+                        "{}: measured error at most {} on the study's scenes and the hard \
+                         surfaces, within the target {e}",
+                        c.label, c.worst_error
+                    ),
+                });
+                coarsen((c.config)(res), stats, e, &mut d)
+            }
+            None => {
+                let samples = exact_samples_for(e);
+                d.push(Decision {
+                    name: "setting",
+                    taken: true,
+                    why: format!(
+                        "no map setting measured within {e} (the best: {}); exact with {samples} \
+                         samples (error about 0.05/sqrt(samples))",
+                        CANDIDATES[CANDIDATES.len() - 1].worst_error
+                    ),
+                });
+                MethodConfig::Exact(ExactConfig { samples })
+            }
+        }
+    } else if let Some(Real(t)) = target.time {
+        match probe_seconds {
+            None => (CANDIDATES[0].config)(res),
+            Some(p) => {
+                let left = t - p;
+                let best = CANDIDATES
+                    .iter()
+                    .rev()
+                    .find(|c| c.time_ratio == 1.0 || c.time_ratio * p <= left)
+                    .unwrap_or(&CANDIDATES[0]);
+                d.push(Decision {
+                    name: "setting",
+                    taken: true,
+                    why: format!(
+                        "{}: the probe took {:.4} s, predicted {:.4} s (x{} measured at most) \
+                         within the {:.4} s left of {t} s",
+                        best.label,
+                        p,
+                        best.time_ratio * p,
+                        best.time_ratio,
+                        left.max(0.0)
+                    ),
+                });
+                (best.config)(res)
+            }
+        }
+    } else {
+        d.push(Decision {
+            name: "setting",
+            taken: true,
+            why: format!(
+                "no target: {} (the study's point furthest ahead of ray tracing)",
+                CANDIDATES[0].label
+            ),
+        });
+        (CANDIDATES[0].config)(res)
+    };
+    Plan {
+        decisions: d,
+        hard: false,
+        config,
+    }
+}
+
+/// Coarser occluder maps for a bitmask setting under a loose target (at
+/// least 0.01): halved while the narrowest penumbra spans COARSE_TEXELS
+/// occluder texels, never below 64.
+fn coarsen(
+    config: MethodConfig,
+    stats: &SceneStats,
+    error: f64,
+    d: &mut Vec<Decision>,
+) -> MethodConfig {
+    let MethodConfig::Bitmask(mut c) = config else {
+        return config;
+    };
+    let narrow = stats.narrowest_penumbra();
+    let (w, h) = stats.resolution;
+    let mut f = 1usize;
+    while error >= 0.01
+        && narrow / (2 * f) as f64 >= COARSE_TEXELS
+        && w / (2 * f) >= 64
+        && h / (2 * f) >= 64
+    {
+        f *= 2;
+    }
+    d.push(Decision {
+        name: "occluder_resolution",
+        taken: f > 1,
+        why: format!(
+            "the narrowest penumbra spans {narrow:.1} output texels; occluder maps at 1/{f} of \
+             the output's resolution keep at least {COARSE_TEXELS} of their texels across it{}",
+            if error < 0.01 {
+                " (targets under 0.01 keep the full resolution)"
+            } else {
+                ""
+            }
+        ),
+    });
+    if f > 1 {
+        c.occluder_resolution = Some((w / f, h / f));
+    }
+    MethodConfig::Bitmask(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stats() -> SceneStats {
+        SceneStats {
+            resolution: (256, 256),
+            extent: [0.35, 0.35],
+            light_size: [1.0, 1.0],
+            occ_w_near: 1.0 / 2.0,
+            occ_w_far: 1.0 / 3.0,
+            rec_w_near: 0.25,
+            rec_w_far: 0.25,
+            occ_bounds: [-0.1, 0.1, -0.1, 0.1],
+            occ_flat: false,
+        }
+    }
+
+    #[test]
+    fn a_tiny_light_is_a_point_and_a_big_one_is_not() {
+        let mut s = stats();
+        assert!(!plan(&s, &Target::default(), None).hard);
+        s.light_size = [1e-4, 1e-4];
+        assert!(plan(&s, &Target::default(), None).hard);
+    }
+
+    #[test]
+    fn tighter_targets_pick_costlier_settings() {
+        let s = stats();
+        let pick = |e: f64| plan(&s, &Target::new(Some(e), None).unwrap(), None).config;
+        assert!(matches!(pick(0.05), MethodConfig::Ssm(_)));
+        assert!(matches!(pick(0.01), MethodConfig::Bitmask(c) if c.samples == 256));
+        assert!(matches!(pick(0.005), MethodConfig::Bitmask(c) if c.samples == 1024));
+        assert!(matches!(pick(0.001), MethodConfig::Exact(c) if c.samples == 2500));
+    }
+
+    #[test]
+    fn wide_penumbrae_coarsen_the_occluder_maps_for_loose_targets_only() {
+        let s = stats();
+        // Narrowest: (1/3 - 1/4) / (0.7 / 256) = 30.5 texels: one halving.
+        let c = plan(&s, &Target::new(Some(0.01), None).unwrap(), None).config;
+        assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution == Some((128, 128))));
+        let c = plan(&s, &Target::new(Some(0.007), None).unwrap(), None).config;
+        assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution.is_none()));
+        let mut contact = s;
+        contact.occ_w_far = 0.25;
+        let c = plan(&contact, &Target::new(Some(0.01), None).unwrap(), None).config;
+        assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution.is_none()));
+    }
+
+    #[test]
+    fn a_flat_occluder_takes_the_sum_whatever_the_target() {
+        let mut s = stats();
+        s.occ_flat = true;
+        let p = plan(&s, &Target::new(Some(0.002), None).unwrap(), None);
+        assert!(matches!(p.config, MethodConfig::Ssm(_)));
+        assert!(p.decisions.iter().any(|d| d.name == "union" && !d.taken));
+    }
+
+    #[test]
+    fn a_budget_picks_what_the_probe_predicts_fits() {
+        let s = stats();
+        let t = Target::new(None, Some(1.0)).unwrap();
+        assert!(matches!(plan(&s, &t, None).config, MethodConfig::Ssm(_)));
+        // Probe 1 ms: 1024 samples predicted 0.5 s, fits.
+        assert!(
+            matches!(plan(&s, &t, Some(1e-3)).config, MethodConfig::Bitmask(c) if c.samples == 1024)
+        );
+        // Probe 0.1 s: nothing else fits.
+        assert!(matches!(
+            plan(&s, &t, Some(0.1)).config,
+            MethodConfig::Ssm(_)
+        ));
+    }
+
+    #[test]
+    fn targets_are_checked() {
+        assert!(Target::new(Some(0.0), None).is_err());
+        assert!(Target::new(Some(f64::NAN), None).is_err());
+        assert!(Target::new(None, Some(-1.0)).is_err());
+        assert!(Target::new(Some(0.01), Some(1.0)).is_err());
+    }
+}

@@ -1,0 +1,107 @@
+"""ss.Auto(error=..., time=...): each decision taken when the scene calls for
+it and only then, and the planned result meeting its target."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import softshadow as ss
+from softshadow import metrics, scenes
+
+
+def decision(sm: ss.ShadowMap, name: str) -> ss.Decision:
+    assert sm.plan is not None
+    (d,) = [d for d in sm.plan.decisions if d.name == name]
+    return d
+
+
+def planned(make, target=0.01, res=64, **kw) -> ss.ShadowMap:
+    scene, light = make(**kw)
+    return ss.soft_shadow_map(scene, light, resolution=res, method=ss.Auto(error=target))
+
+
+def test_a_light_whose_penumbrae_are_under_half_a_texel_is_a_point():
+    tiny = planned(scenes.bunny_floating, light_size=1e-4)
+    assert decision(tiny, "hard").taken
+    # The hard shadow map: visibility is 0 or 1, as for a point light.
+    assert set(np.unique(tiny.visibility)) <= {0.0, 1.0}
+    point = ss.soft_shadow_map(
+        *scenes.bunny_floating(light_size=0.0), resolution=64, extent=tiny.extent, method=tiny.method
+    )
+    assert np.array_equal(tiny.visibility, point.visibility)
+    assert not decision(planned(scenes.bunny_floating), "hard").taken
+
+
+def test_a_plate_parallel_to_the_light_takes_the_sum_and_a_tilted_one_the_union():
+    flat = planned(scenes.square_plate, target=0.005)
+    assert not decision(flat, "union").taken and isinstance(flat.method, ss.Ssm)
+    tilted = planned(scenes.tilted_plate, target=0.005)
+    assert decision(tilted, "union").taken and isinstance(tilted.method, ss.Bitmask)
+
+
+def test_wide_penumbrae_coarsen_the_occluder_maps_and_contact_does_not():
+    floating = planned(scenes.bunny_floating, res=256)
+    assert decision(floating, "occluder_resolution").taken
+    assert floating.method.occluder_resolution < (256, 256)
+    contact = planned(scenes.bunny_on_floor, res=256)
+    assert not decision(contact, "occluder_resolution").taken
+    assert contact.method.occluder_resolution == (256, 256)
+    # A tight target keeps the full resolution even where penumbrae are wide.
+    tight = planned(scenes.bunny_floating, target=0.005, res=256)
+    assert tight.method.occluder_resolution == (256, 256)
+
+
+def test_receivers_beyond_every_penumbra_are_reported():
+    assert decision(planned(scenes.bunny_floating), "out_of_reach").taken
+    # The plate's shadow fills the fitted map.
+    assert not decision(planned(scenes.square_plate), "out_of_reach").taken
+
+
+def test_tighter_targets_cost_more_samples():
+    loose, tight = (planned(scenes.torus_floating, target=t) for t in (0.01, 0.005))
+    assert isinstance(loose.method, ss.Bitmask) and isinstance(tight.method, ss.Bitmask)
+    assert tight.method.samples > loose.method.samples
+    below_maps = planned(scenes.torus_floating, target=0.001)
+    assert isinstance(below_maps.method, ss.Exact)
+    assert "exact" in str(below_maps.plan)
+
+
+def test_a_time_budget_runs_a_probe_then_what_fits():
+    scene, light = scenes.bunny_floating()
+    none_fits = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(time=1e-6))
+    assert isinstance(none_fits.method, ss.Ssm)
+    roomy = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(time=30.0))
+    assert isinstance(roomy.method, ss.Bitmask)
+    assert "probe" in decision(roomy, "setting").why
+    assert roomy.timings["plan"] < 0.05 * sum(roomy.timings.values())
+
+
+def test_without_a_target_auto_is_the_rule_and_has_no_plan():
+    scene, light = scenes.bunny_floating()
+    sm = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto())
+    assert sm.plan is None and isinstance(sm.method, ss.Ssm)
+    assert ss.soft_shadow_map(scene, light, resolution=64, method=ss.Bitmask()).plan is None
+
+
+def test_auto_targets_are_checked_and_round_trip():
+    a = ss.Auto(error=0.01)
+    assert (a.error, a.time) == (0.01, None) and repr(a) == "Auto(error=0.01)"
+    assert ss.Auto(**a.to_dict()) == a and pickle.loads(pickle.dumps(a)) == a
+    assert ss.Auto(time=2.0) != ss.Auto() and ss.Auto().to_dict() == {"error": None, "time": None}
+    for kw, arg in [(dict(error=0.0), "error"), (dict(error=2.0), "error"), (dict(time=-1.0), "time")]:
+        with pytest.raises(ValueError, match=arg):
+            ss.Auto(**kw)
+    with pytest.raises(ValueError, match="time.*not both"):
+        ss.Auto(error=0.01, time=1.0)
+    with pytest.raises(TypeError, match="error"):
+        ss.Auto(error="small")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("name", ["bunny_floating", "bunny_on_floor", "two_spheres", "torus"])
+def test_the_plan_meets_its_target_against_mitsuba(reference_for, name):
+    scene, light = scenes.SCENES[name]()
+    base = ss.soft_shadow_map(scene, light, resolution=256)
+    ref = reference_for(name, base, scene.occluders)
+    sm = ss.soft_shadow_map(scene, light, resolution=256, extent=base.extent, method=ss.Auto(error=0.01))
+    assert metrics.shadow_error(sm.visibility, ref) <= 0.01, sm.plan
