@@ -158,20 +158,35 @@ impl<const W: usize> Pattern<W> {
     /// anyway (and the branch mispredicts).
     #[inline(always)]
     fn x_band(&self, ka: u16, kb: u16) -> Mask<W> {
-        let (a, b) = (&self.x_ge[ka as usize], &self.x_ge[kb as usize]);
-        std::array::from_fn(|q| a[q] & !b[q])
+        and_not(&self.x_ge[ka as usize], &self.x_ge[kb as usize])
     }
 
     #[inline(always)]
     fn y_band(&self, kc: u16, kd: u16) -> Mask<W> {
-        let (c, d) = (&self.y_ge[kc as usize], &self.y_ge[kd as usize]);
-        std::array::from_fn(|q| c[q] & !d[q])
+        and_not(&self.y_ge[kc as usize], &self.y_ge[kd as usize])
     }
 }
 
+// Explicit loops, not `std::array::from_fn`: the kernels are compiled with
+// AVX2 / AVX-512 enabled (gather/simd.rs), and from_fn's closure was not
+// inlined into them (profiled: a third of the time in `try_from_fn`, and
+// libm calls for ceil and floor outside the vector code).
 #[inline(always)]
 fn and<const W: usize>(a: Mask<W>, b: Mask<W>) -> Mask<W> {
-    std::array::from_fn(|q| a[q] & b[q])
+    let mut m = [0u64; W];
+    for q in 0..W {
+        m[q] = a[q] & b[q];
+    }
+    m
+}
+
+#[inline(always)]
+fn and_not<const W: usize>(a: &Mask<W>, b: &Mask<W>) -> Mask<W> {
+    let mut m = [0u64; W];
+    for q in 0..W {
+        m[q] = a[q] & !b[q];
+    }
+    m
 }
 
 /// Light coordinate t in [-1, 1] (half-light units relative to the
@@ -308,12 +323,15 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
     ) {
         let p = self.p;
         let b = p.bounds(w - g.wr[0]);
-        let xb: [Mask<W>; TILE_W] =
-            std::array::from_fn(|c| p.x_band(b.lo(x0 - r.xr[c]), b.hi(x1 - r.xr[c])));
-        let yb: [Mask<W>; ROWS_PER_GROUP] = std::array::from_fn(|row| {
+        let mut xb = [[0u64; W]; TILE_W];
+        for (c, m) in xb.iter_mut().enumerate() {
+            *m = p.x_band(b.lo(x0 - r.xr[c]), b.hi(x1 - r.xr[c]));
+        }
+        let mut yb = [[0u64; W]; ROWS_PER_GROUP];
+        for (row, m) in yb.iter_mut().enumerate() {
             let l = row * TILE_W;
-            p.y_band(b.lo(-r.nay0[l]), b.hi(r.ay1[l]))
-        });
+            *m = p.y_band(b.lo(-r.nay0[l]), b.hi(r.ay1[l]));
+        }
         self.mark_tile(acc, &xb, &yb);
     }
 
@@ -338,7 +356,12 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         for l in 0..LANES {
             let wr = g.wr[l];
             let d = w - wr;
-            let i: [f32; 4] = std::array::from_fn(|q| corner_inv(c[q], wr, d));
+            let i = [
+                corner_inv(c[0], wr, d),
+                corner_inv(c[1], wr, d),
+                corner_inv(c[2], wr, d),
+                corner_inv(c[3], wr, d),
+            ];
             let (a, e) = (x0 - r.xr[l], x1 - r.xr[l]);
             let (bottom, top) = (-r.nay0[l], r.ay1[l]);
             let (xa, xb) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
@@ -367,18 +390,26 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         let p = self.p;
         let b = p.scaled(1.0);
         let wr = g.wr[0];
-        let i: [f32; 4] = std::array::from_fn(|q| corner_inv(c[q], wr, w - wr));
-        let xb: [Mask<W>; TILE_W] = std::array::from_fn(|col| {
+        let d = w - wr;
+        let i = [
+            corner_inv(c[0], wr, d),
+            corner_inv(c[1], wr, d),
+            corner_inv(c[2], wr, d),
+            corner_inv(c[3], wr, d),
+        ];
+        let mut xb = [[0u64; W]; TILE_W];
+        for (col, m) in xb.iter_mut().enumerate() {
             let (a, e) = (x0 - r.xr[col], x1 - r.xr[col]);
-            let (xa, xb) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
-            p.x_band(b.lo(xa), b.hi(xb))
-        });
-        let yb: [Mask<W>; ROWS_PER_GROUP] = std::array::from_fn(|row| {
+            let (lo, hi) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
+            *m = p.x_band(b.lo(lo), b.hi(hi));
+        }
+        let mut yb = [[0u64; W]; ROWS_PER_GROUP];
+        for (row, m) in yb.iter_mut().enumerate() {
             let l = row * TILE_W;
             let (bottom, top) = (-r.nay0[l], r.ay1[l]);
-            let (ya, yb) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
-            p.y_band(b.lo(ya), b.hi(yb))
-        });
+            let (lo, hi) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
+            *m = p.y_band(b.lo(lo), b.hi(hi));
+        }
         self.mark_tile(acc, &xb, &yb);
     }
 

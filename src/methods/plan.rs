@@ -374,7 +374,7 @@ mod tests {
             extent: [0.35, 0.35],
             light_size: [1.0, 1.0],
             occ_w_near: 1.0 / 2.0,
-            occ_w_far: 1.0 / 3.0,
+            occ_w_far: 1.0 / 2.9,
             rec_w_near: 0.25,
             rec_w_far: 0.25,
             occ_bounds: [-0.1, 0.1, -0.1, 0.1],
@@ -403,7 +403,8 @@ mod tests {
     #[test]
     fn wide_penumbrae_coarsen_the_occluder_maps_for_loose_targets_only() {
         let s = stats();
-        // Narrowest: (1/3 - 1/4) / (0.7 / 256) = 30.5 texels: one halving.
+        // Narrowest: (1/2.9 - 1/4) / (0.7 / 256) = 34.7 texels: one halving
+        // (17.3 >= COARSE_TEXELS at 1/2, 8.7 at 1/4).
         let c = plan(&s, &Target::new(Some(0.01), None).unwrap(), None).config;
         assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution == Some((128, 128))));
         let c = plan(&s, &Target::new(Some(0.007), None).unwrap(), None).config;
