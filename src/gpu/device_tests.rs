@@ -347,6 +347,38 @@ fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
 }
 
 #[test]
+fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
+    // A large light over a 320² occluder map: every receiver's rows in reach
+    // take several dispatches per layer (32-word masks: the fewest rows per
+    // chunk), and the quads' corners widen the reach.
+    if !device_or_skip() {
+        return;
+    }
+    use crate::geom::light::MapGrid;
+    let grid = MapGrid::new(24, 20, [0.6, 0.5]).unwrap();
+    let og = MapGrid::new(320, 320, [0.6, 0.5]).unwrap();
+    let (front, back) = tilted_depth_maps(&og);
+    let receiver = vec![2.8f32; grid.len()];
+    let light = [2.5, 2.0];
+    for method in bitmask_kernels()
+        .into_iter()
+        .filter(|m| matches!(m, Method::Bitmask { samples: 1024, .. }))
+    {
+        // Chunks from the depths' own bound (depth unit 1: the receivers
+        // lie within [2^-16, 2^16]).
+        let w_max = front.iter().fold(0f64, |m, &z| m.max(1.0 / z as f64));
+        assert!(super::gather::chunking(&og, light, w_max, method).1 > 2);
+        let (c, _) =
+            pipeline::from_depth(&grid, &og, light, &front, Some(&back), &receiver, method)
+                .unwrap();
+        let (g, _) =
+            super::from_depth(&grid, &og, light, &front, Some(&back), &receiver, method).unwrap();
+        assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 100);
+        assert_eq!(same_bits(&c, &g), 0, "{method:?}");
+    }
+}
+
+#[test]
 fn triangles_larger_than_an_invocations_loop_budget_are_drawn_whole() {
     // The floor's two triangles cover 300 x 300 texels: one invocation per
     // triangle would stop after 65535 loop iterations on lavapipe.
