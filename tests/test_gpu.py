@@ -90,6 +90,71 @@ def test_gpu_matches_cpu_on_the_scenes(gpu, name, passes, method, samples):
         assert_depth_maps_agree(a, b, f"{name} middle {k}")
 
 
+def same_maps(c, g) -> bool:
+    """Whether every map of the two results holds the same bits."""
+    pairs = [(c.receiver_depth, g.receiver_depth), (c.occluder_depth, g.occluder_depth)]
+    if c.occluder_depth_back is not None:
+        pairs.append((c.occluder_depth_back, g.occluder_depth_back))
+    pairs += list(zip(c.occluder_depth_middle, g.occluder_depth_middle, strict=True))
+    return all((a.view(np.uint32) == b.view(np.uint32)).all() for a, b in pairs)
+
+
+def assert_bitmask_agrees(c, g, name: str) -> None:
+    """The bitmask's masks OR, so on the same maps (lavapipe) the GPU's
+    visibility is the CPU's bit for bit (hierarchy off); where a real GPU
+    rounds a silhouette texel differently, within the usual tolerances."""
+    if same_maps(c, g):
+        differ = c.visibility.view(np.uint32) != g.visibility.view(np.uint32)
+        assert not differ.any(), f"{name}: {differ.sum()} texels differ on the same maps"
+    else:
+        assert_visibility_agrees(c.visibility, g.visibility, name)
+
+
+@pytest.mark.parametrize("gaps", ["closed", "open"])
+@pytest.mark.parametrize("samples", [16, 1024])
+@pytest.mark.parametrize("passes", [1, 2])
+@pytest.mark.parametrize("name", SCENES)
+def test_gpu_bitmask_is_the_cpus_bit_for_bit(gpu, name, passes, samples, gaps):
+    scene, light = getattr(scenes, name)()
+    config = ss.Bitmask(samples=samples, passes=passes, gaps=gaps, hierarchy=False)
+    c = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=config, backend="cpu")
+    g = ss.soft_shadow_map(scene, light, resolution=(64, 48), method=config, backend="gpu")
+    assert repr(g.method) == repr(c.method) and g.method.gaps == gaps
+    assert_depth_maps_agree(c.occluder_depth, g.occluder_depth, f"{name} front")
+    assert_bitmask_agrees(c, g, name)
+    # Closed gaps make the quads' corners on the CPU, between two submissions.
+    assert ("corners" in g.timings) == (gaps == "closed")
+
+
+@pytest.mark.parametrize("gaps", ["closed", "open"])
+@pytest.mark.parametrize("samples", [64, 1024])
+def test_gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit(gpu, samples, gaps):
+    scene, light = scenes.bunny_floating()
+    sm = ss.soft_shadow_map(scene, light, resolution=(48, 40), occluder_resolution=(36, 30), passes=2)
+    config = ss.Bitmask(samples=samples, gaps=gaps, hierarchy=False)
+    for back in (sm.occluder_depth_back, None):
+        kw = dict(light_size=light.size, extent=sm.extent, occluder_depth_back=back, method=config)
+        c = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="cpu", **kw)
+        g = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="gpu", **kw)
+        assert ((c.visibility > 0.01) & (c.visibility < 0.99)).sum() > 30
+        differ = c.visibility.view(np.uint32) != g.visibility.view(np.uint32)
+        assert not differ.any(), f"back {back is not None}: {differ.sum()} texels differ"
+
+
+def test_gpu_bitmask_gaps_change_the_answer(gpu):
+    # The quads close the gaps between neighbours: less light in the
+    # penumbra than the flat patches let through, on both backends.
+    scene, light = scenes.bunny_floating()
+    v = {
+        gaps: ss.soft_shadow_map(
+            scene, light, resolution=48, method=ss.Bitmask(samples=256, gaps=gaps), backend="gpu"
+        ).visibility
+        for gaps in ("closed", "open")
+    }
+    assert (v["closed"] != v["open"]).any()
+    assert v["closed"].mean() < v["open"].mean()
+
+
 @pytest.mark.parametrize(
     "config",
     [

@@ -172,6 +172,213 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
     }
 }
 
+/// Every bitmask kernel the GPU runs: both gaps, the smallest and largest
+/// masks (8 and 32 words) and one between.
+fn bitmask_kernels() -> Vec<Method> {
+    use crate::methods::bitmask::Gaps;
+    [16, 256, 1024]
+        .into_iter()
+        .flat_map(|samples| {
+            Gaps::ALL.map(|gaps| Method::Bitmask {
+                samples,
+                hierarchy: false,
+                gaps,
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn gpu_bitmask_is_the_cpus_bit_for_bit_both_gaps_every_mask() {
+    // The visibility itself, not within a tolerance: masks OR, so the GPU's
+    // order does not matter and its bits are the CPU's (hierarchy off).
+    if !device_or_skip() {
+        return;
+    }
+    use crate::methods::bitmask::Gaps;
+    for (passes, occ) in [(1, None), (2, None), (2, Some((40, 30)))] {
+        let mut by_gaps = vec![];
+        for method in bitmask_kernels() {
+            let go = |gpu: bool| {
+                let s = MapSettings {
+                    width: 64,
+                    height: 48,
+                    extent: None,
+                    occluder_resolution: occ,
+                    passes,
+                    method,
+                };
+                let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
+                let (rv, rf) = floor();
+                let light = RectLight::new(
+                    [0.0, 4.0, 0.0],
+                    [0.0, -1.0, 0.0],
+                    [0.0, 0.0, 1.0],
+                    [1.0, 1.0],
+                )
+                .unwrap();
+                let (o, r) = (
+                    MeshRef {
+                        vertices: &ov,
+                        faces: &of,
+                    },
+                    MeshRef {
+                        vertices: &rv,
+                        faces: &rf,
+                    },
+                );
+                if gpu {
+                    super::from_meshes(o, r, &light.into(), &s).unwrap()
+                } else {
+                    pipeline::from_meshes(o, r, &light.into(), &s).unwrap()
+                }
+            };
+            let (c, g) = (go(false), go(true));
+            let penumbra = c
+                .visibility
+                .iter()
+                .filter(|&&v| v > 0.01 && v < 0.99)
+                .count();
+            assert!(penumbra > 50, "{method:?}");
+            let front = |r: &ShadowResult| r.occluder_front.clone().unwrap();
+            assert_eq!(same_bits(&front(&c), &front(&g)), 0, "{method:?} front");
+            let n = same_bits(&c.visibility, &g.visibility);
+            eprintln!(
+                "{method:?} passes {passes} occ {occ:?}: {n} texels differ, penumbra {penumbra}"
+            );
+            assert_eq!(n, 0, "{method:?}, passes {passes}, occluders {occ:?}");
+            if passes == 2 && occ.is_none() {
+                // Two layers (the sphere's back): names from both submissions.
+                let names: Vec<&str> = g.timings.iter().map(|t| t.0).collect();
+                let mut unique = names.clone();
+                unique.sort();
+                unique.dedup();
+                assert_eq!(unique.len(), names.len(), "{names:?}");
+            }
+            by_gaps.push((method, g.visibility));
+        }
+        // The quads change the answer (the sphere's curved silhouette).
+        for pair in by_gaps.chunks(2) {
+            let [(a, va), (b, vb)] = pair else { panic!() };
+            assert!(matches!(
+                a,
+                Method::Bitmask {
+                    gaps: Gaps::Closed,
+                    ..
+                }
+            ));
+            assert!(matches!(
+                b,
+                Method::Bitmask {
+                    gaps: Gaps::Open,
+                    ..
+                }
+            ));
+            assert!(same_bits(va, vb) > 0, "{a:?}: closed and open agree");
+        }
+    }
+}
+
+/// Depth-map inputs whose texels make every corner rule: tilted rectangles
+/// (connected planes, extrapolated borders), steps between them, and holes.
+fn tilted_depth_maps(og: &crate::geom::light::MapGrid) -> (Vec<f32>, Vec<f32>) {
+    let mut seed = 7u64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let rects: Vec<[f64; 7]> = (0..10)
+        .map(|_| {
+            let (x, y) = (next() - 0.6, next() - 0.6);
+            let (w, h) = (0.1 + 0.3 * next(), 0.1 + 0.3 * next());
+            let (sx, sy) = (0.8 * next() - 0.4, 0.8 * next() - 0.4);
+            [x, y, x + w, y + h, 1.2 + 0.6 * next(), sx, sy]
+        })
+        .collect();
+    let at = |k: usize, back: bool| -> f32 {
+        let (x, y) = (og.x_of(k % og.width), og.y_of(k / og.width));
+        let z = rects
+            .iter()
+            .filter(|r| (r[0]..r[2]).contains(&x) && (r[1]..r[3]).contains(&y))
+            .map(|r| r[4] + r[5] * x + r[6] * y + if back { 0.1 } else { 0.0 })
+            .fold(f64::INFINITY, f64::min);
+        z as f32
+    };
+    let front = (0..og.len()).map(|k| at(k, false)).collect();
+    let back = (0..og.len()).map(|k| at(k, true)).collect();
+    (front, back)
+}
+
+#[test]
+fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
+    if !device_or_skip() {
+        return;
+    }
+    use crate::geom::light::MapGrid;
+    let grid = MapGrid::new(48, 40, [0.6, 0.5]).unwrap();
+    for og in [grid, MapGrid::new(61, 37, [0.6, 0.5]).unwrap()] {
+        let (front, back) = tilted_depth_maps(&og);
+        let receiver: Vec<f32> = (0..grid.len())
+            .map(|k| 2.6 + 0.1 * ((k * 7) % 5) as f32)
+            .collect();
+        for method in bitmask_kernels() {
+            for back in [None, Some(&back[..])] {
+                let light = [0.8, 0.6];
+                let (c, _) =
+                    pipeline::from_depth(&grid, &og, light, &front, back, &receiver, method)
+                        .unwrap();
+                let (g, t) =
+                    super::from_depth(&grid, &og, light, &front, back, &receiver, method).unwrap();
+                assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 50);
+                let n = same_bits(&c, &g);
+                assert_eq!(n, 0, "{method:?}, back {}, {og:?}", back.is_some());
+                let closed = matches!(
+                    method,
+                    Method::Bitmask {
+                        gaps: crate::methods::bitmask::Gaps::Closed,
+                        ..
+                    }
+                );
+                assert_eq!(t.iter().any(|s| s.0 == "corners"), closed);
+            }
+        }
+    }
+}
+
+#[test]
+fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
+    // A large light over a 320² occluder map: every receiver's rows in reach
+    // take several dispatches per layer (32-word masks: the fewest rows per
+    // chunk), and the quads' corners widen the reach.
+    if !device_or_skip() {
+        return;
+    }
+    use crate::geom::light::MapGrid;
+    let grid = MapGrid::new(24, 20, [0.6, 0.5]).unwrap();
+    let og = MapGrid::new(320, 320, [0.6, 0.5]).unwrap();
+    let (front, back) = tilted_depth_maps(&og);
+    let receiver = vec![2.8f32; grid.len()];
+    let light = [2.5, 2.0];
+    for method in bitmask_kernels()
+        .into_iter()
+        .filter(|m| matches!(m, Method::Bitmask { samples: 1024, .. }))
+    {
+        // Chunks from the depths' own bound (depth unit 1: the receivers
+        // lie within [2^-16, 2^16]).
+        let w_max = front.iter().fold(0f64, |m, &z| m.max(1.0 / z as f64));
+        assert!(super::gather::chunking(&og, light, w_max, method).1 > 2);
+        let (c, _) =
+            pipeline::from_depth(&grid, &og, light, &front, Some(&back), &receiver, method)
+                .unwrap();
+        let (g, _) =
+            super::from_depth(&grid, &og, light, &front, Some(&back), &receiver, method).unwrap();
+        assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 100);
+        assert_eq!(same_bits(&c, &g), 0, "{method:?}");
+    }
+}
+
 #[test]
 fn triangles_larger_than_an_invocations_loop_budget_are_drawn_whole() {
     // The floor's two triangles cover 300 x 300 texels: one invocation per
@@ -497,6 +704,63 @@ mod eye {
     }
 
     #[test]
+    fn gpu_bitmask_renders_are_the_cpus_bit_for_bit() {
+        // The points mode: where both G-buffers see the same surface point
+        // the visibility is the same bits, for both gaps, 16 and 1024
+        // samples, 1 and 2 passes, both lights.
+        if !device_or_skip() {
+            return;
+        }
+        use crate::methods::bitmask::Gaps;
+        let meshes = scene();
+        let cam = camera((80, 60));
+        for (lname, light) in lights() {
+            for samples in [16, 1024] {
+                for passes in [1, 2] {
+                    let mut by_gaps = vec![];
+                    for gaps in Gaps::ALL {
+                        let method = MethodConfig::Bitmask(BitmaskConfig {
+                            samples,
+                            passes: Some(passes),
+                            hierarchy: Some(false),
+                            gaps,
+                            ..Default::default()
+                        });
+                        let c = render(&meshes, &light, &cam, method, BackendChoice::Cpu).unwrap();
+                        let g = render(&meshes, &light, &cam, method, BackendChoice::Gpu).unwrap();
+                        assert_eq!(c.method, g.method);
+                        let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+                        let same = same_surface(&c.output, &g.output);
+                        let compared = same.iter().filter(|&&s| s).count();
+                        let differ = (0..cv.len())
+                            .filter(|&k| same[k] && cv[k].to_bits() != gv[k].to_bits())
+                            .count();
+                        let penumbra = (0..cv.len())
+                            .filter(|&k| same[k] && cv[k] > 0.02 && cv[k] < 0.98)
+                            .count();
+                        eprintln!(
+                            "{lname} {samples} {passes} {gaps:?}: {differ} of {compared} differ, \
+                             penumbra {penumbra}"
+                        );
+                        let seen = c.output.gbuffer.mesh_id.iter().filter(|&&m| m >= 0).count();
+                        assert!(compared * 100 >= seen * 99 && penumbra > 20);
+                        assert_eq!(differ, 0, "{lname} {samples} {passes} {gaps:?}");
+                        let names: Vec<&str> = g.output.timings.iter().map(|t| t.0).collect();
+                        assert_eq!(names.contains(&"corners"), gaps == Gaps::Closed);
+                        by_gaps.push(g.output.visibility);
+                    }
+                    let n = by_gaps[0]
+                        .iter()
+                        .zip(&by_gaps[1])
+                        .filter(|(a, b)| a.to_bits() != b.to_bits())
+                        .count();
+                    assert!(n > 0, "{lname} {samples} {passes}: closed and open agree");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn wide_penumbrae_on_fine_maps_take_many_chunks() {
         // A large light over a fine map: each group's window spans hundreds
         // of occluder texels, shaded in several dispatches per layer.
@@ -513,7 +777,19 @@ mod eye {
         )
         .unwrap()
         .into();
-        for (mname, method) in methods().into_iter().skip(1) {
+        // ssm, bitmask (256, closed gaps) and bitmask with 1024 samples and
+        // open gaps (32-word masks: fewer rows per chunk).
+        let mut cases: Vec<(&str, MethodConfig)> = methods().into_iter().skip(1).collect();
+        cases.push((
+            "bitmask 1024 open",
+            MethodConfig::Bitmask(BitmaskConfig {
+                samples: 1024,
+                hierarchy: Some(false),
+                gaps: crate::methods::bitmask::Gaps::Open,
+                ..Default::default()
+            }),
+        ));
+        for (mname, method) in cases {
             let call = |backend| {
                 let refs: Vec<MeshRef> = meshes
                     .iter()
@@ -549,6 +825,10 @@ mod eye {
                 mean <= 1e-4 && max <= 2e-3,
                 "{mname}: mean {mean}, max {max}"
             );
+            if mname.starts_with("bitmask") {
+                // Masks OR: the same bits wherever the surface is the same.
+                assert_eq!(max, 0.0, "{mname}");
+            }
         }
     }
 

@@ -29,12 +29,17 @@
 //!   workgroup per group, the group's window from its bounds, rows outward
 //!   from its centre: `Kernel::shade_points`' traversal). No hierarchy, f32
 //!   sums (configs resolve so on the GPU); then, on the CPU, maps::shade's
-//!   last step (`maps::finish`: each point cut to its bound).
+//!   last step (`maps::finish`: each point cut to its bound). Bitmask with
+//!   closed gaps reads its micro-quads' corners, made on the CPU from the
+//!   layers read back (`gather::layer_corners`, the CPU kernel's own
+//!   function; stage "corners"), so its layers and its shading are two
+//!   submissions.
 //!   A hard light has no GPU map kernel and is refused (`exact` runs it,
 //!   with one ray).
 //!
 //! Two submissions: the first hits (the CPU needs them to place everything
-//! else), then the shading with one readback of the visibility (and maps).
+//! else), then the shading with one readback of the visibility (and maps);
+//! three with closed gaps (the layers, then the shading).
 
 use super::context::{gpu, Gpu};
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
@@ -47,7 +52,7 @@ use super::gather::{
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::gather_params;
-use super::timing::StageTimer;
+use super::timing::{merged, StageTimer};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::eye::gbuffer::{self, SceneTriangles};
@@ -251,7 +256,8 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
             visibility: vis,
             maps,
             light_space: f.space,
-            timings,
+            // Several submissions time some stages more than once: summed.
+            timings: merged(timings),
         },
         method,
     ))
@@ -648,8 +654,10 @@ fn shade_maps(
     let n_points = lanes.len();
     let acc_words = gather::accumulator_words(method, passes) as u64 * n_points as u64;
     fits(g, "resolution", (acc_words * 4).max(n_points as u64 * 16))?;
-    let (cols, steps) = window_bounds(&grid, f.light_size, w_bound, &groups);
-    let (steps_per_chunk, chunks) = gather::points_chunking(cols, steps, method);
+    let quads = gather::needs_corners(method);
+    if quads {
+        fits(g, "map_resolution", texels * 16)?;
+    }
     let mut params = gather_params(&grid, &grid, f.light_size, passes, method);
     params.rec_w = 0;
     params.rec_h = 0;
@@ -705,6 +713,33 @@ fn shade_maps(
         enc.clear_buffer(&acc, 0, None);
         enc.clear_buffer(&status, 0, None);
         raster.record_occluders(g, &mut enc, &timer, &maps_buf, 0, &grid, passes);
+        // Closed gaps: the layers come back first, for their corners.
+        let mut layers_read = None;
+        let mut timer = timer;
+        let mut w_bound = w_bound;
+        let corners_buf = if quads {
+            let first = submit_and_read(g, enc, &timer, &[(&maps_buf, maps_bytes)], sw)?;
+            let m: Vec<f32> = words(&first.buffers[0])
+                .into_iter()
+                .map(f32::from_bits)
+                .collect();
+            let layer_maps: Vec<&[f32]> = m.chunks_exact(layer_len).collect();
+            let corners = gather::layer_corners(&layer_maps, &grid);
+            sw.lap("corners");
+            w_bound = w_bound.max(corners.w_max as f64);
+            let buf = upload(device, "corners", &corners.corners);
+            sw.lap("upload");
+            layers_read = Some(first);
+            timer = StageTimer::new(g, 2);
+            enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("softshadow eye quads"),
+            });
+            Some(buf)
+        } else {
+            None
+        };
+        let (cols, steps) = window_bounds(&grid, f.light_size, w_bound, &groups);
+        let (steps_per_chunk, chunks) = gather::points_chunking(cols, steps, method);
         let b = GatherBuffers {
             maps: &maps_buf,
             rows: &rows,
@@ -713,6 +748,7 @@ fn shade_maps(
             vis: &vis,
             tables: tables.as_ref(),
             acc: &acc,
+            corners: corners_buf.as_ref(),
         };
         {
             let mut pass = enc.begin_compute_pass(&timer.pass("row_stats"));
@@ -733,13 +769,22 @@ fn shade_maps(
             };
             gather::record_shade_points(device, &mut pass, method, &b, &params, &pts)?;
         }
-        submit_and_read(
-            g,
-            enc,
-            &timer,
-            &[(&maps_buf, maps_bytes), (&vis, vis_bytes), (&status, 4)],
-            sw,
-        )
+        match layers_read {
+            None => submit_and_read(
+                g,
+                enc,
+                &timer,
+                &[(&maps_buf, maps_bytes), (&vis, vis_bytes), (&status, 4)],
+                sw,
+            ),
+            Some(mut first) => {
+                // The maps from the first readback, then the visibility and status.
+                let out = submit_and_read(g, enc, &timer, &[(&vis, vis_bytes), (&status, 4)], sw)?;
+                first.buffers.extend(out.buffers);
+                first.device_timings.extend(out.device_timings);
+                Ok(first)
+            }
+        }
     })?;
     if words(&out.buffers[2])[0] != 0 {
         return Err(Error::gpu(

@@ -1,6 +1,7 @@
 //! Depth maps the user rendered -> visibility on the GPU: the maps go up in
 //! one buffer (receiver, front, back), the shading stage runs, and the
-//! visibility comes back in one readback.
+//! visibility comes back in one readback. Bitmask with closed gaps makes its
+//! corners on the CPU from the maps given (stage "corners") and uploads them.
 
 use super::context::gpu;
 use super::dispatch::upload;
@@ -74,6 +75,13 @@ pub fn from_depth(
     let n_layers = 1 + back.is_some() as u32;
     check_size(g, method, grid, occluder_grid, n_layers)?;
     let mut sw = Stopwatch::new();
+    // Bitmask's connected micro-quads: their corners, on the CPU.
+    let corners = gather::needs_corners(method).then(|| {
+        let layers: Vec<&[f32]> = std::iter::once(front).chain(back).collect();
+        let c = gather::layer_corners(&layers, occluder_grid);
+        sw.lap("corners");
+        c
+    });
     // The maps as the shaders read them: f32 bits, receiver first.
     let mut words: Vec<u32> =
         Vec::with_capacity(grid.len() + n_layers as usize * occluder_grid.len());
@@ -101,7 +109,16 @@ pub fn from_depth(
             sh.record(g, &mut enc, &timer, &maps);
             return submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], &mut sw);
         }
-        let shading = Shading::new(g, method, grid, occluder_grid, light_size, n_layers, w_max);
+        let shading = Shading::new(
+            g,
+            method,
+            grid,
+            occluder_grid,
+            light_size,
+            n_layers,
+            w_max,
+            corners.as_ref(),
+        );
         sw.lap("upload");
         let timer = StageTimer::new(g, 2);
         let mut enc = g

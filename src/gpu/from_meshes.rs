@@ -5,7 +5,10 @@
 //! back in one readback.
 //!
 //! On the CPU stay the f64 work WGSL cannot do: the light-space transform,
-//! the extent fit and the triangle set-up (clip, project, snap).
+//! the extent fit and the triangle set-up (clip, project, snap). Bitmask
+//! with closed gaps also makes its micro-quads' corners there, with the CPU
+//! kernel's own function: it takes two submissions, the maps (read back),
+//! then, after the corners (stage "corners") go up, the shading.
 
 use super::context::gpu;
 use super::dispatch::storage;
@@ -17,7 +20,7 @@ use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::shading::{check_size, Shading};
 use super::smoothies::{self, Receivers, SmoothieShading};
-use super::timing::StageTimer;
+use super::timing::{merged, StageTimer};
 use crate::error::{Error, Result};
 use crate::geom::light::is_point;
 use crate::geom::light_space::LightSpace;
@@ -51,6 +54,8 @@ pub fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
 /// The shading stage of a method: over occluder maps, or over triangles.
 enum Stage {
     Maps(Shading),
+    /// Bitmask with closed gaps: the shading waits for the maps' corners.
+    Quads,
     Rays(ExactShading),
     Smoothies(SmoothieShading),
     /// PCSS reads the front layer at `grid.len()` in `maps`.
@@ -145,6 +150,7 @@ pub fn from_meshes(
                 max_taps,
                 grid.len() as u32,
             )?),
+            _ if gather::needs_corners(s.method) => Stage::Quads,
             _ => Stage::Maps(Shading::new(
                 g,
                 s.method,
@@ -153,6 +159,7 @@ pub fn from_meshes(
                 light_size,
                 layers,
                 w_max,
+                None,
             )),
         };
         let maps = storage(
@@ -176,6 +183,7 @@ pub fn from_meshes(
                 sh.record(g, &mut enc, &timer, &maps)?;
                 sources.push((&sh.vis, sh.vis_bytes));
             }
+            Stage::Quads => {}
             Stage::Rays(sh) => {
                 sh.record(g, &mut enc, &timer, &maps);
                 sources.push((&sh.vis, sh.vis_bytes));
@@ -190,7 +198,37 @@ pub fn from_meshes(
                 sources.push((&sh.vis, sh.vis_bytes));
             }
         }
-        submit_and_read(g, enc, &timer, &sources, &mut sw)
+        let mut out = submit_and_read(g, enc, &timer, &sources, &mut sw)?;
+        if let Stage::Quads = shading {
+            // The corners from the maps read back, then the shading.
+            let m = words(&out.buffers[0]);
+            let occ: &[f32] = bytemuck::cast_slice(&m[grid.len()..]);
+            let layer_maps: Vec<&[f32]> = occ.chunks_exact(occluder_grid.len()).collect();
+            let corners = gather::layer_corners(&layer_maps, &occluder_grid);
+            sw.lap("corners");
+            let sh = Shading::new(
+                g,
+                s.method,
+                &grid,
+                &occluder_grid,
+                light_size,
+                layers,
+                w_max,
+                Some(&corners),
+            );
+            sw.lap("upload");
+            let timer = StageTimer::new(g, 2);
+            let mut enc = g
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("softshadow quads"),
+                });
+            sh.record(g, &mut enc, &timer, &maps)?;
+            let shaded = submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], &mut sw)?;
+            out.buffers.extend(shaded.buffers);
+            out.device_timings.extend(shaded.device_timings);
+        }
+        Ok(out)
     })?;
     if out.buffers.get(2).is_some_and(|b| words(b)[0] != 0) {
         return Err(Error::gpu(
@@ -202,6 +240,8 @@ pub fn from_meshes(
     let visibility = visibility(&out.buffers[1])?;
     let mut timings = sw.timings;
     timings.extend(out.device_timings);
+    // Two submissions (closed gaps) time their stages twice: summed.
+    let timings = merged(timings);
     let rec_len = grid.len();
     let occ_len = occluder_grid.len();
     let map_of = |k: usize, empty_zero: bool| -> Vec<f32> {

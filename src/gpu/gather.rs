@@ -4,23 +4,130 @@
 //! are `methods/gather.rs` with `methods/ssm.rs` and `methods/bitmask.rs`.
 //! Points mode (the eye view): one workgroup per group of 64 sorted points,
 //! twin of `visibility_points` (`record_shade_points`).
+//!
+//! `bitmask` has four modules (`Variant`): masks of 8 u32 words (up to 256
+//! samples) or 32 (1024 samples), set in the WGSL by `bitmask_source`, and
+//! flat micro-patches (`gaps="open"`, `bitmask_open.wgsl`) or connected
+//! micro-quads (`gaps="closed"`, `bitmask_closed.wgsl`). The quads' corner
+//! 1/depths come from the CPU kernel's own function (`layer_corners`: the
+//! same bits), uploaded as one more buffer; row_stats widens the rows' bounds
+//! to them as the CPU's `Layer::connect` does.
 
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
+use crate::methods::bitmask::Gaps;
 use crate::methods::ssm::Precision;
 use crate::methods::Method;
 use bytemuck::{Pod, Zeroable};
+use rayon::prelude::*;
 use std::sync::OnceLock;
 
 pub const GATHER_SOURCE: &str = include_str!("gather.wgsl");
 pub const SSM_SOURCE: &str = include_str!("ssm.wgsl");
 pub const BITMASK_SOURCE: &str = include_str!("bitmask.wgsl");
+pub const BITMASK_OPEN_SOURCE: &str = include_str!("bitmask_open.wgsl");
+pub const BITMASK_CLOSED_SOURCE: &str = include_str!("bitmask_closed.wgsl");
 
 /// The WGSL of the module that runs `method`: the shared gather part and the
 /// method's own file.
 pub fn module_source(method_source: &str) -> String {
     format!("{GATHER_SOURCE}\n{method_source}")
+}
+
+/// bitmask.wgsl's line that sets the mask's words.
+const WORDS_LINE: &str = "const WORDS: u32 = 8u;";
+
+/// The bitmask module with masks of `words` u32 words and the `gaps`
+/// option's add_texel.
+pub fn bitmask_source(words: u32, gaps: Gaps) -> String {
+    assert!(
+        BITMASK_SOURCE.matches(WORDS_LINE).count() == 1 && words.is_multiple_of(4),
+        "bitmask.wgsl sets WORDS once, to a multiple of 4"
+    );
+    let body = BITMASK_SOURCE.replace(WORDS_LINE, &format!("const WORDS: u32 = {words}u;"));
+    let tail = match gaps {
+        Gaps::Open => BITMASK_OPEN_SOURCE,
+        Gaps::Closed => BITMASK_CLOSED_SOURCE,
+    };
+    module_source(&format!("{body}\n{tail}"))
+}
+
+/// u32 words of a bitmask mask with `samples` light samples, as
+/// `Bitmask::rank_tables` lays its entries out: the CPU's 4 u64 up to 256
+/// samples, 16 u64 for 1024.
+pub fn mask_words(samples: u32) -> u32 {
+    if samples <= 256 {
+        8
+    } else {
+        32
+    }
+}
+
+/// The shader modules of the occluder-map methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variant {
+    Ssm,
+    Bitmask { words: u32, gaps: Gaps },
+}
+
+impl Variant {
+    /// Every variant, in the order of `index`.
+    #[cfg(test)]
+    pub const ALL: [Variant; 5] = [
+        Variant::Ssm,
+        Variant::Bitmask {
+            words: 8,
+            gaps: Gaps::Open,
+        },
+        Variant::Bitmask {
+            words: 8,
+            gaps: Gaps::Closed,
+        },
+        Variant::Bitmask {
+            words: 32,
+            gaps: Gaps::Open,
+        },
+        Variant::Bitmask {
+            words: 32,
+            gaps: Gaps::Closed,
+        },
+    ];
+
+    pub fn index(self) -> usize {
+        match self {
+            Variant::Ssm => 0,
+            Variant::Bitmask { words, gaps } => {
+                1 + 2 * (words == 32) as usize + (gaps == Gaps::Closed) as usize
+            }
+        }
+    }
+
+    /// The entry points' prefix ("ssm", "bitmask").
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Ssm => "ssm",
+            Variant::Bitmask { .. } => "bitmask",
+        }
+    }
+
+    pub fn source(self) -> String {
+        match self {
+            Variant::Ssm => module_source(SSM_SOURCE),
+            Variant::Bitmask { words, gaps } => bitmask_source(words, gaps),
+        }
+    }
+
+    /// Whether the module reads the corners buffer (binding 13).
+    pub fn reads_corners(self) -> bool {
+        matches!(
+            self,
+            Variant::Bitmask {
+                gaps: Gaps::Closed,
+                ..
+            }
+        )
+    }
 }
 
 /// `GatherParams` of gather.wgsl.
@@ -131,11 +238,12 @@ pub fn chunking(og: &MapGrid, light_size: [f64; 2], w_max: f64, method: Method) 
     (rows_per_chunk as u32, rows.div_ceil(rows_per_chunk) as u32)
 }
 
-/// Iterations one texel costs the method's loop (the bitmask's 8 words, in
-/// case the compiler keeps them a loop).
+/// Iterations one texel costs the method's loop: the texel, and the
+/// bitmask's mask words as vec4s (bitmask.wgsl's `mark`; 2 for 8 words, 8 for
+/// 32), in case the compiler keeps them a loop.
 pub fn texel_cost(method: Method) -> usize {
     match method {
-        Method::Bitmask { .. } => 9,
+        Method::Bitmask { samples, .. } => mask_words(samples) as usize / 4 + 1,
         _ => 1,
     }
 }
@@ -175,7 +283,7 @@ struct MethodPipelines {
 /// The GPU kernels have neither the occluder hierarchy nor the other
 /// precisions of the CPU's ssm (its one-level f32 sum is the CPU's
 /// two-level one up to rounding).
-fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
+fn variant(method: Method) -> Result<Variant> {
     let no_hierarchy = || {
         Error::invalid(
             "hierarchy",
@@ -192,12 +300,15 @@ fn method_source(method: Method) -> Result<(&'static str, &'static str)> {
         Method::Ssm {
             precision: Precision::F32,
             ..
-        } => Ok(("ssm", SSM_SOURCE)),
+        } => Ok(Variant::Ssm),
         Method::Ssm { precision, .. } => Err(Error::invalid(
             "precision",
             format!("the GPU backend sums in f32 only, got {precision:?}; use backend=\"cpu\""),
         )),
-        Method::Bitmask { .. } => Ok(("bitmask", BITMASK_SOURCE)),
+        Method::Bitmask { samples, gaps, .. } => Ok(Variant::Bitmask {
+            words: mask_words(samples),
+            gaps,
+        }),
         Method::Exact { .. } => Err(Error::invalid(
             "method",
             format!(
@@ -221,20 +332,21 @@ pub fn check_method(method: Method) -> Result<()> {
     if matches!(method, Method::Smoothies { .. }) {
         return Ok(());
     }
-    method_source(method).map(|_| ())
+    variant(method).map(|_| ())
+}
+
+/// Whether the method's kernel reads the occluder layers' corners
+/// (`layer_corners`: bitmask with closed gaps).
+pub fn needs_corners(method: Method) -> bool {
+    variant(method).is_ok_and(Variant::reads_corners)
 }
 
 fn pipelines(device: &wgpu::Device, method: Method) -> Result<&'static MethodPipelines> {
-    static SSM: OnceLock<MethodPipelines> = OnceLock::new();
-    static BITMASK: OnceLock<MethodPipelines> = OnceLock::new();
-    let (name, source) = method_source(method)?;
-    let cell = match method {
-        Method::Ssm { .. } => &SSM,
-        Method::Bitmask { .. } => &BITMASK,
-        _ => unreachable!("method_source refused it"),
-    };
-    Ok(cell.get_or_init(|| {
-        let m = module(device, name, &module_source(source));
+    static CELLS: [OnceLock<MethodPipelines>; 5] = [const { OnceLock::new() }; 5];
+    let v = variant(method)?;
+    let name = v.name();
+    Ok(CELLS[v.index()].get_or_init(|| {
+        let m = module(device, name, &v.source());
         MethodPipelines {
             row_stats: pipeline(device, &m, "row_stats"),
             chunk: pipeline(device, &m, name),
@@ -250,16 +362,11 @@ struct PointsPipelines {
 }
 
 fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static PointsPipelines> {
-    static SSM: OnceLock<PointsPipelines> = OnceLock::new();
-    static BITMASK: OnceLock<PointsPipelines> = OnceLock::new();
-    let (name, source) = method_source(method)?;
-    let cell = match method {
-        Method::Ssm { .. } => &SSM,
-        Method::Bitmask { .. } => &BITMASK,
-        _ => unreachable!("method_source refused it"),
-    };
-    Ok(cell.get_or_init(|| {
-        let m = module(device, name, &module_source(source));
+    static CELLS: [OnceLock<PointsPipelines>; 5] = [const { OnceLock::new() }; 5];
+    let v = variant(method)?;
+    let name = v.name();
+    Ok(CELLS[v.index()].get_or_init(|| {
+        let m = module(device, name, &v.source());
         PointsPipelines {
             chunk: pipeline(device, &m, &format!("{name}_points")),
             resolve: pipeline(device, &m, &format!("{name}_points_resolve")),
@@ -278,13 +385,38 @@ pub struct GatherBuffers<'a> {
     pub tables: Option<&'a wgpu::Buffer>,
     /// Per-receiver accumulators, zeroed (`accumulator_words` u32 a receiver).
     pub acc: &'a wgpu::Buffer,
+    /// The occluder layers' corners (`layer_corners`), where the method reads
+    /// them (`needs_corners`).
+    pub corners: Option<&'a wgpu::Buffer>,
 }
 
+impl GatherBuffers<'_> {
+    /// `buffers` for bindings 0, 1, ... with the corners at binding 13 where
+    /// the module reads them.
+    fn with_corners<'b>(
+        &'b self,
+        method: Method,
+        mut buffers: Vec<Option<&'b wgpu::Buffer>>,
+    ) -> Result<Vec<Option<&'b wgpu::Buffer>>> {
+        if variant(method)?.reads_corners() {
+            let c = self.corners.ok_or_else(|| {
+                Error::gpu("bitmask with closed gaps needs the occluder layers' corners")
+            })?;
+            buffers.resize(CORNERS_BINDING, None);
+            buffers.push(Some(c));
+        }
+        Ok(buffers)
+    }
+}
+
+/// bitmask_closed.wgsl's binding of the corners.
+const CORNERS_BINDING: usize = 13;
+
 /// u32 words of accumulator per receiver texel: a sum per layer (ssm), or
-/// one 256-bit mask (bitmask).
+/// one mask (bitmask: `mask_words`).
 pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
     match method {
-        Method::Bitmask { .. } => 8,
+        Method::Bitmask { samples, .. } => mask_words(samples),
         _ => n_layers,
     }
 }
@@ -293,11 +425,57 @@ pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
 /// tables), or None.
 pub fn method_tables(method: Method) -> Option<Vec<u32>> {
     match method {
-        Method::Bitmask { samples, .. } => Some(
-            crate::methods::bitmask::Bitmask::new(samples, Default::default(), None).rank_tables(),
-        ),
+        Method::Bitmask { samples, gaps, .. } => {
+            let t = crate::methods::bitmask::Bitmask::new(samples, gaps, None).rank_tables();
+            // x_ge and y_ge, S + 1 entries each of mask_words words.
+            assert_eq!(
+                t.len(),
+                2 * (samples as usize + 1) * mask_words(samples) as usize
+            );
+            Some(t)
+        }
         _ => None,
     }
+}
+
+/// The connected micro-quads' corner 1/depths of every occluder layer
+/// (bitmask with closed gaps), as bitmask_closed.wgsl reads them: layer
+/// after layer, 4 per texel; and the largest of them.
+pub struct LayerCorners {
+    pub corners: Vec<[f32; 4]>,
+    pub w_max: f32,
+}
+
+/// The corners of the occluder depth `layers` on `og`, made by the CPU
+/// kernel's own function with its inputs (`Kernel::new` at level 0: the
+/// texels' 1/depth as `Layer::from_depth` takes it, a texel's tangent size
+/// 2 half_texel in f64 then f32), so the GPU reads the CPU's bits.
+pub fn layer_corners(layers: &[&[f32]], og: &MapGrid) -> LayerCorners {
+    let (hw, hh) = og.half_texel();
+    // Kernel::new's (2 hw f) as f32 with f = 1 at level 0.
+    let (dx, dy) = ((2.0 * hw * 1.0) as f32, (2.0 * hh * 1.0) as f32);
+    let mut corners = Vec::with_capacity(layers.len() * og.len());
+    for depth in layers {
+        debug_assert_eq!(depth.len(), og.len());
+        let w: Vec<f32> = depth
+            .par_iter()
+            .map(|&z| {
+                if z.is_finite() && z > 0.0 {
+                    1.0 / z
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        corners.extend(crate::methods::gather::corners::corners(
+            &w, og.width, og.height, dx, dy,
+        ));
+    }
+    let w_max = corners
+        .par_iter()
+        .map(|c| c.iter().fold(0f32, |m, &x| m.max(x)))
+        .reduce(|| 0.0, f32::max);
+    LayerCorners { corners, w_max }
 }
 
 /// Records the row statistics pass body.
@@ -313,7 +491,10 @@ pub fn record_row_stats(
     let bg = bind(
         device,
         &p.row_stats,
-        &[Some(b.maps), Some(b.rows), Some(b.layer_w_max), Some(&u)],
+        &b.with_corners(
+            method,
+            vec![Some(b.maps), Some(b.rows), Some(b.layer_w_max), Some(&u)],
+        )?,
     );
     pass.set_pipeline(&p.row_stats);
     pass.set_bind_group(0, &bg, &[]);
@@ -353,17 +534,20 @@ pub fn record_shade(
             let bg = bind(
                 device,
                 &p.chunk,
-                &[
-                    Some(b.maps),
-                    Some(b.rows),
-                    Some(b.layer_w_max),
-                    Some(&u),
-                    Some(b.axes),
-                    None,
-                    b.tables,
-                    Some(b.acc),
-                    Some(&c),
-                ],
+                &b.with_corners(
+                    method,
+                    vec![
+                        Some(b.maps),
+                        Some(b.rows),
+                        Some(b.layer_w_max),
+                        Some(&u),
+                        Some(b.axes),
+                        None,
+                        b.tables,
+                        Some(b.acc),
+                        Some(&c),
+                    ],
+                )?,
             );
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, 1);
@@ -431,21 +615,24 @@ pub fn record_shade_points(
             let bg = bind(
                 device,
                 &p.chunk,
-                &[
-                    Some(b.maps),
-                    Some(b.rows),
-                    Some(b.layer_w_max),
-                    Some(&u),
-                    Some(b.axes),
-                    None,
-                    b.tables,
-                    Some(b.acc),
-                    Some(&c),
-                    Some(&pu),
-                    Some(pts.points),
-                    Some(pts.groups),
-                    Some(pts.status),
-                ],
+                &b.with_corners(
+                    method,
+                    vec![
+                        Some(b.maps),
+                        Some(b.rows),
+                        Some(b.layer_w_max),
+                        Some(&u),
+                        Some(b.axes),
+                        None,
+                        b.tables,
+                        Some(b.acc),
+                        Some(&c),
+                        Some(&pu),
+                        Some(pts.points),
+                        Some(pts.groups),
+                        Some(pts.status),
+                    ],
+                )?,
             );
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, 1);

@@ -14,9 +14,14 @@
 // after 65535 in all; real GPUs reset long-running dispatches) whatever the
 // penumbra's size in texels.
 //
-// A method's file defines `add_texel(w, x0, x1, xr_s, r, rc)`, which adds one
-// micro-patch to its per-invocation state (a `var<private>`), and its entry
-// points, which load that state from `acc`, call `gather_chunk` and store it.
+// A method's file defines `add_texel(t, w, x0, x1, xr_s, r, rc)`, which adds
+// occluder texel t (its index in `maps`) to its per-invocation state (a
+// `var<private>`), `texel_reach(t, w)`, the 1/depth up to which texel t
+// reaches (w for a flat micro-patch; the nearest of its centre and corners
+// for bitmask's connected micro-quads, as the CPU's Layer::connect widens its
+// bounds), which row_stats takes the rows' nearest 1/depth from, and its
+// entry points, which load that state from `acc`, call `gather_chunk` and
+// store it.
 //
 // Points mode (the eye view, src/gpu/eye.rs): the receivers are arbitrary
 // light-space points (x, y tangents, 1/depth), sorted and cut into groups of
@@ -121,8 +126,9 @@ fn clamp_index(c: f32, lo: i32, hi: i32) -> i32 {
     return i32(clamp(c, f32(lo), f32(hi)));
 }
 
-// Per occluder row: nearest 1/depth and occupied columns; per layer, the
-// nearest 1/depth of all (atomicMax on the bits of a positive float).
+// Per occluder row: nearest 1/depth (the method's texel_reach) and occupied
+// columns; per layer, the nearest 1/depth of all (atomicMax on the bits of a
+// positive float).
 @compute @workgroup_size(64)
 fn row_stats(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = gid.x;
@@ -142,7 +148,7 @@ fn row_stats(@builtin(global_invocation_id) gid: vec3<u32>) {
                 found = true;
             }
             span.last = i + 1u;
-            span.w_max = max(span.w_max, w);
+            span.w_max = max(span.w_max, texel_reach(base + i, w));
         }
     }
     rows[n] = span;
@@ -254,7 +260,7 @@ fn gather_chunk(rc: Receiver) {
                 continue;
             }
             let x0 = axes[gp.ax_col_x0s + i];
-            add_texel(w, x0, x0 + gp.wx, xr_s, r, rc);
+            add_texel(row + i, w, x0, x0 + gp.wx, xr_s, r, rc);
         }
     }
 }
@@ -412,7 +418,7 @@ fn points_row(j: i32, b: GroupBounds, rc: Receiver, xr_s: f32) {
             continue;
         }
         let x0 = axes[gp.ax_col_x0s + i];
-        add_texel(w, x0, x0 + gp.wx, xr_s, r, rc);
+        add_texel(row + i, w, x0, x0 + gp.wx, xr_s, r, rc);
     }
     points_end_row();
 }

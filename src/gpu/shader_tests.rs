@@ -5,8 +5,8 @@
 use super::exact::{ExactParams, SOURCE as EXACT_SOURCE};
 use super::eye::{GpuRayStart, HitsParams, HITS_SOURCE, RAYS_SOURCE};
 use super::gather::{
-    module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, PointsParams, RowSpan,
-    BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
+    module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, PointsParams, RowSpan, Variant,
+    BITMASK_CLOSED_SOURCE, BITMASK_OPEN_SOURCE, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
 use super::pcss::{Coord, GpuPcssPoint, PcssChunk, PcssParams, SOURCE as PCSS_SOURCE};
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
@@ -17,18 +17,23 @@ use super::smoothies::{
 use std::mem::{offset_of, size_of};
 
 /// Every shader module the backend builds, by name.
-fn modules() -> Vec<(&'static str, String)> {
-    vec![
-        ("raster.wgsl", RASTER_SOURCE.to_string()),
-        ("gather.wgsl + ssm.wgsl", module_source(SSM_SOURCE)),
-        ("gather.wgsl + bitmask.wgsl", module_source(BITMASK_SOURCE)),
-        ("exact.wgsl", EXACT_SOURCE.to_string()),
-        ("exact.wgsl + eye_hits.wgsl", HITS_SOURCE.to_string()),
-        ("exact.wgsl + eye_rays.wgsl", RAYS_SOURCE.to_string()),
-        ("smoothies.wgsl", SMOOTHIES_SOURCE.to_string()),
-        ("shadow_mapping.wgsl", SM_SOURCE.to_string()),
-        ("pcss.wgsl", PCSS_SOURCE.to_string()),
-    ]
+fn modules() -> Vec<(String, String)> {
+    let mut m: Vec<(String, String)> = vec![
+        ("raster.wgsl".into(), RASTER_SOURCE.to_string()),
+        ("exact.wgsl".into(), EXACT_SOURCE.to_string()),
+        ("exact.wgsl + eye_hits.wgsl".into(), HITS_SOURCE.to_string()),
+        ("exact.wgsl + eye_rays.wgsl".into(), RAYS_SOURCE.to_string()),
+        ("smoothies.wgsl".into(), SMOOTHIES_SOURCE.to_string()),
+        ("shadow_mapping.wgsl".into(), SM_SOURCE.to_string()),
+        ("pcss.wgsl".into(), PCSS_SOURCE.to_string()),
+    ];
+    // The occluder-map methods' modules: ssm and the four bitmask ones.
+    m.extend(
+        Variant::ALL
+            .iter()
+            .map(|v| (format!("gather.wgsl + {v:?}"), v.source())),
+    );
+    m
 }
 
 fn parse(name: &str, src: &str) -> naga::Module {
@@ -45,6 +50,8 @@ fn every_wgsl_file_is_used_by_a_module() {
         GATHER_SOURCE,
         SSM_SOURCE,
         BITMASK_SOURCE,
+        BITMASK_OPEN_SOURCE,
+        BITMASK_CLOSED_SOURCE,
         EXACT_SOURCE,
         HITS_SOURCE,
         RAYS_SOURCE,
@@ -67,13 +74,87 @@ fn every_wgsl_file_is_used_by_a_module() {
 #[test]
 fn every_wgsl_module_parses_and_validates() {
     for (name, src) in modules() {
-        let module = parse(name, &src);
+        let module = parse(&name, &src);
         naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::default(),
         )
         .validate(&module)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+    }
+}
+
+#[test]
+fn bitmask_modules_have_their_words_and_read_the_corners_only_with_closed_gaps() {
+    use crate::methods::bitmask::Gaps;
+    let mut indices = vec![];
+    for v in Variant::ALL {
+        indices.push(v.index());
+        let Variant::Bitmask { words, gaps } = v else {
+            continue;
+        };
+        let src = v.source();
+        let module = parse(&format!("{v:?}"), &src);
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap();
+        // The private mask holds WORDS / 4 vec4s.
+        let (_, mask) = module
+            .global_variables
+            .iter()
+            .find(|(_, g)| g.name.as_deref() == Some("mask"))
+            .unwrap();
+        match module.types[mask.ty].inner {
+            naga::TypeInner::Array {
+                size: naga::ArraySize::Constant(n),
+                ..
+            } => assert_eq!(n.get(), words / 4, "{v:?}"),
+            ref t => panic!("{v:?}: mask is {t:?}"),
+        }
+        // Binding 13 (the corners) exists, and is read by row_stats and the
+        // chunk entry points, only with closed gaps; never by the resolves.
+        let corners = module
+            .global_variables
+            .iter()
+            .find(|(_, g)| g.binding.as_ref().is_some_and(|b| b.binding == 13))
+            .map(|(h, _)| h);
+        assert_eq!(corners.is_some(), gaps == Gaps::Closed, "{v:?}");
+        for (k, ep) in module.entry_points.iter().enumerate() {
+            let reads = corners.is_some_and(|h| !info.get_entry_point(k)[h].is_empty());
+            let should = gaps == Gaps::Closed
+                && ["row_stats", "bitmask", "bitmask_points"].contains(&ep.name.as_str());
+            assert_eq!(reads, should, "{v:?} {}", ep.name);
+        }
+    }
+    indices.sort();
+    assert_eq!(indices, (0..Variant::ALL.len()).collect::<Vec<_>>());
+}
+
+#[test]
+fn mask_words_are_the_rank_tables_entries_and_cost_their_loop() {
+    use super::gather::{mask_words, method_tables, texel_cost};
+    use crate::methods::bitmask::{Gaps, SAMPLE_COUNTS};
+    use crate::methods::Method;
+    for samples in SAMPLE_COUNTS {
+        for gaps in Gaps::ALL {
+            let m = Method::Bitmask {
+                samples,
+                hierarchy: false,
+                gaps,
+            };
+            // method_tables asserts the length; the words hold every sample.
+            let t = method_tables(m).unwrap();
+            let words = mask_words(samples) as usize;
+            assert_eq!(t.len(), 2 * (samples as usize + 1) * words);
+            assert!(32 * words >= samples as usize);
+            // x_ge[0]: every sample.
+            let all: u32 = t[..words].iter().map(|w| w.count_ones()).sum();
+            assert_eq!(all, samples);
+            assert_eq!(texel_cost(m), words / 4 + 1);
+        }
     }
 }
 

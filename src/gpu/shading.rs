@@ -1,7 +1,8 @@
 //! The shading stage on the GPU, shared by both entry points (meshes, depth
 //! maps): from occluder and receiver maps already in a `maps` buffer
 //! (receiver at 0, then the occluder layers) to the visibility, in two passes
-//! ("row_stats", "shadow").
+//! ("row_stats", "shadow"). Bitmask with closed gaps also reads the layers'
+//! corners (`gather::layer_corners`, made on the CPU from the maps).
 
 use super::context::Gpu;
 use super::dispatch::{storage, upload};
@@ -11,8 +12,8 @@ use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::methods::Method;
 
-/// Refuses maps (and accumulators) that do not fit one buffer binding, or
-/// offsets beyond u32.
+/// Refuses maps (and accumulators, and the corners) that do not fit one
+/// buffer binding, or offsets beyond u32.
 pub fn check_size(
     g: &Gpu,
     method: Method,
@@ -21,9 +22,15 @@ pub fn check_size(
     n_layers: u32,
 ) -> Result<()> {
     let texels = grid.len() as u64 + n_layers as u64 * og.len() as u64;
-    // The accumulators: a sum per layer (ssm) or a 256-bit mask (bitmask) per receiver.
+    // The accumulators: a sum per layer (ssm) or a mask (bitmask) per receiver.
     let acc = gather::accumulator_words(method, n_layers) as u64 * grid.len() as u64;
-    let bytes = 4 * texels.max(acc);
+    // The corners: 4 1/depths per occluder texel (bitmask, closed gaps).
+    let corners = if gather::needs_corners(method) {
+        4 * n_layers as u64 * og.len() as u64
+    } else {
+        0
+    };
+    let bytes = 4 * texels.max(acc).max(corners);
     if texels >= u32::MAX as u64 || bytes > g.max_storage_binding {
         return Err(Error::too_large(
             "resolution",
@@ -47,7 +54,13 @@ fn axes(grid: &MapGrid, og: &MapGrid, light_size: [f64; 2], p: &mut GatherParams
     p.ax_rec_y = data.len() as u32;
     data.extend((0..grid.height).map(|j| grid.y_of(j) as f32));
     p.ax_col_x0s = data.len() as u32;
-    data.extend((0..og.width).map(|i| ((og.x_of(i) - hw) * 2.0 / light_size[0]) as f32));
+    // As the CPU's `col_x0_scaled`: the f32 left edge, scaled in f64 (one
+    // rounding from f64 differs from these two in the last bit now and then,
+    // which moved a rank: a sample of one texel in 2000 on a 61-wide grid).
+    data.extend((0..og.width).map(|i| {
+        let x0 = (og.x_of(i) - hw) as f32;
+        (x0 as f64 * 2.0 / light_size[0]) as f32
+    }));
     p.ax_row_y = data.len() as u32;
     data.extend((0..og.height).map(|j| og.y_of(j) as f32));
     data
@@ -98,13 +111,16 @@ pub struct Shading {
     acc: wgpu::Buffer,
     axes: wgpu::Buffer,
     tables: Option<wgpu::Buffer>,
+    corners: Option<wgpu::Buffer>,
     pub vis: wgpu::Buffer,
     pub vis_bytes: u64,
 }
 
 impl Shading {
-    /// Uploads the axes (and the method's tables) and makes the buffers.
-    /// `w_max` bounds the occluders' 1/depth (it sets the chunking).
+    /// Uploads the axes (and the method's tables, and the layers' `corners`
+    /// where the method reads them) and makes the buffers. `w_max` bounds
+    /// the occluders' 1/depth (it sets the chunking; the corners widen it).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         g: &Gpu,
         method: Method,
@@ -113,10 +129,13 @@ impl Shading {
         light_size: [f64; 2],
         n_layers: u32,
         w_max: f64,
+        corners: Option<&gather::LayerCorners>,
     ) -> Shading {
         let device = &g.device;
+        debug_assert_eq!(corners.is_some(), gather::needs_corners(method));
         let mut params = gather_params(grid, og, light_size, n_layers, method);
         let ax = axes(grid, og, light_size, &mut params);
+        let w_max = corners.map_or(w_max, |c| w_max.max(c.w_max as f64));
         let (rows_per_chunk, chunks) = gather::chunking(og, light_size, w_max, method);
         params.rows_per_chunk = rows_per_chunk;
         let acc_words = gather::accumulator_words(method, n_layers) as u64 * grid.len() as u64;
@@ -145,6 +164,7 @@ impl Shading {
             ),
             axes: upload(device, "axes", &ax),
             tables: gather::method_tables(method).map(|t| upload(device, "method tables", &t)),
+            corners: corners.map(|c| upload(device, "corners", &c.corners)),
             vis: storage(
                 device,
                 "visibility",
@@ -174,6 +194,7 @@ impl Shading {
             vis: &self.vis,
             tables: self.tables.as_ref(),
             acc: &self.acc,
+            corners: self.corners.as_ref(),
         };
         {
             let mut pass = enc.begin_compute_pass(&timer.pass("row_stats"));

@@ -10,8 +10,14 @@ const D2_MIN: f32 = 1e-36;
 // The receiver's sum of this layer while gather_chunk runs.
 var<private> sum: f32;
 
-// Sum::add_texel's arithmetic for micro-patch [x0, x1] x (row r) at 1/depth w.
-fn add_texel(w: f32, x0: f32, x1: f32, xr_s: f32, r: RowReach, rc: Receiver) {
+// A flat micro-patch reaches as far as its own 1/depth.
+fn texel_reach(t: u32, w: f32) -> f32 {
+    return w;
+}
+
+// Sum::add_texel's arithmetic for micro-patch [x0, x1] x (row r) at 1/depth w
+// (texel t of `maps`, which the sum does not need).
+fn add_texel(t: u32, w: f32, x0: f32, x1: f32, xr_s: f32, r: RowReach, rc: Receiver) {
     let d = w - rc.wr;
     let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
     let cy = min(r.ay1, d) + min(r.nay0, d);
