@@ -156,6 +156,8 @@ struct Candidate {
 /// Occluder texels the narrowest penumbra must span before the occluder
 /// maps are coarsened for a loose target.
 pub const COARSE_TEXELS: f64 = 16.0;
+/// The tightest target for which occluder maps are coarsened.
+pub const COARSE_TARGET: f64 = 0.02;
 
 fn bitmask(samples: u32, hierarchy: bool) -> MethodConfig {
     MethodConfig::Bitmask(BitmaskConfig {
@@ -169,26 +171,28 @@ fn bitmask(samples: u32, hierarchy: bool) -> MethodConfig {
 const CANDIDATES: [Candidate; 4] = [
     Candidate {
         label: "ssm, 2 passes, quarter-resolution occluder maps (the sum)",
-        worst_error: 0.038,
+        worst_error: 0.046,
         time_ratio: 1.0,
         config: |r| MethodConfig::Ssm(super::config::auto_rule(r)),
     },
     Candidate {
         label: "bitmask, 256 samples, gaps closed, hierarchy",
-        worst_error: 0.008,
-        time_ratio: 120.0,
+        worst_error: 0.0077,
+        time_ratio: 160.0,
         config: |_| bitmask(256, true),
     },
     Candidate {
         label: "bitmask, 256 samples, gaps closed, no hierarchy",
-        worst_error: 0.0066,
-        time_ratio: 160.0,
+        worst_error: 0.0061,
+        time_ratio: 152.0,
         config: |_| bitmask(256, false),
     },
     Candidate {
         label: "bitmask, 1024 samples, gaps closed, no hierarchy",
+        // Worst: the fence, 0.0051 against Mitsuba whose own noise there is
+        // 0.0041 (0.0043 against 4096-sample exact).
         worst_error: 0.005,
-        time_ratio: 500.0,
+        time_ratio: 618.0,
         config: |_| bitmask(1024, false),
     },
 ];
@@ -324,8 +328,12 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
 }
 
 /// Coarser occluder maps for a bitmask setting under a loose target (at
-/// least 0.01): halved while the narrowest penumbra spans COARSE_TEXELS
-/// occluder texels, never below 64.
+/// least COARSE_TARGET): halved while the narrowest penumbra spans
+/// COARSE_TEXELS occluder texels, never below 64.
+///
+/// The penumbrae say nothing of thin occluders: at 0.01 the fence's bars
+/// (2 texels of a 128² map) came out at 0.0161 (docs/benchmarks/gaps.md),
+/// hence the looser bound.
 fn coarsen(
     config: MethodConfig,
     stats: &SceneStats,
@@ -338,7 +346,7 @@ fn coarsen(
     let narrow = stats.narrowest_penumbra();
     let (w, h) = stats.resolution;
     let mut f = 1usize;
-    while error >= 0.01
+    while error >= COARSE_TARGET
         && narrow / (2 * f) as f64 >= COARSE_TEXELS
         && w / (2 * f) >= 64
         && h / (2 * f) >= 64
@@ -351,8 +359,8 @@ fn coarsen(
         why: format!(
             "the narrowest penumbra spans {narrow:.1} output texels; occluder maps at 1/{f} of \
              the output's resolution keep at least {COARSE_TEXELS} of their texels across it{}",
-            if error < 0.01 {
-                " (targets under 0.01 keep the full resolution)"
+            if error < COARSE_TARGET {
+                " (targets under 0.02 keep the full resolution)"
             } else {
                 ""
             }
@@ -405,13 +413,13 @@ mod tests {
         let s = stats();
         // Narrowest: (1/2.9 - 1/4) / (0.7 / 256) = 34.7 texels: one halving
         // (17.3 >= COARSE_TEXELS at 1/2, 8.7 at 1/4).
-        let c = plan(&s, &Target::new(Some(0.01), None).unwrap(), None).config;
+        let c = plan(&s, &Target::new(Some(0.02), None).unwrap(), None).config;
         assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution == Some((128, 128))));
-        let c = plan(&s, &Target::new(Some(0.007), None).unwrap(), None).config;
+        let c = plan(&s, &Target::new(Some(0.01), None).unwrap(), None).config;
         assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution.is_none()));
         let mut contact = s;
         contact.occ_w_far = 0.25;
-        let c = plan(&contact, &Target::new(Some(0.01), None).unwrap(), None).config;
+        let c = plan(&contact, &Target::new(Some(0.02), None).unwrap(), None).config;
         assert!(matches!(c, MethodConfig::Bitmask(b) if b.occluder_resolution.is_none()));
     }
 
@@ -429,7 +437,7 @@ mod tests {
         let s = stats();
         let t = Target::new(None, Some(1.0)).unwrap();
         assert!(matches!(plan(&s, &t, None).config, MethodConfig::Ssm(_)));
-        // Probe 1 ms: 1024 samples predicted 0.5 s, fits.
+        // Probe 1 ms: 1024 samples predicted 0.62 s, fits.
         assert!(
             matches!(plan(&s, &t, Some(1e-3)).config, MethodConfig::Bitmask(c) if c.samples == 1024)
         );
