@@ -22,7 +22,7 @@
 //!     light: &Light::Rect(light),
 //!     resolution: (64, 64),
 //!     extent: None,
-//!     method: MethodConfig::Bitmask(BitmaskConfig::new(Some(64), None, None, None)?),
+//!     method: MethodConfig::Bitmask(BitmaskConfig::new(Some(64), None, None, None, None)?),
 //!     backend: BackendChoice::Cpu,
 //!     threads: Some(1),
 //! })?;

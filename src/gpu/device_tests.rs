@@ -207,6 +207,7 @@ fn gpu_bitmask_is_the_cpus_bit_for_bit_both_gaps_every_mask() {
                     occluder_resolution: occ,
                     passes,
                     method,
+                    hard: false,
                 };
                 let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
                 let (rv, rf) = floor();
