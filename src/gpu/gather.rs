@@ -457,16 +457,7 @@ pub fn layer_corners(layers: &[&[f32]], og: &MapGrid) -> LayerCorners {
     let mut corners = Vec::with_capacity(layers.len() * og.len());
     for depth in layers {
         debug_assert_eq!(depth.len(), og.len());
-        let w: Vec<f32> = depth
-            .par_iter()
-            .map(|&z| {
-                if z.is_finite() && z > 0.0 {
-                    1.0 / z
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let w = crate::methods::gather::corners::inverse_depth(depth);
         corners.extend(crate::methods::gather::corners::corners(
             &w, og.width, og.height, dx, dy,
         ));

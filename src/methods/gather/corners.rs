@@ -48,6 +48,22 @@ use rayon::prelude::*;
 /// of the best on each.
 pub const MAX_SLOPE: f32 = 4.0;
 
+/// 1/depth per texel, 0 where empty (no finite positive depth): the form
+/// the kernels read a depth layer in (`Layer::from_depth`) and `corners`
+/// takes (the GPU twin computes its corners from it too).
+pub fn inverse_depth(depth: &[f32]) -> Vec<f32> {
+    depth
+        .par_iter()
+        .map(|&z| {
+            if z.is_finite() && z > 0.0 {
+                1.0 / z
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 /// Corner 1/depths per texel: [top-left, top-right, bottom-left,
 /// bottom-right], top meaning the row above (smaller j, larger y). 0 for
 /// empty texels. `w`: 1/depth per texel (0: empty), `width` x `height`;

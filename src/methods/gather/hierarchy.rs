@@ -44,16 +44,7 @@ pub(super) struct RowSpan {
 impl Layer {
     /// Level 0: the occluder map as given.
     fn from_depth(depth: &[f32], width: usize) -> Layer {
-        let w: Vec<f32> = depth
-            .par_iter()
-            .map(|&z| {
-                if z.is_finite() && z > 0.0 {
-                    1.0 / z
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let w = super::corners::inverse_depth(depth);
         let w_far = w
             .iter()
             .map(|&x| if x > 0.0 { x } else { f32::INFINITY })
