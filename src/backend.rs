@@ -208,13 +208,19 @@ fn planned(
 )> {
     use crate::methods::plan::plan;
     let t0 = std::time::Instant::now();
-    let stats = pipeline::scene_stats(
+    // The framing every run starts from (its checks, transform and extent
+    // fit), on the rule's settings; the planner reads its depth ranges.
+    let (w, h) = ctx.resolution;
+    let rule = MapSettings::new(w, h, extent, &call.method.resolve(ctx)?);
+    let framed = pipeline::frame_scene(
         &call.occluders,
         &call.receivers,
         space,
-        ctx.resolution,
-        extent,
+        &rule,
+        &mut pipeline::Stopwatch::new(),
     )?;
+    let stats = pipeline::scene_stats(&framed, ctx.resolution);
+    drop(framed);
     let mut p = plan(&stats, target, None);
     let mut planning = t0.elapsed().as_secs_f64();
     let mut probe = None;

@@ -28,7 +28,7 @@
 //! is predicted from it by the largest ratio measured on the study's scenes.
 
 use super::config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
-use super::shadow_mapping::config::Real;
+use super::shadow_mapping::config::{check_real, Real};
 use crate::error::{Error, Result};
 
 /// What `ss.Auto` aims at: an error (the paper's §4.2.1 metric), a time
@@ -45,18 +45,12 @@ pub const MIN_ERROR: f64 = 1e-4;
 
 impl Target {
     pub fn new(error: Option<f64>, time: Option<f64>) -> Result<Target> {
-        let check = |arg: &str, v: Option<f64>, lo: f64, hi: f64, what: &str| {
-            v.map(|v| {
-                if v.is_finite() && v >= lo && v <= hi {
-                    Ok(Real(v))
-                } else {
-                    Err(Error::invalid(arg, format!("must be {what}, got {v}")))
-                }
-            })
-            .transpose()
-        };
-        let error = check("error", error, MIN_ERROR, 1.0, "in [1e-4, 1]")?;
-        let time = check("time", time, 1e-6, 1e6, "a time in seconds in [1e-6, 1e6]")?;
+        let error = error
+            .map(|e| check_real("error", e, MIN_ERROR, 1.0, "an error"))
+            .transpose()?;
+        let time = time
+            .map(|t| check_real("time", t, 1e-6, 1e6, "a time in seconds"))
+            .transpose()?;
         if error.is_some() && time.is_some() {
             return Err(Error::invalid(
                 "time",

@@ -140,45 +140,22 @@ pub(crate) fn frame_scene(
     })
 }
 
-/// What a plan reads of a scene (`methods/plan.rs`): its light-space depth
-/// ranges and bounds and the map's extent (given, or fitted as
-/// `frame_scene` fits it), for an output of `resolution`. One pass over the
-/// vertices; the ratios the planner forms do not depend on the depth unit.
+/// What a plan reads of a framed scene (`methods/plan.rs`): its
+/// light-space depth ranges and bounds, the map's extent and the light's
+/// size, for an output of `resolution`. One pass over the vertices; the
+/// ratios the planner forms do not depend on the depth unit.
 pub(crate) fn scene_stats(
-    occluders: &MeshRef,
-    receivers: &MeshRef,
-    light: &LightSpace,
+    f: &FramedScene,
     resolution: (usize, usize),
-    extent: Option<[f64; 2]>,
-) -> Result<crate::methods::plan::SceneStats> {
-    occluders.validate("occluders")?;
-    receivers.validate("receivers")?;
-    if occluders.is_empty() || receivers.is_empty() {
-        let which = if occluders.is_empty() {
-            "occluders"
-        } else {
-            "receivers"
-        };
-        return Err(Error::invalid(
-            which,
-            format!("the scene has no {which} triangles"),
-        ));
-    }
-    let occ_ls = occluders.to_light_space(light);
-    let rec_ls = receivers.to_light_space(light);
-    let light_size = light.size();
-    let extent = match extent {
-        Some(e) => e,
-        None => fit_extent(&occ_ls, &rec_ls, light_size)?,
-    };
+) -> crate::methods::plan::SceneStats {
     let z_range = |v: &[DVec3]| {
         v.iter().fold((f64::INFINITY, 0f64), |(lo, hi), q| {
             (lo.min(q.z), hi.max(q.z))
         })
     };
-    let (oz0, oz1) = z_range(&occ_ls);
-    let (rz0, rz1) = z_range(&rec_ls);
-    let bounds = occ_ls.iter().fold(
+    let (oz0, oz1) = z_range(&f.occ_ls);
+    let (rz0, rz1) = z_range(&f.rec_ls);
+    let bounds = f.occ_ls.iter().fold(
         [
             f64::INFINITY,
             f64::NEG_INFINITY,
@@ -191,10 +168,10 @@ pub(crate) fn scene_stats(
         },
     );
     let w = |z: f64| if z > 0.0 { 1.0 / z } else { f64::INFINITY };
-    Ok(crate::methods::plan::SceneStats {
+    crate::methods::plan::SceneStats {
         resolution,
-        extent,
-        light_size,
+        extent: [f.grid.tx, f.grid.ty],
+        light_size: f.light_size,
         occ_w_near: w(oz0),
         occ_w_far: w(oz1),
         rec_w_near: w(rz0.max(0.0)),
@@ -202,5 +179,5 @@ pub(crate) fn scene_stats(
         occ_bounds: bounds,
         // One depth to 1e-9 of it: a plane parallel to the light.
         occ_flat: oz1 - oz0 <= 1e-9 * oz1,
-    })
+    }
 }
