@@ -11,10 +11,10 @@ mod from_scene;
 mod points;
 
 // The GPU pipelines (and the planner) start from the same framing and checks.
-pub use frame::Timings;
 pub(crate) use frame::frame_scene;
 #[cfg(feature = "gpu")]
 pub(crate) use frame::FramedScene;
+pub use frame::Timings;
 pub(crate) use frame::{near_plane, scene_stats, Stopwatch};
 pub use from_depth::{check_depth, from_depth};
 #[cfg(feature = "gpu")]
