@@ -172,13 +172,13 @@ const CANDIDATES: [Candidate; 4] = [
     Candidate {
         label: "bitmask, 256 samples, gaps closed, hierarchy",
         worst_error: 0.0077,
-        time_ratio: 160.0,
+        time_ratio: 33.0,
         config: |_| bitmask(256, true),
     },
     Candidate {
         label: "bitmask, 256 samples, gaps closed, no hierarchy",
         worst_error: 0.0061,
-        time_ratio: 152.0,
+        time_ratio: 33.0,
         config: |_| bitmask(256, false),
     },
     Candidate {
@@ -186,7 +186,7 @@ const CANDIDATES: [Candidate; 4] = [
         // Worst: the fence, 0.0051 against Mitsuba whose own noise there is
         // 0.0041 (0.0043 against 4096-sample exact).
         worst_error: 0.005,
-        time_ratio: 618.0,
+        time_ratio: 76.0,
         config: |_| bitmask(1024, false),
     },
 ];
@@ -431,7 +431,7 @@ mod tests {
         let s = stats();
         let t = Target::new(None, Some(1.0)).unwrap();
         assert!(matches!(plan(&s, &t, None).config, MethodConfig::Ssm(_)));
-        // Probe 1 ms: 1024 samples predicted 0.62 s, fits.
+        // Probe 1 ms: 1024 samples predicted 0.076 s, fits.
         assert!(
             matches!(plan(&s, &t, Some(1e-3)).config, MethodConfig::Bitmask(c) if c.samples == 1024)
         );
