@@ -102,10 +102,17 @@ pub fn visibility(
         .with_min_len(64)
         .map(|(k, s)| match s {
             None => 0.0,
-            Some(s) => stratified(&bvh, k as u64, grid, size, |x, y| {
-                let o = s.origin(x, y);
-                (o, Vec3::new(x, y, 0.0) - o, 0.0)
-            }),
+            Some(s) => stratified(
+                &bvh,
+                (s.above.min(s.below), s.above.max(s.below)),
+                k as u64,
+                grid,
+                size,
+                |x, y| {
+                    let o = s.origin(x, y);
+                    (o, Vec3::new(x, y, 0.0) - o, 0.0)
+                },
+            ),
         })
         .collect()
 }

@@ -1,6 +1,6 @@
 // Ray casting on the GPU: the twin of src/methods/exact.rs. One invocation
 // per receiver texel casts its chunk of the stratified light samples through
-// the BVH built on the CPU (median split), counting the samples that see the
+// the BVH built on the CPU (binned SAH, bvh.rs), counting the samples that see the
 // light into `seen` (a gather: each invocation owns its receiver's count);
 // then a resolve divides by the sample count. The jitter is exact.rs's u64
 // hash, emulated with u32 pairs; the ray-triangle test is its Möller-Trumbore
@@ -96,7 +96,7 @@ fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
-// exact.rs's hit_t: Möller-Trumbore, where the line o + t d crosses
+// bvh.rs's hit_t: Möller-Trumbore, where the line o + t d crosses
 // triangle t (edges included): ok = false when it does not.
 struct Crossing {
     ok: bool,
@@ -127,7 +127,7 @@ fn hit_t(t: u32, o: vec3<f32>, d: vec3<f32>) -> Crossing {
     return Crossing(true, dot3(e2, q) * inv);
 }
 
-// exact.rs's hits: any crossing with t in (t0, t1).
+// bvh.rs's hits: any crossing with t in (t0, t1).
 fn hits(t: u32, o: vec3<f32>, d: vec3<f32>) -> bool {
     let c = hit_t(t, o, d);
     return c.ok && c.t > ep.t0 && c.t < ep.t1;
@@ -157,7 +157,7 @@ fn fmax(a: f32, b: f32) -> f32 {
 // Loop iterations this invocation has run (see ExactParams::budget).
 var<private> iterations: u32 = 0u;
 
-// exact.rs's Bvh::occluded: whether o + t d, t in (t0, t1), hits a triangle.
+// bvh.rs's Bvh::occluded (the one-ray reference): whether o + t d, t in (t0, t1), hits a triangle.
 fn occluded(o: vec3<f32>, d: vec3<f32>) -> bool {
     let inv = vec3<f32>(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
     var stack: array<u32, 64>;

@@ -5,6 +5,7 @@
 //! table of methods, options, defaults and limits.
 
 pub mod bitmask;
+pub mod bvh;
 pub mod capabilities;
 pub mod config;
 pub mod exact;
@@ -14,6 +15,7 @@ pub mod pcss;
 pub mod plan;
 pub mod point_light;
 pub mod shadow_mapping;
+pub(crate) mod shaft;
 pub mod smoothies;
 pub mod ssm;
 

@@ -1,0 +1,630 @@
+//! A bounding volume hierarchy over triangles, for shadow rays (any hit) and
+//! camera rays (nearest hit), shared by `exact`, the eye view and the GPU
+//! twins (which traverse the same nodes, uploaded).
+//!
+//! Build: binned surface area heuristic (SAH; Wald 2007, "On fast
+//! construction of SAH-based bounding volume hierarchies"). A split of a
+//! node of area A into children of areas A_l, A_r with n_l, n_r triangles is
+//! expected to cost C_node + (A_l n_l + A_r n_r) / A * C_tri for a random ray
+//! through the node; the build takes the cheapest of `BINS - 1` planes per
+//! axis over the centroids' bounds, and splits every node of more than
+//! `LEAF` triangles. Median splits (the earlier build) ignore
+//! how empty space is distributed: on the bunny, SAH visits fewer nodes per
+//! shadow ray (docs/methods/exact.md gives the numbers).
+//!
+//! Depth is bounded for the fixed 64-entry traversal stacks (CPU and WGSL):
+//! below `SAH_DEPTH` levels the build falls back to median splits, which
+//! halve the count each level, so no tree is deeper than `SAH_DEPTH` + 32.
+
+use glam::Vec3;
+
+/// Triangles per BVH leaf at most.
+pub(crate) const LEAF: usize = 4;
+/// Levels built by SAH; deeper nodes split at the median.
+const SAH_DEPTH: usize = 28;
+/// Candidate planes per axis (bins - 1).
+const BINS: usize = 16;
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Node {
+    pub(crate) min: Vec3,
+    pub(crate) max: Vec3,
+    /// Leaf: first triangle; inner: index of the left child (right = left + 1).
+    pub(crate) start: u32,
+    /// Triangles in a leaf; 0 for an inner node.
+    pub(crate) count: u32,
+}
+
+/// A bounding volume hierarchy over triangles.
+pub struct Bvh {
+    pub(crate) nodes: Vec<Node>,
+    tris: Vec<[Vec3; 3]>,
+    /// The index each triangle had in the input (`nearest` reports it).
+    order: Vec<u32>,
+    /// Each node's parent (the root's is itself), for the shadow cache.
+    parent: Vec<u32>,
+}
+
+fn bounds<'a>(tris: impl Iterator<Item = &'a [Vec3; 3]>) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for t in tris {
+        for v in t {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+    }
+    (lo, hi)
+}
+
+fn centroid(t: &[Vec3; 3]) -> Vec3 {
+    (t[0] + t[1] + t[2]) * (1.0 / 3.0)
+}
+
+/// Half the surface area of a box (the SAH needs ratios only); 0 for an
+/// empty box.
+fn half_area(lo: Vec3, hi: Vec3) -> f32 {
+    let e = (hi - lo).max(Vec3::ZERO);
+    e.x * e.y + e.y * e.z + e.z * e.x
+}
+
+/// The SAH split of `tris` (more than `LEAF` of them): the axis and the
+/// number of triangles that go left once the slice is partitioned by
+/// centroid along that axis at the returned plane, or `None` when every
+/// centroid is the same point (no plane separates them).
+fn sah_split(tris: &[([Vec3; 3], u32)]) -> Option<(usize, f32)> {
+    let (clo, chi) = tris.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(a, b), t| (a.min(centroid(&t.0)), b.max(centroid(&t.0))),
+    );
+    let mut best: Option<(f32, usize, f32)> = None;
+    for axis in 0..3 {
+        let (lo, hi) = (clo[axis], chi[axis]);
+        if !(hi > lo) {
+            continue;
+        }
+        let scale = BINS as f32 / (hi - lo);
+        let bin_of = |c: f32| (((c - lo) * scale) as usize).min(BINS - 1);
+        let mut count = [0u32; BINS];
+        let mut blo = [Vec3::splat(f32::INFINITY); BINS];
+        let mut bhi = [Vec3::splat(f32::NEG_INFINITY); BINS];
+        for (t, _) in tris {
+            let b = bin_of(centroid(t)[axis]);
+            count[b] += 1;
+            for v in t {
+                blo[b] = blo[b].min(*v);
+                bhi[b] = bhi[b].max(*v);
+            }
+        }
+        // Sweep from the right: area and count of bins [k, BINS).
+        let mut right = [(0f32, 0u32); BINS];
+        let (mut lo_acc, mut hi_acc, mut n_acc) = (
+            Vec3::splat(f32::INFINITY),
+            Vec3::splat(f32::NEG_INFINITY),
+            0,
+        );
+        for k in (1..BINS).rev() {
+            lo_acc = lo_acc.min(blo[k]);
+            hi_acc = hi_acc.max(bhi[k]);
+            n_acc += count[k];
+            right[k] = (half_area(lo_acc, hi_acc), n_acc);
+        }
+        let (mut lo_acc, mut hi_acc, mut n_acc) = (
+            Vec3::splat(f32::INFINITY),
+            Vec3::splat(f32::NEG_INFINITY),
+            0,
+        );
+        for k in 1..BINS {
+            lo_acc = lo_acc.min(blo[k - 1]);
+            hi_acc = hi_acc.max(bhi[k - 1]);
+            n_acc += count[k - 1];
+            let (ar, nr) = right[k];
+            if n_acc == 0 || nr == 0 {
+                continue;
+            }
+            let cost = half_area(lo_acc, hi_acc) * n_acc as f32 + ar * nr as f32;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, lo + k as f32 / scale));
+            }
+        }
+    }
+    // The parent's area, C_node and C_tri rescale or shift every candidate
+    // alike, so the cheapest plane is found without them; the node is split
+    // whatever the cost, because leaves are capped at LEAF triangles.
+    best.map(|(_, axis, plane)| (axis, plane))
+}
+
+impl Bvh {
+    /// The nodes as the GPU twin (`gpu/exact.wgsl`) reads them: min xyz,
+    /// max xyz (f32 bits), start, count: 8 words a node.
+    #[cfg(feature = "gpu")]
+    pub(crate) fn node_words(&self) -> Vec<u32> {
+        self.nodes
+            .iter()
+            .flat_map(|n| {
+                [
+                    n.min.x.to_bits(),
+                    n.min.y.to_bits(),
+                    n.min.z.to_bits(),
+                    n.max.x.to_bits(),
+                    n.max.y.to_bits(),
+                    n.max.z.to_bits(),
+                    n.start,
+                    n.count,
+                ]
+            })
+            .collect()
+    }
+
+    /// The triangles in BVH order, 9 floats each.
+    #[cfg(feature = "gpu")]
+    pub(crate) fn triangle_floats(&self) -> Vec<f32> {
+        self.tris
+            .iter()
+            .flat_map(|t| t.iter().flat_map(|v| v.to_array()))
+            .collect()
+    }
+
+    /// The input index of the triangle in each BVH slot (what `nearest`
+    /// reports), for the GPU twin's closest hits (`gpu/eye_hits.wgsl`).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    pub fn build(tris: Vec<[Vec3; 3]>) -> Bvh {
+        let mut tris: Vec<([Vec3; 3], u32)> = tris
+            .into_iter()
+            .enumerate()
+            .map(|(k, t)| (t, k as u32))
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
+        let (lo, hi) = bounds(tris.iter().map(|t| &t.0));
+        nodes.push(Node {
+            min: lo,
+            max: hi,
+            start: 0,
+            count: tris.len() as u32,
+        });
+        // Iterative build: (node index, depth) work list.
+        let mut work = vec![(0usize, 0usize)];
+        while let Some((n, depth)) = work.pop() {
+            let Node { start, count, .. } = nodes[n];
+            let (s, c) = (start as usize, count as usize);
+            if c <= LEAF {
+                continue;
+            }
+            let slice = &mut tris[s..s + c];
+            let split = if depth < SAH_DEPTH {
+                sah_split(slice)
+            } else {
+                None
+            };
+            let mid = match split {
+                Some((axis, plane)) => partition(slice, |t| centroid(&t.0)[axis] < plane),
+                None => 0,
+            };
+            // No SAH plane, or one that (by rounding at a bin edge) put
+            // everything on one side: the median on the longest axis.
+            let mid = if mid == 0 || mid == c {
+                median_split(slice)
+            } else {
+                mid
+            };
+            let left = nodes.len();
+            for (off, len) in [(0, mid), (mid, c - mid)] {
+                let (lo, hi) = bounds(tris[s + off..s + off + len].iter().map(|t| &t.0));
+                nodes.push(Node {
+                    min: lo,
+                    max: hi,
+                    start: (s + off) as u32,
+                    count: len as u32,
+                });
+            }
+            nodes[n].start = left as u32;
+            nodes[n].count = 0;
+            work.push((left, depth + 1));
+            work.push((left + 1, depth + 1));
+        }
+        let (tris, order): (Vec<[Vec3; 3]>, Vec<u32>) = tris.into_iter().unzip();
+        let mut parent = vec![0u32; nodes.len()];
+        for (k, n) in nodes.iter().enumerate() {
+            if n.count == 0 && !tris.is_empty() {
+                parent[n.start as usize] = k as u32;
+                parent[n.start as usize + 1] = k as u32;
+            }
+        }
+        Bvh {
+            nodes,
+            tris,
+            order,
+            parent,
+        }
+    }
+
+    /// Levels from the root to the deepest leaf (1 for a single leaf).
+    #[cfg(test)]
+    fn depth(&self) -> usize {
+        let mut deepest = 0;
+        let mut work = vec![(0usize, 1usize)];
+        while let Some((n, d)) = work.pop() {
+            deepest = deepest.max(d);
+            let node = self.nodes[n];
+            if node.count == 0 && !self.tris.is_empty() {
+                work.push((node.start as usize, d + 1));
+                work.push((node.start as usize + 1, d + 1));
+            }
+        }
+        deepest
+    }
+
+    pub(crate) fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// The nearest hit of the ray o + t d, t in (0, t1): its t and the
+    /// triangle's index in the input. Children are visited nearer first, so
+    /// a hit found early prunes the farther subtrees.
+    pub fn nearest(&self, o: Vec3, d: Vec3, t1: f32) -> Option<(f32, u32)> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let inv = d.recip();
+        let entry = |n: &Node, best: f32| {
+            let a = (n.min - o) * inv;
+            let b = (n.max - o) * inv;
+            let tmin = a.min(b).max_element().max(0.0);
+            let tmax = a.max(b).min_element().min(best);
+            (tmin <= tmax).then_some(tmin)
+        };
+        let mut best = t1;
+        let mut hit = None;
+        let mut stack = [0u32; 64];
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let node = &self.nodes[stack[sp] as usize];
+            if entry(node, best).is_none() {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.start as usize;
+                for (k, t) in self.tris[s..s + node.count as usize].iter().enumerate() {
+                    if let Some(th) = hit_t(t, o, d) {
+                        if th > 0.0 && th < best {
+                            best = th;
+                            hit = Some(s + k);
+                        }
+                    }
+                }
+            } else {
+                let (l, r) = (node.start, node.start + 1);
+                let (el, er) = (
+                    entry(&self.nodes[l as usize], best),
+                    entry(&self.nodes[r as usize], best),
+                );
+                // Push the farther child first so the nearer one pops next.
+                let order = match (el, er) {
+                    (Some(a), Some(b)) if b < a => [Some(l), Some(r)],
+                    _ => [er.and(Some(r)), el.and(Some(l))],
+                };
+                for c in order.into_iter().flatten() {
+                    debug_assert!(sp < stack.len());
+                    stack[sp] = c;
+                    sp += 1;
+                }
+            }
+        }
+        hit.map(|k| (best, self.order[k]))
+    }
+
+    /// Whether the segment o + t d, t in (t0, t1), crosses node `n`'s box
+    /// (the slab test; NaN from 0 * inf compares false and keeps the node).
+    #[inline]
+    fn enters(&self, n: &Node, o: Vec3, inv: Vec3, t0: f32, t1: f32) -> bool {
+        let a = (n.min - o) * inv;
+        let b = (n.max - o) * inv;
+        let tmin = a.min(b).max_element().max(t0);
+        let tmax = a.max(b).min_element().min(t1);
+        tmin <= tmax
+    }
+
+    /// Whether the segment o + t d, t in (t0, t1), hits a triangle of leaf
+    /// `leaf` (its box tested first). `inv` is `d.recip()`.
+    ///
+    /// The slab test is monotone in the box (IEEE rounding is), so a ray
+    /// that enters a leaf's box enters every ancestor's: testing a leaf
+    /// alone answers as the traversal from the root does.
+    #[inline]
+    pub(crate) fn leaf_occludes(
+        &self,
+        leaf: u32,
+        o: Vec3,
+        d: Vec3,
+        inv: Vec3,
+        t0: f32,
+        t1: f32,
+    ) -> bool {
+        let node = &self.nodes[leaf as usize];
+        debug_assert!(node.count > 0);
+        if !self.enters(node, o, inv, t0, t1) {
+            return false;
+        }
+        let s = node.start as usize;
+        self.tris[s..s + node.count as usize]
+            .iter()
+            .any(|t| hits(t, o, d, t0, t1))
+    }
+
+    /// The node `levels` above node `k` (or the root).
+    pub(crate) fn ancestor(&self, mut k: u32, levels: u32) -> u32 {
+        for _ in 0..levels {
+            k = self.parent[k as usize];
+        }
+        k
+    }
+
+    /// Whether the segment o + t d, t in (t0, t1), hits a triangle of the
+    /// subtree at node `root`; the leaf that it hits in (for the caller's
+    /// cache). With `root` 0, the whole tree.
+    pub(crate) fn occluding_leaf(
+        &self,
+        root: u32,
+        o: Vec3,
+        d: Vec3,
+        t0: f32,
+        t1: f32,
+    ) -> Option<u32> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let inv = d.recip();
+        let mut stack = [0u32; 64];
+        stack[0] = root;
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let k = stack[sp];
+            let node = &self.nodes[k as usize];
+            if !self.enters(node, o, inv, t0, t1) {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.start as usize;
+                if self.tris[s..s + node.count as usize]
+                    .iter()
+                    .any(|t| hits(t, o, d, t0, t1))
+                {
+                    return Some(k);
+                }
+            } else {
+                // The build bounds the depth (SAH_DEPTH + 32 < 64) and the
+                // stack holds at most one pending sibling per level.
+                debug_assert!(sp + 2 <= stack.len());
+                stack[sp] = node.start;
+                stack[sp + 1] = node.start + 1;
+                sp += 2;
+            }
+        }
+        None
+    }
+
+    /// Whether the segment o + t d, t in (t0, t1), hits any triangle, one
+    /// ray through the binary tree: the answer the 4-wide traversal, the
+    /// packets (`shaft.rs`) and the GPU twin (`gpu/exact.wgsl`'s
+    /// `occluded`, which this is written as) give, which the tests hold
+    /// them to.
+    #[cfg(test)]
+    pub(crate) fn occluded(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> bool {
+        if self.tris.is_empty() {
+            return false;
+        }
+        let inv = d.recip();
+        let mut stack = [0u32; 64];
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let node = &self.nodes[stack[sp] as usize];
+            if !self.enters(node, o, inv, t0, t1) {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.start as usize;
+                if self.tris[s..s + node.count as usize]
+                    .iter()
+                    .any(|t| hits(t, o, d, t0, t1))
+                {
+                    return true;
+                }
+            } else {
+                stack[sp] = node.start;
+                stack[sp + 1] = node.start + 1;
+                sp += 2;
+            }
+        }
+        false
+    }
+}
+
+/// Moves the elements for which `left` holds to the front; their count.
+fn partition<T>(v: &mut [T], left: impl Fn(&T) -> bool) -> usize {
+    let mut k = 0;
+    for j in 0..v.len() {
+        if left(&v[j]) {
+            v.swap(k, j);
+            k += 1;
+        }
+    }
+    k
+}
+
+/// Splits at the median centroid on the longest axis of the centroids'
+/// bounds; the left half's count.
+fn median_split(slice: &mut [([Vec3; 3], u32)]) -> usize {
+    let (clo, chi) = slice.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(a, b), t| (a.min(centroid(&t.0)), b.max(centroid(&t.0))),
+    );
+    let ext = chi - clo;
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    let mid = slice.len() / 2;
+    slice.select_nth_unstable_by(mid, |a, b| {
+        centroid(&a.0)[axis].total_cmp(&centroid(&b.0)[axis])
+    });
+    mid
+}
+
+/// Möller-Trumbore, any hit with t in (t0, t1).
+#[inline]
+pub(crate) fn hits(tri: &[Vec3; 3], o: Vec3, d: Vec3, t0: f32, t1: f32) -> bool {
+    hit_t(tri, o, d).is_some_and(|t| t > t0 && t < t1)
+}
+
+/// Möller-Trumbore: the line's parameter t where it crosses the triangle
+/// (edges included), or None.
+#[inline]
+fn hit_t(tri: &[Vec3; 3], o: Vec3, d: Vec3) -> Option<f32> {
+    let e1 = tri[1] - tri[0];
+    let e2 = tri[2] - tri[0];
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - tri[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(e2.dot(q) * inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic uniform in [0, 1).
+    fn rng(seed: u64) -> impl FnMut() -> f32 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    fn random_tris(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
+        let mut r = rng(seed);
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0, 1.0 + r() * 2.0);
+                [
+                    c,
+                    c + Vec3::new(r() * 0.3, r() * 0.1, r() * 0.1),
+                    c + Vec3::new(r() * 0.1, r() * 0.3, r() * 0.1),
+                ]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn any_hit_agrees_with_brute_force() {
+        let tris = random_tris(500, 1);
+        let bvh = Bvh::build(tris.clone());
+        let mut r = rng(2);
+        for _ in 0..2000 {
+            let o = Vec3::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0, 4.0);
+            let d = Vec3::new(r() - 0.5, r() - 0.5, 0.0) - o;
+            let brute = tris.iter().any(|t| hits(t, o, d, 1e-5, 1.0 - 1e-5));
+            assert_eq!(bvh.occluded(o, d, 1e-5, 1.0 - 1e-5), brute);
+        }
+    }
+
+    #[test]
+    fn nearest_agrees_with_brute_force() {
+        let tris = random_tris(300, 3);
+        let bvh = Bvh::build(tris.clone());
+        let mut r = rng(4);
+        for _ in 0..1000 {
+            let o = Vec3::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0, 4.0);
+            let d = Vec3::new(r() - 0.5, r() - 0.5, -1.0);
+            let brute = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(k, t)| {
+                    hit_t(t, o, d)
+                        .filter(|&th| th > 0.0)
+                        .map(|th| (th, k as u32))
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            assert_eq!(bvh.nearest(o, d, f32::INFINITY), brute);
+        }
+    }
+
+    #[test]
+    fn every_triangle_lands_in_one_leaf_of_at_most_leaf_size() {
+        let bvh = Bvh::build(random_tris(1000, 5));
+        let mut seen = vec![0u32; 1000];
+        for n in bvh.nodes.iter().filter(|n| n.count > 0) {
+            assert!(n.count as usize <= LEAF);
+            for k in n.start..n.start + n.count {
+                seen[bvh.order[k as usize] as usize] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
+    }
+
+    #[test]
+    fn depth_stays_within_the_traversal_stacks() {
+        // Identical triangles (no plane separates them) and a geometric
+        // progression (SAH peels one triangle a level): both must stay
+        // under the 64-entry stacks.
+        let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 5000];
+        assert!(Bvh::build(same).depth() <= 32);
+        let chain: Vec<[Vec3; 3]> = (0..3000)
+            .map(|k| {
+                let x = 1.5f32.powi(k / 50);
+                [
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                ]
+            })
+            .collect();
+        let d = Bvh::build(chain).depth();
+        assert!(d <= SAH_DEPTH + 32, "depth {d}");
+    }
+
+    #[test]
+    fn sah_beats_the_median_on_clustered_triangles() {
+        // Two clusters far apart, of 100 and 300 triangles: SAH separates
+        // them at the root; the median (200 a side) would cut the larger.
+        let mut tris = random_tris(400, 6);
+        for t in tris.iter_mut().skip(100) {
+            for v in t.iter_mut() {
+                v.x += 20.0;
+            }
+        }
+        let bvh = Bvh::build(tris);
+        let root = bvh.nodes[0];
+        let (l, r) = (
+            bvh.nodes[root.start as usize],
+            bvh.nodes[root.start as usize + 1],
+        );
+        assert!(l.max.x < 10.0 || l.min.x > 10.0);
+        assert!(r.max.x < 10.0 || r.min.x > 10.0);
+    }
+}
