@@ -409,40 +409,12 @@ impl Bvh {
         None
     }
 
-    /// Whether the segment o + t d, t in (t0, t1), hits any triangle, one
-    /// ray through the binary tree: the answer the 4-wide traversal, the
-    /// packets (`shaft.rs`) and the GPU twin (`gpu/exact.wgsl`'s
-    /// `occluded`, which this is written as) give, which the tests hold
-    /// them to.
+    /// Whether the segment o + t d, t in (t0, t1), hits any triangle: one
+    /// ray through the whole tree, as the GPU twin (`gpu/exact.wgsl`'s
+    /// `occluded`) traces it; the answer `shaft.rs`'s packets are held to.
     #[cfg(test)]
     pub(crate) fn occluded(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> bool {
-        if self.tris.is_empty() {
-            return false;
-        }
-        let inv = d.recip();
-        let mut stack = [0u32; 64];
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            let node = &self.nodes[stack[sp] as usize];
-            if !self.enters(node, o, inv, t0, t1) {
-                continue;
-            }
-            if node.count > 0 {
-                let s = node.start as usize;
-                if self.tris[s..s + node.count as usize]
-                    .iter()
-                    .any(|t| hits(t, o, d, t0, t1))
-                {
-                    return true;
-                }
-            } else {
-                stack[sp] = node.start;
-                stack[sp + 1] = node.start + 1;
-                sp += 2;
-            }
-        }
-        false
+        self.occluding_leaf(0, o, d, t0, t1).is_some()
     }
 }
 
@@ -512,11 +484,11 @@ fn hit_t(tri: &[Vec3; 3], o: Vec3, d: Vec3) -> Option<f32> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A deterministic uniform in [0, 1).
-    fn rng(seed: u64) -> impl FnMut() -> f32 {
+    pub(crate) fn rng(seed: u64) -> impl FnMut() -> f32 {
         let mut s = seed;
         move || {
             s = s

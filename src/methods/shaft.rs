@@ -165,16 +165,7 @@ impl<'a> Packet<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn rng(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        }
-    }
+    use crate::methods::bvh::tests::rng;
 
     /// Small triangles at depths 1.5 to 2.5 (the light is at 0).
     fn scene(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
