@@ -17,8 +17,9 @@
 //! usually blocked by nearby triangles. A single leaf hit only 4% of the
 //! rays on the floating bunny (its triangles back-project to about one
 //! light sample each); the subtree costs a few more box tests per ray and
-//! was faster: 2 levels measured fastest of 0, 2, 3, 4 and 6
-//! (docs/methods/exact.md).
+//! was faster. Of 0 (the leaf), 2, 3, 4 and 6 levels, 2 gave the smallest
+//! total time over the four study scenes, 3 within noise of it (timed by
+//! benchmarks/time_exact.py; the 0 and 2 rows are in docs/methods/exact.md).
 //!
 //! The answer per ray is the one `Bvh::occluded` gives: a leaf's slab test
 //! passes only if its ancestors' do (`Bvh::leaf_occludes`), the order in
