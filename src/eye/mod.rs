@@ -337,7 +337,8 @@ fn render_cpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         let tris = traced_triangles(&f, &scene);
         sw.lap("triangles");
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
-        let v = rays::visibility(f.light_size, tris, &starts, samples);
+        let order = rays::tiled(&f.hits, call.camera.width, call.camera.height);
+        let v = rays::visibility(f.light_size, tris, &starts, &order, samples);
         for (&k, v) in f.hits.iter().zip(v) {
             visibility[k] = v;
         }

@@ -12,7 +12,8 @@
 //! are traced exactly as the light-view `exact` traces them.
 
 use crate::geom::light_space::LightSpace;
-use crate::methods::exact::{sample_grid, stratified, Bvh};
+use crate::methods::exact::{sample_grid, Bvh};
+use crate::methods::shadow_rays::{tile_order, visibilities, RayOrigin, Sampling};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -84,35 +85,48 @@ pub fn ray_starts(
         .collect()
 }
 
+impl RayOrigin for RayStart {
+    #[inline(always)]
+    fn bounds(&self) -> (Vec3, Vec3) {
+        (self.above.min(self.below), self.above.max(self.below))
+    }
+    #[inline(always)]
+    fn origin(&self, x: f32, y: f32) -> Vec3 {
+        RayStart::origin(self, x, y)
+    }
+}
+
 /// Visibility at ray starts `starts` (a pixel's jitter key is its index in
 /// `starts`), every triangle of `triangles` (kernel light space,
-/// unit-scaled) blocking; 0 for `None`.
+/// unit-scaled) blocking; 0 for `None`. `order` (a permutation of the
+/// indices of `starts`) is the order to trace them in: neighbours next to
+/// each other (`tiled`), so that packets are coherent.
 pub fn visibility(
     light_size: [f64; 2],
     triangles: Vec<[Vec3; 3]>,
     starts: &[Option<RayStart>],
+    order: &[usize],
     samples: u32,
 ) -> Vec<f32> {
     let bvh = Bvh::build(triangles);
-    let grid = sample_grid(samples, light_size);
-    let size = light_size.map(|s| s as f32);
-    starts
-        .par_iter()
-        .enumerate()
-        .with_min_len(64)
-        .map(|(k, s)| match s {
-            None => 0.0,
-            Some(s) => stratified(
-                &bvh,
-                (s.above.min(s.below), s.above.max(s.below)),
-                k as u64,
-                grid,
-                size,
-                |x, y| {
-                    let o = s.origin(x, y);
-                    (o, Vec3::new(x, y, 0.0) - o, 0.0)
-                },
-            ),
-        })
+    let s = Sampling {
+        grid: sample_grid(samples, light_size),
+        size: light_size.map(|s| s as f32),
+        t0: 0.0,
+    };
+    visibilities(&bvh, starts, order, &s, 0.0)
+}
+
+/// The order of `pixels` (flat indices into an image `width` wide, each
+/// once) in 4 x 2 tiles (`shadow_rays::tile_order`): the indices into `pixels`.
+pub fn tiled(pixels: &[usize], width: usize, height: usize) -> Vec<usize> {
+    let mut at = vec![usize::MAX; width * height];
+    for (k, &p) in pixels.iter().enumerate() {
+        at[p] = k;
+    }
+    tile_order(width, height)
+        .into_iter()
+        .map(|p| at[p])
+        .filter(|&k| k != usize::MAX)
         .collect()
 }

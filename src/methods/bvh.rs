@@ -16,6 +16,7 @@
 //! below `SAH_DEPTH` levels the build falls back to median splits, which
 //! halve the count each level, so no tree is deeper than `SAH_DEPTH` + 32.
 
+use super::bvh_wide::{collapse, Wide};
 use glam::Vec3;
 
 /// Triangles per BVH leaf at most.
@@ -41,8 +42,12 @@ pub struct Bvh {
     tris: Vec<[Vec3; 3]>,
     /// The index each triangle had in the input (`nearest` reports it).
     order: Vec<u32>,
-    /// Each node's parent (the root's is itself), for the shadow cache.
-    parent: Vec<u32>,
+    /// Each triangle as `hit_t` reads it: v0, e1 = v1 - v0, e2 = v2 - v0.
+    edges: Vec<[f32; 9]>,
+    /// The tree collapsed to four-wide nodes (`bvh_wide.rs`), and each
+    /// one's parent (for the shadow cache).
+    pub(crate) wide: Vec<Wide>,
+    wide_parent: Vec<u32>,
 }
 
 fn bounds<'a>(tris: impl Iterator<Item = &'a [Vec3; 3]>) -> (Vec3, Vec3) {
@@ -231,18 +236,21 @@ impl Bvh {
             work.push((left + 1, depth + 1));
         }
         let (tris, order): (Vec<[Vec3; 3]>, Vec<u32>) = tris.into_iter().unzip();
-        let mut parent = vec![0u32; nodes.len()];
-        for (k, n) in nodes.iter().enumerate() {
-            if n.count == 0 && !tris.is_empty() {
-                parent[n.start as usize] = k as u32;
-                parent[n.start as usize + 1] = k as u32;
-            }
-        }
+        let edges = tris
+            .iter()
+            .map(|t| {
+                let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+                [t[0].x, t[0].y, t[0].z, e1.x, e1.y, e1.z, e2.x, e2.y, e2.z]
+            })
+            .collect();
+        let (wide, wide_parent) = collapse(&nodes);
         Bvh {
             nodes,
             tris,
             order,
-            parent,
+            edges,
+            wide,
+            wide_parent,
         }
     }
 
@@ -264,6 +272,12 @@ impl Bvh {
 
     pub(crate) fn is_empty(&self) -> bool {
         self.tris.is_empty()
+    }
+
+    /// The triangles in BVH order as corner and edges: v0, v1 - v0, v2 - v0.
+    #[inline(always)]
+    pub(crate) fn edges(&self) -> &[[f32; 9]] {
+        &self.edges
     }
 
     /// The nearest hit of the ray o + t d, t in (0, t1): its t and the
@@ -333,37 +347,10 @@ impl Bvh {
         tmin <= tmax
     }
 
-    /// Whether the segment o + t d, t in (t0, t1), hits a triangle of leaf
-    /// `leaf` (its box tested first). `inv` is `d.recip()`.
-    ///
-    /// The slab test is monotone in the box (IEEE rounding is), so a ray
-    /// that enters a leaf's box enters every ancestor's: testing a leaf
-    /// alone answers as the traversal from the root does.
-    #[inline]
-    pub(crate) fn leaf_occludes(
-        &self,
-        leaf: u32,
-        o: Vec3,
-        d: Vec3,
-        inv: Vec3,
-        t0: f32,
-        t1: f32,
-    ) -> bool {
-        let node = &self.nodes[leaf as usize];
-        debug_assert!(node.count > 0);
-        if !self.enters(node, o, inv, t0, t1) {
-            return false;
-        }
-        let s = node.start as usize;
-        self.tris[s..s + node.count as usize]
-            .iter()
-            .any(|t| hits(t, o, d, t0, t1))
-    }
-
-    /// The node `levels` above node `k` (or the root).
-    pub(crate) fn ancestor(&self, mut k: u32, levels: u32) -> u32 {
+    /// The wide node `levels` above wide node `k` (or the root).
+    pub(crate) fn wide_ancestor(&self, mut k: u32, levels: u32) -> u32 {
         for _ in 0..levels {
-            k = self.parent[k as usize];
+            k = self.wide_parent[k as usize];
         }
         k
     }
@@ -415,9 +402,8 @@ impl Bvh {
 
     /// Whether the segment o + t d, t in (t0, t1), hits any triangle: one
     /// ray through the whole tree, as the GPU twin (`gpu/exact.wgsl`'s
-    /// `occluded`) traces it; the answer `shaft.rs`'s packets are held to.
-    #[cfg(test)]
-    pub(crate) fn occluded(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> bool {
+    /// `occluded`) traces it; the answer every lane of `packet.rs` gets.
+    pub fn occluded(&self, o: Vec3, d: Vec3, t0: f32, t1: f32) -> bool {
         self.occluding_leaf(0, o, d, t0, t1).is_some()
     }
 }

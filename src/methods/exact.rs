@@ -1,6 +1,7 @@
 //! Exact visibility by ray casting: stratified light samples per receiver,
-//! shadow rays against a BVH over the occluder triangles (`bvh.rs`), one
-//! receiver's rays traced as a packet (`shaft.rs`), all cores.
+//! shadow rays against a BVH over the occluder triangles (`bvh.rs`), culled
+//! by shafts and traced in packets of neighbouring receivers
+//! (`shadow_rays.rs`), all cores.
 //!
 //! Not a soft shadow map: it reads the occluder triangles (not the occluder
 //! maps) and the receiver points. It converges to the true visibility as
@@ -13,69 +14,27 @@
 //! precision. The light is the rectangle [-Lx/2, Lx/2] x [-Ly/2, Ly/2] at Z = 0.
 
 pub use super::bvh::Bvh;
-use super::shaft::Packet;
+pub(crate) use super::shadow_rays::RAY_EPS;
+use super::shadow_rays::{tile_order, visibilities, Sampling};
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use glam::Vec3;
-use rayon::prelude::*;
 
 /// The exact method with `samples` light samples per receiver.
 pub struct Exact {
     pub samples: u32,
 }
 
-/// Shadow rays start this fraction of the way from the receiver and stop this
-/// fraction short of the light: occluders touching the receiver or the light
-/// are not hit by rounding alone.
-pub(crate) const RAY_EPS: f32 = 1e-5;
-
-/// A 32-bit mix (splitmix-style) for deterministic jitter.
-#[inline]
-fn hash(mut x: u64) -> u64 {
-    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x ^ (x >> 31)
-}
-
-#[inline]
-fn unit(h: u64) -> f32 {
-    (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-}
-
-/// The fraction of `grid` stratified light samples whose segment is clear:
-/// `ray(x, y)` gives, for the light point (x, y, 0), the segment's origin
-/// o, its direction d = light point - o, and t0 (the segment is t in (t0,
-/// 1 - RAY_EPS)). Every origin lies in the box `origins`, where the
-/// packet's shaft starts. The jitter is a hash of `key` and the sample.
-#[inline]
-pub(crate) fn stratified(
-    bvh: &Bvh,
-    origins: (Vec3, Vec3),
-    key: u64,
-    grid: (u32, u32),
-    size: [f32; 2],
-    mut ray: impl FnMut(f32, f32) -> (Vec3, Vec3, f32),
-) -> f32 {
-    let (na, nb) = grid;
-    let mut packet = Packet::new(bvh, origins.0, origins.1, [size[0] * 0.5, size[1] * 0.5]);
-    if packet.is_clear() {
-        // Every sample would be counted: the same 1.0 as the loop gives.
-        return 1.0;
+/// The light point (x, y) that `exact`'s ray of sample (sa, sb) of the
+/// `grid` goes to from the receiver whose jitter key is `key` (its texel or
+/// point index), for a light of `size`: for tracing the same rays elsewhere
+/// (benchmarks/bvh_crates compares BVH crates on them).
+pub fn light_sample(key: u64, sa: u32, sb: u32, grid: (u32, u32), size: [f32; 2]) -> (f32, f32) {
+    Sampling {
+        grid,
+        size,
+        t0: RAY_EPS,
     }
-    let mut seen = 0u32;
-    for sb in 0..nb {
-        for sa in 0..na {
-            let h = hash(key ^ hash(((sb * na + sa) as u64) << 1));
-            let x = ((sa as f32 + unit(h)) / na as f32 - 0.5) * size[0];
-            let y = ((sb as f32 + unit(hash(h))) / nb as f32 - 0.5) * size[1];
-            let (o, d, t0) = ray(x, y);
-            debug_assert!(o.cmpge(origins.0).all() && o.cmple(origins.1).all());
-            if !packet.occluded(o, d, t0, 1.0 - RAY_EPS) {
-                seen += 1;
-            }
-        }
-    }
-    seen as f32 / (na * nb) as f32
+    .sample(key, sa, sb)
 }
 
 /// The stratification grid a x b = samples, a the largest divisor <= sqrt,
@@ -95,29 +54,21 @@ pub fn sample_grid(samples: u32, light_size: [f64; 2]) -> (u32, u32) {
 }
 
 impl Exact {
-    /// Visibility at a receiver at light-space position p (planar depth p.z).
-    fn visibility(&self, bvh: &Bvh, p: Vec3, key: u64, grid: (u32, u32), size: [f32; 2]) -> f32 {
-        stratified(bvh, (p, p), key, grid, size, |x, y| {
-            (p, Vec3::new(x, y, 0.0) - p, RAY_EPS)
-        })
-    }
-
-    fn shade(&self, inputs: &ShadowInputs, pts: &[(u64, Option<Vec3>)]) -> Vec<f32> {
+    /// The visibility of receivers `pts` (light-space points; `None`: lit;
+    /// the jitter key is the index), traced in `order`.
+    fn shade(&self, inputs: &ShadowInputs, pts: &[Option<Vec3>], order: &[usize]) -> Vec<f32> {
         let Some(tris) = inputs.occluder_triangles else {
             // Nothing to occlude with: callers check before (the pipeline
             // refuses exact without meshes), so this is all-lit by definition.
             return vec![1.0; pts.len()];
         };
         let bvh = Bvh::build(tris.to_vec());
-        let grid = sample_grid(self.samples, inputs.light_size);
-        let size = [inputs.light_size[0] as f32, inputs.light_size[1] as f32];
-        pts.par_iter()
-            .with_min_len(64)
-            .map(|&(key, p)| match p {
-                Some(p) => self.visibility(&bvh, p, key, grid, size),
-                None => 1.0,
-            })
-            .collect()
+        let s = Sampling {
+            grid: sample_grid(self.samples, inputs.light_size),
+            size: [inputs.light_size[0] as f32, inputs.light_size[1] as f32],
+            t0: RAY_EPS,
+        };
+        visibilities(&bvh, pts, order, &s, 1.0)
     }
 }
 
@@ -128,26 +79,22 @@ fn light_point(p: &LightPoint) -> Option<Vec3> {
 impl ShadowMethod for Exact {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         let g = &inputs.grid;
-        let pts: Vec<(u64, Option<Vec3>)> = (0..g.len())
+        let pts: Vec<Option<Vec3>> = (0..g.len())
             .map(|k| {
-                let p = LightPoint {
+                light_point(&LightPoint {
                     x: g.x_of(k % g.width) as f32,
                     y: g.y_of(k / g.width) as f32,
                     z: inputs.receiver[k],
-                };
-                (k as u64, light_point(&p))
+                })
             })
             .collect();
-        self.shade(inputs, &pts)
+        self.shade(inputs, &pts, &tile_order(g.width, g.height))
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        let pts: Vec<(u64, Option<Vec3>)> = points
-            .iter()
-            .enumerate()
-            .map(|(k, p)| (k as u64, light_point(p)))
-            .collect();
-        self.shade(inputs, &pts)
+        let pts: Vec<Option<Vec3>> = points.iter().map(light_point).collect();
+        let order: Vec<usize> = (0..pts.len()).collect();
+        self.shade(inputs, &pts, &order)
     }
 }
 

@@ -6,15 +6,18 @@
 
 pub mod bitmask;
 pub mod bvh;
+pub(crate) mod bvh_wide;
 pub mod capabilities;
 pub mod config;
 pub mod exact;
 pub(crate) mod gather;
+pub(crate) mod packet;
 pub mod pcf;
 pub mod pcss;
 pub mod plan;
 pub mod point_light;
 pub mod shadow_mapping;
+pub(crate) mod shadow_rays;
 pub(crate) mod shaft;
 pub mod smoothies;
 pub mod ssm;

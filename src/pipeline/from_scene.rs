@@ -81,7 +81,8 @@ pub fn from_scene(
             }
             all
         };
-        let v = rays::visibility(light_size, tris, &keyed, samples);
+        let order = crate::methods::shadow_rays::tile_order(grid.width, grid.height);
+        let v = rays::visibility(light_size, tris, &keyed, &order, samples);
         for &k in &texels {
             visibility[k] = v[k];
         }

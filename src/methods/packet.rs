@@ -1,0 +1,363 @@
+//! Eight shadow rays traced together through the BVH, one per lane: the
+//! rays of eight neighbouring receivers toward the same stratum of the
+//! light (Wald et al. 2001, "Interactive rendering with coherent ray
+//! tracing"; packets of neighbouring pixels' rays, here shadow rays).
+//!
+//! Neighbouring receivers' rays to one stratum start a texel apart and end
+//! within a stratum of each other, so they cross the occluders close
+//! together and mostly enter the same nodes: a node is fetched once for
+//! the eight, and its slab test, like each triangle's, runs on all lanes at
+//! once (the lane loops below compile to AVX2 under `simd.rs`-style
+//! dispatch: `exact.rs` calls through `traverse`).
+//!
+//! Every lane gets the answer its ray alone gets from `Bvh::occluded`:
+//! the lane operations are the scalar ones, in the same order (glam's
+//! `Vec3::min`/`max` are `a < b ? a : b`, as the lanes' selects are; `f32::
+//! min`/`max` against t0 and t1 drop a NaN as the selects with t0 and t1
+//! second do), a lane counts a triangle's hit only where its own slab test
+//! entered the leaf (which, the slab test being monotone in the box, it
+//! does only if it entered every ancestor: `Bvh::leaf_occludes`), and the
+//! order in which an any-hit search visits nodes does not change its answer.
+
+use super::bvh::Bvh;
+use glam::Vec3;
+
+/// Rays per packet.
+pub(crate) const LANES: usize = 8;
+/// One bit per lane.
+pub(crate) type Mask = u8;
+/// Every lane.
+pub(crate) const ALL: Mask = Mask::MAX;
+
+type F = [f32; LANES];
+
+/// Eight segments o + t d.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rays {
+    o: [F; 3],
+    d: [F; 3],
+    inv: [F; 3],
+}
+
+impl Rays {
+    /// The rays from `o[i]` along `d[i]`.
+    #[inline(always)]
+    pub(crate) fn new(o: [Vec3; LANES], d: [Vec3; LANES]) -> Rays {
+        let o = [0, 1, 2].map(|a| o.map(|v| v[a]));
+        let d = [0, 1, 2].map(|a| d.map(|v| v[a]));
+        // Vec3::recip per lane.
+        let inv = d.map(|c| c.map(|x| 1.0 / x));
+        Rays { o, d, inv }
+    }
+
+    fn lane(&self, i: usize) -> (Vec3, Vec3) {
+        let v = |c: &[F; 3]| Vec3::new(c[0][i], c[1][i], c[2][i]);
+        (v(&self.o), v(&self.d))
+    }
+}
+
+impl Bvh {
+    /// The lanes of `active` whose segment o + t d, t in (t0, t1), hits a
+    /// triangle under wide node `from` (0: the whole tree), and the wide
+    /// node holding the last leaf that blocked one (for the caller's
+    /// shadow cache). Each lane's answer under the root is
+    /// `Bvh::occluded`'s for its ray.
+    #[inline(always)]
+    pub(crate) fn occluded_lanes(
+        &self,
+        from: u32,
+        rays: &Rays,
+        active: Mask,
+        t0: f32,
+        t1: f32,
+    ) -> (Mask, Option<u32>) {
+        if self.is_empty() || active == 0 {
+            return (0, None);
+        }
+        #[cfg(target_arch = "x86_64")]
+        {
+            if is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has the features the function is compiled for.
+                return unsafe { avx2::occluded(self, from, rays, active, t0, t1) };
+            }
+        }
+        // One lane at a time through the whole binary tree, as
+        // `Bvh::occluded`: no cache (searching more than `from`'s subtree
+        // finds what it holds too).
+        let mut blocked = 0;
+        for i in 0..LANES {
+            let (o, d) = rays.lane(i);
+            if active & (1 << i) != 0 && self.occluding_leaf(0, o, d, t0, t1).is_some() {
+                blocked |= 1 << i;
+            }
+        }
+        (blocked, None)
+    }
+}
+
+/// The lanes in AVX2 registers, each operation the scalar one.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{Bvh, Mask, Rays};
+    use crate::methods::bvh_wide::Wide;
+    use core::arch::x86_64::*;
+
+    struct Lanes {
+        o: [__m256; 3],
+        d: [__m256; 3],
+        inv: [__m256; 3],
+        t0: __m256,
+        t1: __m256,
+    }
+
+    /// The rays in registers.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn lanes(rays: &Rays, t0: f32, t1: f32) -> Lanes {
+        // SAFETY: each array is LANES = 8 f32s, an unaligned 256-bit load.
+        let load = |a: &[f32; 8]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
+        Lanes {
+            o: rays.o.each_ref().map(load),
+            d: rays.d.each_ref().map(load),
+            inv: rays.inv.each_ref().map(load),
+            t0: _mm256_set1_ps(t0),
+            t1: _mm256_set1_ps(t1),
+        }
+    }
+
+    /// The lanes whose segment enters the box of slot `k` of `w`:
+    /// `Bvh::enters` per lane. minps(a, b) is a < b ? a : b and maxps(a,
+    /// b) is a > b ? a : b, glam's `Vec3::min`/`max` and the ones of its
+    /// `max_element`/`min_element`; maxps(m, t0) keeps t0 for a NaN m as
+    /// `f32::max` does (and minps(m, t1) t1).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn enter(l: &Lanes, w: &Wide, k: usize) -> i32 {
+        let slab = |a: usize| {
+            let p = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(w.lo[a][k]), l.o[a]), l.inv[a]);
+            let q = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(w.hi[a][k]), l.o[a]), l.inv[a]);
+            (_mm256_min_ps(p, q), _mm256_max_ps(p, q))
+        };
+        let (n0, f0) = slab(0);
+        let (n1, f1) = slab(1);
+        let (n2, f2) = slab(2);
+        let tmin = _mm256_max_ps(_mm256_max_ps(_mm256_max_ps(n0, n1), n2), l.t0);
+        let tmax = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(f0, f1), f2), l.t1);
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax))
+    }
+
+    /// The lanes of `open` whose segment hits the triangle with corner v0
+    /// and edges e1, e2 (`Bvh::edges`): `bvh::hits` (Möller-Trumbore) per
+    /// lane, glam's cross and dot products operation for operation. Lanes
+    /// outside `open` may be set.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn hit(l: &Lanes, tri: &[f32; 9], open: i32) -> i32 {
+        let s1 = _mm256_set1_ps;
+        let (mul, sub, add, and) = (_mm256_mul_ps, _mm256_sub_ps, _mm256_add_ps, _mm256_and_ps);
+        let [v0x, v0y, v0z, e1x, e1y, e1z, e2x, e2y, e2z] = tri.map(|x| s1(x));
+        let [dx, dy, dz] = l.d;
+        // p = d x e2.
+        let px = sub(mul(dy, e2z), mul(e2y, dz));
+        let py = sub(mul(dz, e2x), mul(e2z, dx));
+        let pz = sub(mul(dx, e2y), mul(e2x, dy));
+        let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+        let inv = _mm256_div_ps(s1(1.0), det);
+        let sx = sub(l.o[0], v0x);
+        let sy = sub(l.o[1], v0y);
+        let sz = sub(l.o[2], v0z);
+        let u = mul(add(add(mul(sx, px), mul(sy, py)), mul(sz, pz)), inv);
+        // det != 0 and finite (|det| < inf, false for NaN); 0 <= u <= 1
+        // (false for NaN).
+        let abs = _mm256_andnot_ps(s1(-0.0), det);
+        let ok = and(
+            _mm256_cmp_ps::<_CMP_NEQ_OQ>(det, s1(0.0)),
+            _mm256_cmp_ps::<_CMP_LT_OQ>(abs, s1(f32::INFINITY)),
+        );
+        let ok = and(ok, _mm256_cmp_ps::<_CMP_GE_OQ>(u, s1(0.0)));
+        let ok = and(ok, _mm256_cmp_ps::<_CMP_LE_OQ>(u, s1(1.0)));
+        if _mm256_movemask_ps(ok) & open == 0 {
+            return 0;
+        }
+        // q = s x e1.
+        let qx = sub(mul(sy, e1z), mul(e1y, sz));
+        let qy = sub(mul(sz, e1x), mul(e1z, sx));
+        let qz = sub(mul(sx, e1y), mul(e1x, sy));
+        let v = mul(add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz)), inv);
+        let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv);
+        // Not (v < 0 or u + v > 1): true for NaN, as the scalar test.
+        let ok = and(ok, _mm256_cmp_ps::<_CMP_NLT_UQ>(v, s1(0.0)));
+        let ok = and(ok, _mm256_cmp_ps::<_CMP_NGT_UQ>(add(u, v), s1(1.0)));
+        let ok = and(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, l.t0));
+        let ok = and(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, l.t1));
+        _mm256_movemask_ps(ok)
+    }
+
+    /// `Bvh::occluded_lanes` (the caller checked a non-empty tree and an
+    /// active lane): the wide nodes from `from` down, each slot's box
+    /// tested for the lanes still open, a leaf's triangles for the lanes
+    /// that entered it.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn occluded(
+        bvh: &Bvh,
+        from: u32,
+        rays: &Rays,
+        active: Mask,
+        t0: f32,
+        t1: f32,
+    ) -> (Mask, Option<u32>) {
+        let l = lanes(rays, t0, t1);
+        let (wide, nodes, tris) = (&bvh.wide, &bvh.nodes, bvh.edges());
+        let mut open = active as i32;
+        let mut found = None;
+        // Binary trees are at most 60 levels deep (bvh.rs), wide ones 30,
+        // with at most 3 pending children a level.
+        let mut stack = [0u32; 96];
+        stack[0] = from;
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let wk = stack[sp];
+            let w = &wide[wk as usize];
+            let n = w.len as usize;
+            // The slots' tests do not depend on each other: the processor
+            // overlaps them.
+            let mut entered = [0i32; 4];
+            for (k, e) in entered.iter_mut().enumerate().take(n) {
+                *e = enter(&l, w, k);
+            }
+            for (k, &e) in entered.iter().enumerate().take(n) {
+                let e = e & open;
+                if e == 0 {
+                    continue;
+                }
+                if w.leaves & (1 << k) == 0 {
+                    debug_assert!(sp < stack.len());
+                    stack[sp] = w.child[k];
+                    sp += 1;
+                    continue;
+                }
+                let leaf = &nodes[w.child[k] as usize];
+                let s = leaf.start as usize;
+                for tri in &tris[s..s + leaf.count as usize] {
+                    let blocked = hit(&l, tri, e & open) & e & open;
+                    if blocked != 0 {
+                        open &= !blocked;
+                        found = Some(wk);
+                        if open == 0 {
+                            return (active, found);
+                        }
+                    }
+                }
+            }
+        }
+        (active & !(open as Mask), found)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::bvh::tests::rng;
+
+    #[test]
+    fn every_lane_answers_as_its_ray_alone() {
+        // Random small triangles and rays from a few origins near each
+        // other toward a light at z = 0, some through box edges.
+        let mut r = rng(7);
+        let tris: Vec<[Vec3; 3]> = (0..2000)
+            .map(|_| {
+                let c = Vec3::new(r() * 3.0 - 1.5, r() * 3.0 - 1.5, 1.0 + 2.0 * r());
+                [
+                    c,
+                    c + Vec3::new(r() * 0.1, r() * 0.03, r() * 0.03),
+                    c + Vec3::new(r() * 0.03, r() * 0.1, r() * 0.03),
+                ]
+            })
+            .collect();
+        let bvh = Bvh::build(tris);
+        let mut blocked = 0;
+        for _ in 0..3000 {
+            let base = Vec3::new(r() * 3.0 - 1.5, r() * 3.0 - 1.5, 4.0);
+            let o: [Vec3; LANES] =
+                std::array::from_fn(|_| base + Vec3::new(r() * 0.05, r() * 0.05, 0.0));
+            let l = Vec3::new(r() - 0.5, r() - 0.5, 0.0);
+            let d: [Vec3; LANES] =
+                std::array::from_fn(|i| l + Vec3::new(r() * 0.06, r() * 0.06, 0.0) - o[i]);
+            let active = (r() * 256.0) as Mask | 1;
+            let (got, _) = bvh.occluded_lanes(0, &Rays::new(o, d), active, 1e-5, 1.0 - 1e-5);
+            for i in 0..LANES {
+                let want = active & (1 << i) != 0 && bvh.occluded(o[i], d[i], 1e-5, 1.0 - 1e-5);
+                assert_eq!(got & (1 << i) != 0, want, "lane {i}");
+                blocked += want as u32;
+            }
+        }
+        assert!(
+            blocked > 1000,
+            "the rays should often be blocked: {blocked}"
+        );
+    }
+
+    #[test]
+    fn a_subtree_blocks_only_lanes_the_whole_tree_blocks() {
+        // The shadow cache searches a subtree first: what it finds there
+        // must be blocked in the whole tree too, and it must name a node
+        // in that subtree.
+        let mut r = rng(9);
+        let tris: Vec<[Vec3; 3]> = (0..3000)
+            .map(|_| {
+                let c = Vec3::new(r() * 2.0 - 1.0, r() * 2.0 - 1.0, 1.0 + r());
+                [
+                    c,
+                    c + Vec3::new(0.08, 0.0, 0.01),
+                    c + Vec3::new(0.0, 0.08, 0.01),
+                ]
+            })
+            .collect();
+        let bvh = Bvh::build(tris);
+        let mut from_cache = 0;
+        for _ in 0..2000 {
+            let base = Vec3::new(r() * 2.0 - 1.0, r() * 2.0 - 1.0, 4.0);
+            let o: [Vec3; LANES] =
+                std::array::from_fn(|_| base + Vec3::new(r() * 0.05, r() * 0.05, 0.0));
+            let l = Vec3::new(r() - 0.5, r() - 0.5, 0.0);
+            let d: [Vec3; LANES] = std::array::from_fn(|i| l - o[i]);
+            let rays = Rays::new(o, d);
+            let (all, node) = bvh.occluded_lanes(0, &rays, ALL, 1e-5, 1.0 - 1e-5);
+            let Some(w) = node else { continue };
+            let sub = bvh.wide_ancestor(w, 1);
+            let (part, _) = bvh.occluded_lanes(sub, &rays, ALL, 1e-5, 1.0 - 1e-5);
+            assert_eq!(part & !all, 0);
+            from_cache += (part != 0) as u32;
+        }
+        assert!(
+            from_cache > 100,
+            "the subtree should often block: {from_cache}"
+        );
+    }
+
+    #[test]
+    fn axis_parallel_rays_through_box_faces_answer_as_alone() {
+        // d.x = 0 exactly with o.x on a box face: 0 * inf = NaN in the slab
+        // test, which the lanes must treat as the scalar test does.
+        let tri = [
+            Vec3::new(0.0, -1.0, 2.0),
+            Vec3::new(1.0, -1.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.0),
+        ];
+        let bvh = Bvh::build(vec![tri]);
+        let o: [Vec3; LANES] = std::array::from_fn(|i| match i {
+            0 => Vec3::new(0.0, 0.0, 4.0),
+            1 => Vec3::new(1.0, 0.0, 4.0),
+            2 => Vec3::new(0.5, 1.0, 4.0),
+            3 => Vec3::new(0.5, -1.0, 4.0),
+            _ => Vec3::new(0.25 * i as f32 - 1.0, 0.1, 4.0),
+        });
+        let d: [Vec3; LANES] = std::array::from_fn(|i| Vec3::new(o[i].x, o[i].y, 0.0) - o[i]);
+        let (got, _) = bvh.occluded_lanes(0, &Rays::new(o, d), ALL, 1e-5, 1.0 - 1e-5);
+        for i in 0..LANES {
+            let want = bvh.occluded(o[i], d[i], 1e-5, 1.0 - 1e-5);
+            assert_eq!(got & (1 << i) != 0, want, "lane {i}");
+        }
+    }
+}

@@ -1,0 +1,253 @@
+//! The shadow rays of many receivers toward stratified samples of the
+//! light: which are traced, in what groups, and what each receiver sees.
+//!
+//! Each receiver sends one ray to a jittered point in each stratum of an
+//! a x b grid over the light (`exact::sample_grid`); the jitter is a hash
+//! of the receiver's key and the stratum, so results are deterministic and
+//! the same on the GPU (`gpu/exact.wgsl`, which traces every ray). What
+//! the CPU skips or groups never changes a ray's answer:
+//!
+//! 1. A receiver whose shaft to the whole light meets no leaf of the BVH
+//!    is lit without a ray (`shaft.rs`): 34% of the receivers of the
+//!    floating bunny at 256².
+//! 2. The others go in packets of `LANES` consecutive receivers (callers
+//!    order them in tiles, `tile_order`, so that they are neighbours). A
+//!    packet's shaft to each region of `REGION` x `REGION` strata is
+//!    tested once; the rays of a clear region are counted lit untraced
+//!    (on the floating bunny, 5.7 M of the 11.1 M rays of the receivers
+//!    step 1 left).
+//! 3. The rest are traced a stratum at a time, the packet's eight rays
+//!    together (`packet.rs`: a four-wide BVH, AVX2 lanes), first through
+//!    the subtree that blocked the packet's last blocked ray (a shadow
+//!    cache, after Haines & Greenberg 1986: neighbouring strata are
+//!    usually blocked by nearby triangles), then from the root.
+//!
+//! Timings and the variants tried are in docs/methods/exact.md.
+
+use super::bvh::Bvh;
+use super::packet::{Mask, Rays, ALL, LANES};
+use super::shaft::is_clear;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Shadow rays start this fraction of the way from the receiver and stop this
+/// fraction short of the light: occluders touching the receiver or the light
+/// are not hit by rounding alone.
+pub(crate) const RAY_EPS: f32 = 1e-5;
+
+/// A 32-bit mix (splitmix-style) for deterministic jitter.
+#[inline]
+fn hash(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^ (x >> 31)
+}
+
+#[inline]
+fn unit(h: u64) -> f32 {
+    (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
+
+/// Where a receiver's shadow rays start: a box holding every origin (where
+/// its shaft starts), and the origin of the ray toward the light point
+/// (x, y, 0).
+pub(crate) trait RayOrigin: Sync {
+    fn bounds(&self) -> (Vec3, Vec3);
+    fn origin(&self, x: f32, y: f32) -> Vec3;
+}
+
+/// A receiver point (the light view).
+impl RayOrigin for Vec3 {
+    #[inline(always)]
+    fn bounds(&self) -> (Vec3, Vec3) {
+        (*self, *self)
+    }
+    #[inline(always)]
+    fn origin(&self, _x: f32, _y: f32) -> Vec3 {
+        *self
+    }
+}
+
+/// The light samples every receiver's rays go to, and where rays start.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Sampling {
+    /// The stratification (`sample_grid`).
+    pub grid: (u32, u32),
+    /// The light's size.
+    pub size: [f32; 2],
+    /// Segments are t in (t0, 1 - RAY_EPS) of origin to light point.
+    pub t0: f32,
+}
+
+impl Sampling {
+    /// The light rectangle of strata [a0, a1) x [b0, b1).
+    fn rect(&self, a0: u32, a1: u32, b0: u32, b1: u32) -> [[f32; 2]; 2] {
+        let (na, nb) = self.grid;
+        let x = |a: u32| (a as f32 / na as f32 - 0.5) * self.size[0];
+        let y = |b: u32| (b as f32 / nb as f32 - 0.5) * self.size[1];
+        [[x(a0), x(a1)], [y(b0), y(b1)]]
+    }
+
+    /// The light point of sample (sa, sb) for the receiver whose jitter
+    /// key is `key`.
+    pub(crate) fn sample(&self, key: u64, sa: u32, sb: u32) -> (f32, f32) {
+        let na = self.grid.0;
+        self.point(key, hash(((sb * na + sa) as u64) << 1), sa, sb)
+    }
+
+    /// `sample`, with `hs` = `hash(((sb * na + sa) as u64) << 1)`, which
+    /// every receiver shares.
+    #[inline(always)]
+    fn point(&self, key: u64, hs: u64, sa: u32, sb: u32) -> (f32, f32) {
+        let (na, nb) = self.grid;
+        let h = hash(key ^ hs);
+        let x = ((sa as f32 + unit(h)) / na as f32 - 0.5) * self.size[0];
+        let y = ((sb as f32 + unit(hash(h))) / nb as f32 - 0.5) * self.size[1];
+        (x, y)
+    }
+}
+
+/// Strata per side of a light region whose shaft is tested per packet
+/// (more where that would make over `MAX_REGIONS` per side).
+const REGION: u32 = 4;
+const MAX_REGIONS: u32 = 8;
+/// Shadow cache: the subtree this many wide levels above the leaf that
+/// blocked the last blocked ray is searched first.
+const CACHE_LEVELS: u32 = 1;
+
+/// Receivers per parallel task (each packs its own).
+const CHUNK: usize = 64;
+
+/// The visibility of each receiver of `receivers` (`absent` for `None`):
+/// the fraction of its stratified light samples whose segment is clear,
+/// the jitter a hash of its index and the sample. `order` (a permutation of
+/// the receivers' indices) is the order to trace them in: `LANES`
+/// consecutive ones go in a packet, so neighbours should be consecutive
+/// (`tile_order`).
+pub(crate) fn visibilities<R: RayOrigin>(
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    order: &[usize],
+    s: &Sampling,
+    absent: f32,
+) -> Vec<f32> {
+    debug_assert_eq!(order.len(), receivers.len());
+    let light = s.rect(0, s.grid.0, 0, s.grid.1);
+    let traced: Vec<Vec<(usize, f32)>> = order
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut out = Vec::with_capacity(chunk.len());
+            let mut pending: Vec<(u64, &R)> = Vec::with_capacity(chunk.len());
+            let mut keys = Vec::with_capacity(chunk.len());
+            for &k in chunk {
+                let Some(r) = &receivers[k] else { continue };
+                let (lo, hi) = r.bounds();
+                if is_clear(bvh, lo, hi, light) {
+                    // Every sample would be counted: the same 1.0 as tracing.
+                    out.push((k, 1.0));
+                } else {
+                    pending.push((k as u64, r));
+                    keys.push(k);
+                }
+            }
+            for (group, keys) in pending.chunks(LANES).zip(keys.chunks(LANES)) {
+                let v = trace_packet(bvh, group, s);
+                out.extend(keys.iter().copied().zip(v));
+            }
+            out
+        })
+        .collect();
+    let mut v = vec![absent; receivers.len()];
+    for (k, x) in traced.into_iter().flatten() {
+        v[k] = x;
+    }
+    v
+}
+
+/// The visibility of up to `LANES` receivers `(key, origin)`, their rays
+/// traced together.
+fn trace_packet<R: RayOrigin>(bvh: &Bvh, group: &[(u64, &R)], s: &Sampling) -> [f32; LANES] {
+    let m = group.len();
+    debug_assert!((1..=LANES).contains(&m));
+    let valid: Mask = if m == LANES { ALL } else { (1 << m) - 1 };
+    // Unused lanes repeat the last receiver (masked off).
+    let lane = |i: usize| group[i.min(m - 1)];
+    let (na, nb) = s.grid;
+    let t1 = 1.0 - RAY_EPS;
+
+    // The packet's origins, and which regions of strata their shaft
+    // leaves clear (every ray there sees the light).
+    let (mut lo, mut hi) = lane(0).1.bounds();
+    for i in 1..m {
+        let (a, b) = lane(i).1.bounds();
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    let side = |n: u32| REGION.max(n.div_ceil(MAX_REGIONS));
+    let (sa_r, sb_r) = (side(na), side(nb));
+    let (ra, rb) = (na.div_ceil(sa_r), nb.div_ceil(sb_r));
+    let mut clear = [false; (MAX_REGIONS * MAX_REGIONS) as usize];
+    for rj in 0..rb {
+        for ri in 0..ra {
+            let (a0, b0) = (ri * sa_r, rj * sb_r);
+            let rect = s.rect(a0, (a0 + sa_r).min(na), b0, (b0 + sb_r).min(nb));
+            clear[(rj * ra + ri) as usize] = is_clear(bvh, lo, hi, rect);
+        }
+    }
+
+    let mut seen = [0u32; LANES];
+    let mut cache: Option<u32> = None;
+    for sb in 0..nb {
+        for sa in 0..na {
+            if clear[((sb / sb_r) * ra + sa / sa_r) as usize] {
+                for n in seen.iter_mut() {
+                    *n += 1;
+                }
+                continue;
+            }
+            let hs = hash(((sb * na + sa) as u64) << 1);
+            let mut o = [Vec3::ZERO; LANES];
+            let mut d = [Vec3::ZERO; LANES];
+            for i in 0..LANES {
+                let (key, r) = lane(i);
+                let (x, y) = s.point(key, hs, sa, sb);
+                o[i] = r.origin(x, y);
+                d[i] = Vec3::new(x, y, 0.0) - o[i];
+            }
+            let rays = Rays::new(o, d);
+            let mut open = valid;
+            for from in [cache, Some(0)].into_iter().flatten() {
+                if open == 0 {
+                    break;
+                }
+                let (blocked, node) = bvh.occluded_lanes(from, &rays, open, s.t0, t1);
+                open &= !blocked;
+                if let Some(w) = node {
+                    cache = Some(bvh.wide_ancestor(w, CACHE_LEVELS));
+                }
+            }
+            for (i, n) in seen.iter_mut().enumerate() {
+                *n += ((open >> i) & 1) as u32;
+            }
+        }
+    }
+    seen.map(|n| n as f32 / (na * nb) as f32)
+}
+
+/// The indices of a width x height grid in tiles of 4 x 2 (row-major
+/// tiles, row-major within one), so that `LANES` consecutive indices are
+/// neighbours.
+pub(crate) fn tile_order(width: usize, height: usize) -> Vec<usize> {
+    let mut order = Vec::with_capacity(width * height);
+    for ty in (0..height).step_by(2) {
+        for tx in (0..width).step_by(4) {
+            for y in ty..(ty + 2).min(height) {
+                for x in tx..(tx + 4).min(width) {
+                    order.push(y * width + x);
+                }
+            }
+        }
+    }
+    order
+}
