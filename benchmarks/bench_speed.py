@@ -1,5 +1,6 @@
 """Speed at low error: softshadow's fastest setting within an error target
-against Mitsuba's ray_test at the same error, on the study's scenes.
+against Mitsuba's ray_test at the same error, and `exact` against ray_test
+per shadow ray, on the study's scenes.
 
     python benchmarks/bench_speed.py [--resolutions 256 512] [--repeats 3]
         [--scenes ...] [--target 0.01] [--out docs/benchmarks/speed.md] [--no-write]
@@ -12,7 +13,11 @@ For each scene and resolution, in one run:
   error;
 - Mitsuba's time at each setting's error, interpolated log-log between its
   sample counts (the study's `mitsuba_seconds_at`), and the ratio to the
-  setting's time.
+  setting's time;
+- `exact` with `EXACT_SAMPLES` rays per receiver against Mitsuba's trace of
+  as many rays per receiver: the speed per shadow ray. *Rays* counts every
+  receiver texel's rays, traced or not: `exact` answers the rays its shafts
+  prove clear without tracing them, Mitsuba traces them all.
 
 Errors are the paper's §4.2.1 metric against a 1024-sample Mitsuba reference
 (cached in ``.cache/references/``); its own noise (a second seed) is printed
@@ -37,6 +42,8 @@ from softshadow.reference.cache import cached_reference_map
 
 STUDY = ("bunny_floating", "bunny_on_floor", "two_spheres", "torus")
 MITSUBA_SAMPLES = (16, 32, 64, 128, 256, 512)
+#: Rays per receiver of the per-ray comparison (one of MITSUBA_SAMPLES).
+EXACT_SAMPLES = 256
 
 
 def settings(res: int) -> dict[str, Any]:
@@ -77,6 +84,11 @@ def main(argv: list[str] | None = None) -> int:
         "|---|---|---|---|---|---|---|---|",
     ]
     detail = []
+    per_ray = [
+        f"| scene | resolution | exact {EXACT_SAMPLES} (ms) | error | Mitsuba ray_test {EXACT_SAMPLES} (ms) | error "
+        "| exact M rays/s | Mitsuba M rays/s | Mitsuba time / exact time |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for res in a.resolutions:
         for name in a.scenes:
             scene, light = scenes.SCENES[name]()
@@ -120,6 +132,25 @@ def main(argv: list[str] | None = None) -> int:
                 )
                 if e <= a.target and (best is None or mt / t > best[0]):
                     best = (mt / t, label, e, t, mt)
+            # exact against Mitsuba on as many rays per receiver.
+            (mitsuba,) = [c for c in curve if c.setting == f"{EXACT_SAMPLES} samples"]
+
+            def run_exact(
+                scene: ss.Scene = scene, light: ss.RectLight = light, res: int = res, extent: Any = base.extent
+            ) -> ss.ShadowMap:
+                return ss.soft_shadow_map(
+                    scene, light, resolution=res, extent=extent, method=ss.Exact(samples=EXACT_SAMPLES)
+                )
+
+            run_exact()  # warm-up
+            t, sm = median_seconds(run_exact, a.repeats)
+            e = metrics.shadow_error(sm.visibility, ref)
+            rays = int(np.isfinite(base.receiver_depth).sum()) * EXACT_SAMPLES / 1e6
+            per_ray.append(
+                f"| {name} | {res}² | {t * 1e3:.1f} | {e:.4f} | {mitsuba.seconds * 1e3:.1f} | {mitsuba.error:.4f} "
+                f"| {rays / t:.1f} | {rays / mitsuba.seconds:.1f} | {mitsuba.seconds / t:.2f} |"
+            )
+            print(per_ray[-1], flush=True)
             if best is None:
                 summary.append(f"| {name} | {res}² | {noise:.4f} | none | | | | |")
             else:
@@ -130,6 +161,14 @@ def main(argv: list[str] | None = None) -> int:
             print(summary[-1], flush=True)
 
     for line in summary:
+        report.line(line)
+    report.line("")
+    report.line(
+        f"`exact` per shadow ray: {EXACT_SAMPLES} stratified rays per receiver texel, end to end from meshes, "
+        f"against Mitsuba's trace of {EXACT_SAMPLES} per texel (medians of {runs(a.repeats)}):"
+    )
+    report.line("")
+    for line in per_ray:
         report.line(line)
     report.line("")
     report.line(f"Every setting (ms, medians of {runs(a.repeats)}; * where Mitsuba's time is extrapolated):")

@@ -81,9 +81,19 @@ impl Bvh {
                 return unsafe { avx2::occluded(self, from, rays, active, t0, t1) };
             }
         }
-        // One lane at a time through the whole binary tree, as
-        // `Bvh::occluded`: no cache (searching more than `from`'s subtree
-        // finds what it holds too).
+        self.occluded_lanes_scalar(rays, active, t0, t1)
+    }
+
+    /// `occluded_lanes` without AVX2: one lane at a time through the whole
+    /// binary tree, as `Bvh::occluded`, and no cache (searching more than a
+    /// subtree finds what it holds too).
+    fn occluded_lanes_scalar(
+        &self,
+        rays: &Rays,
+        active: Mask,
+        t0: f32,
+        t1: f32,
+    ) -> (Mask, Option<u32>) {
         let mut blocked = 0;
         for i in 0..LANES {
             let (o, d) = rays.lane(i);
@@ -285,7 +295,10 @@ mod tests {
             let d: [Vec3; LANES] =
                 std::array::from_fn(|i| l + Vec3::new(r() * 0.06, r() * 0.06, 0.0) - o[i]);
             let active = (r() * 256.0) as Mask | 1;
-            let (got, _) = bvh.occluded_lanes(0, &Rays::new(o, d), active, 1e-5, 1.0 - 1e-5);
+            let rays = Rays::new(o, d);
+            let (got, _) = bvh.occluded_lanes(0, &rays, active, 1e-5, 1.0 - 1e-5);
+            let (scalar, _) = bvh.occluded_lanes_scalar(&rays, active, 1e-5, 1.0 - 1e-5);
+            assert_eq!(got, scalar);
             for i in 0..LANES {
                 let want = active & (1 << i) != 0 && bvh.occluded(o[i], d[i], 1e-5, 1.0 - 1e-5);
                 assert_eq!(got & (1 << i) != 0, want, "lane {i}");
