@@ -161,23 +161,24 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         )?;
         // A sun's map extent is given in world units; the kernels' in tangents.
         let extent = call.extent.map(|e| space.kernel_extent(e));
-        let run = |method: &MethodConfig, hard: bool| {
-            let mut settings = MapSettings::new(w, h, extent, method);
-            settings.hard = hard;
-            match backend {
-                Backend::Cpu => {
-                    pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
+        let run =
+            |method: &MethodConfig, hard: bool, size: (usize, usize), extent: Option<[f64; 2]>| {
+                let mut settings = MapSettings::new(size.0, size.1, extent, method);
+                settings.hard = hard;
+                match backend {
+                    Backend::Cpu => {
+                        pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
+                    }
+                    #[cfg(feature = "gpu")]
+                    Backend::Gpu => {
+                        crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
+                    }
+                    #[cfg(not(feature = "gpu"))]
+                    Backend::Gpu => Err(not_built()),
                 }
-                #[cfg(feature = "gpu")]
-                Backend::Gpu => {
-                    crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
-                }
-                #[cfg(not(feature = "gpu"))]
-                Backend::Gpu => Err(not_built()),
-            }
-        };
+            };
         let Some(target) = target else {
-            return Ok((run(&method, false)?, method, None));
+            return Ok((run(&method, false, (w, h), extent)?, method, None));
         };
         planned(call, &space, extent, &ctx, &target, run)
     })?;
@@ -191,22 +192,24 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
 }
 
 /// A mesh call planned for `target` (`methods/plan.rs`): the scene's stats,
-/// the plan (after a timed probe for a time budget), the planned config
-/// resolved for the backend and run. The planning time is the result's
-/// "plan" stage.
+/// the plan (after a timed probe for a time budget), for a union setting
+/// the occluder raster it will read (layers, thin features) and, where
+/// texels see more than two surfaces, coarse runs that try each peeled
+/// layer; then the planned config resolved for the backend and run. The
+/// planning time (the probe excluded) is the result's "plan" stage.
 fn planned(
     call: &MeshCall,
     space: &LightSpace,
     extent: Option<[f64; 2]>,
     ctx: &CallContext,
     target: &crate::methods::plan::Target,
-    run: impl Fn(&MethodConfig, bool) -> Result<ShadowResult>,
+    run: impl Fn(&MethodConfig, bool, (usize, usize), Option<[f64; 2]>) -> Result<ShadowResult>,
 ) -> Result<(
     ShadowResult,
     MethodConfig,
     Option<crate::methods::plan::Plan>,
 )> {
-    use crate::methods::plan::plan;
+    use crate::methods::plan::{layer_change, plan, LAYER_CHANGE};
     let t0 = std::time::Instant::now();
     // The framing every run starts from (its checks, transform and extent
     // fit), on the rule's settings; the planner reads its depth ranges.
@@ -220,20 +223,17 @@ fn planned(
         &mut pipeline::Stopwatch::new(),
     )?;
     let stats = pipeline::scene_stats(&framed, ctx.resolution);
-    drop(framed);
     let mut p = plan(&stats, target, None);
-    let mut planning = t0.elapsed().as_secs_f64();
     let mut probe = None;
+    let mut probe_seconds = 0.0;
     if target.time.is_some() && !p.hard {
         // The probe: the cheapest soft setting, timed; kept when nothing
         // better fits the budget.
         let cfg = p.config.resolve(ctx)?;
         let t = std::time::Instant::now();
-        let out = run(&cfg, false)?;
-        let seconds = t.elapsed().as_secs_f64();
-        let t1 = std::time::Instant::now();
-        p = plan(&stats, target, Some(seconds + planning));
-        planning += t1.elapsed().as_secs_f64();
+        let out = run(&cfg, false, (w, h), extent)?;
+        probe_seconds = t.elapsed().as_secs_f64();
+        p = plan(&stats, target, Some(t0.elapsed().as_secs_f64()));
         probe = Some((cfg, out));
     }
     // The GPU has no hard shadow map: the soft setting runs there.
@@ -245,10 +245,61 @@ fn planned(
                 .push_str("; the GPU backend has no hard shadow map, the soft setting runs");
         }
     }
+    if let Some(c) = p.bitmask() {
+        let occ = c.occluder_resolution.unwrap_or((w, h));
+        let fitted = [framed.grid.tx, framed.grid.ty];
+        let grid = crate::geom::light::MapGrid::new(occ.0, occ.1, fitted)?;
+        let (raster, mut peeler) = pipeline::occluder_raster(&framed, call.occluders.faces, &grid);
+        if p.refine(&raster, occ, target) {
+            // Each peeled layer tried on coarse maps (receivers at an eighth
+            // of the output's side, occluders at a quarter of the planned,
+            // 256 samples): kept while it changes the shadow. On the
+            // bunnies the change measured so is within 0.0003 of the full
+            // maps' (0.0005-0.0009), in 5 ms a run instead of 90-240.
+            let MethodConfig::Bitmask(planned) = p.config else {
+                unreachable!("refine keeps a union setting")
+            };
+            let coarse = ((w / 8).clamp(16.min(w), w), (h / 8).clamp(16.min(h), h));
+            let quarter = |n: usize| (n / 4).clamp(64.min(n), n);
+            let with = |passes: u32| {
+                MethodConfig::Bitmask(crate::methods::config::BitmaskConfig {
+                    passes: Some(passes),
+                    samples: 256,
+                    occluder_resolution: Some((quarter(occ.0), quarter(occ.1))),
+                    ..planned
+                })
+                .resolve(ctx)
+            };
+            let (mut passes, mut peeled, mut changes) = (2, vec![], vec![]);
+            let mut previous = None;
+            while passes < crate::methods::config::MAX_PASSES {
+                let n = peeler.next_surfaces();
+                peeled.push(n);
+                if n == 0 {
+                    break;
+                }
+                let before = match previous.take() {
+                    Some(v) => v,
+                    None => run(&with(passes)?, false, coarse, Some(fitted))?.visibility,
+                };
+                let after = run(&with(passes + 1)?, false, coarse, Some(fitted))?.visibility;
+                let change = layer_change(&before, &after);
+                changes.push(change);
+                if change < LAYER_CHANGE {
+                    break;
+                }
+                passes += 1;
+                previous = Some(after);
+            }
+            p.set_layers(passes, &peeled, &changes);
+        }
+    }
+    drop(framed);
     let cfg = p.config.resolve(ctx)?;
+    let planning = t0.elapsed().as_secs_f64() - probe_seconds;
     let mut out = match probe {
         Some((probe_cfg, out)) if probe_cfg == cfg => out,
-        _ => run(&cfg, p.hard)?,
+        _ => run(&cfg, p.hard, (w, h), extent)?,
     };
     out.timings.insert(0, ("plan", planning));
     p.config = cfg;

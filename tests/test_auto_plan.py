@@ -33,11 +33,68 @@ def test_a_light_whose_penumbrae_are_under_half_a_texel_is_a_point():
     assert not decision(planned(scenes.bunny_floating), "hard").taken
 
 
-def test_a_plate_parallel_to_the_light_takes_the_sum_and_a_tilted_one_the_union():
+def plates(*placed: tuple[tuple[float, float, float], float]) -> tuple[ss.Scene, ss.RectLight]:
+    """Square plates parallel to the light (centre, half side) over the floor."""
+    occluders = [scenes.quad(c, h) for c, h in placed]
+    return ss.Scene(occluders=occluders, receivers=[scenes.floor()]), scenes.default_light()
+
+
+def side_by_side() -> tuple[ss.Scene, ss.RectLight]:
+    """Two plates at different heights, apart: single surfaces off one plane."""
+    return plates(((-0.3, 2.0, 0.0), 0.2), ((0.3, 1.5, 0.0), 0.2))
+
+
+def stacked() -> tuple[ss.Scene, ss.RectLight]:
+    """Three plates under one another: the middle one, hidden from the
+    light's centre between the top (front) and the bottom (back), is seen
+    from the light's corners."""
+    return plates(((0.0, 3.0, 0.0), 0.15), ((0.0, 1.5, 0.0), 0.15), ((0.0, 0.3, 0.0), 0.2))
+
+
+def test_one_plane_takes_the_sum_and_occluders_off_it_the_union():
     flat = planned(scenes.square_plate, target=0.005)
     assert not decision(flat, "union").taken and isinstance(flat.method, ss.Ssm)
+    # Tilted, the plate still covers each direction from the light once.
     tilted = planned(scenes.tilted_plate, target=0.005)
-    assert decision(tilted, "union").taken and isinstance(tilted.method, ss.Bitmask)
+    assert not decision(tilted, "union").taken and isinstance(tilted.method, ss.Ssm)
+    assert "tilted" in decision(tilted, "union").why
+    apart = planned(side_by_side, target=0.005)
+    assert decision(apart, "union").taken and isinstance(apart.method, ss.Bitmask)
+
+
+def test_single_surfaces_take_one_layer_and_a_back_layer_would_change_nothing():
+    sm = planned(side_by_side)
+    assert decision(sm, "layers").taken and sm.method.passes == 1
+    two = ss.soft_shadow_map(*side_by_side(), resolution=64, extent=sm.extent, method=ss.Bitmask(passes=2))
+    assert np.array_equal(sm.visibility, two.visibility)
+    # Closed meshes have a back: front and back.
+    spheres = planned(scenes.two_spheres)
+    assert not decision(spheres, "layers").taken and spheres.method.passes == 2
+
+
+def test_a_peeled_layer_is_kept_where_it_changes_the_shadow_and_only_there():
+    scene, light = stacked()
+    sm = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(error=0.01))
+    assert decision(sm, "layers").taken and sm.method.passes == 3
+    # The kept layer brings the map closer to the ray-traced shadow.
+    exact = ss.soft_shadow_map(scene, light, resolution=64, extent=sm.extent, method=ss.Exact(samples=1024))
+    two = ss.soft_shadow_map(scene, light, resolution=64, extent=sm.extent, method=ss.Bitmask(passes=2))
+    error = metrics.shadow_error
+    assert error(sm.visibility, exact.visibility) < error(two.visibility, exact.visibility)
+    # The bunny's folds give texels more than two surfaces, but its first
+    # peeled layer changes the shadow by less than LAYER_CHANGE.
+    bunny = planned(scenes.bunny_floating)
+    layers = decision(bunny, "layers")
+    assert not layers.taken and bunny.method.passes == 2 and "peeled layer" in layers.why
+
+
+def test_thin_occluders_refine_the_maps_for_tight_targets_only():
+    tight = planned(scenes.fence, target=0.005)
+    assert decision(tight, "thin_occluders").taken and tight.method.occluder_resolution == (128, 128)
+    loose = planned(scenes.fence, target=0.01)
+    assert not decision(loose, "thin_occluders").taken and loose.method.occluder_resolution == (64, 64)
+    bunny = planned(scenes.bunny_floating, target=0.005)
+    assert not decision(bunny, "thin_occluders").taken and bunny.method.occluder_resolution == (64, 64)
 
 
 def test_wide_penumbrae_coarsen_the_occluder_maps_and_contact_does_not():
@@ -75,7 +132,9 @@ def test_a_time_budget_runs_a_probe_then_what_fits():
     roomy = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(time=30.0))
     assert isinstance(roomy.method, ss.Bitmask)
     assert "probe" in decision(roomy, "setting").why
-    assert roomy.timings["plan"] < 0.05 * sum(roomy.timings.values())
+    # The planning is a stage of its own (its share of the time is measured
+    # by benchmarks/bench_gaps.py, never asserted here: timings are noisy).
+    assert next(iter(roomy.timings)) == "plan"
 
 
 def test_without_a_target_auto_is_the_rule_and_has_no_plan():
@@ -99,10 +158,11 @@ def test_auto_targets_are_checked_and_round_trip():
         ss.Auto(error="small")  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("name", ["bunny_floating", "bunny_on_floor", "two_spheres", "torus"])
-def test_the_plan_meets_its_target_against_mitsuba(reference_for, name):
-    scene, light = scenes.SCENES[name]()
+@pytest.mark.parametrize("target", [0.01, 0.005])
+@pytest.mark.parametrize("name", ["bunny_floating", "bunny_on_floor", "two_spheres", "torus", "fence"])
+def test_the_plan_meets_its_target_against_mitsuba(reference_for, name, target):
+    scene, light = (scenes.SCENES.get(name) or scenes.HARD_SURFACES[name])()
     base = ss.soft_shadow_map(scene, light, resolution=256)
     ref = reference_for(name, base, scene.occluders)
-    sm = ss.soft_shadow_map(scene, light, resolution=256, extent=base.extent, method=ss.Auto(error=0.01))
-    assert metrics.shadow_error(sm.visibility, ref) <= 0.01, sm.plan
+    sm = ss.soft_shadow_map(scene, light, resolution=256, extent=base.extent, method=ss.Auto(error=target))
+    assert metrics.shadow_error(sm.visibility, ref) <= target, sm.plan

@@ -83,6 +83,8 @@ pub struct SceneStats {
     /// Whether every occluder vertex shares one depth (a plane parallel to
     /// the light, or several at one depth).
     pub occ_flat: bool,
+    /// Whether every occluder vertex lies on one plane (any orientation).
+    pub occ_planar: bool,
 }
 
 impl SceneStats {
@@ -230,16 +232,24 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
             config: (CANDIDATES[0].config)(res),
         };
     }
-    let flat = stats.occ_flat;
+    // A plane seen from any point of the light covers each direction once:
+    // the back-projections of its micro-patches do not overlap (§3.4).
+    let flat = stats.occ_flat || stats.occ_planar;
     d.push(Decision {
         name: "union",
         taken: !flat,
-        why: if flat {
+        why: if stats.occ_flat {
             "the occluders are one plane parallel to the light: no back-projections overlap, \
              the sum is exact"
                 .into()
+        } else if flat {
+            "the occluders are one plane (tilted against the light): no back-projections \
+             overlap, the sum is exact up to its texels"
+                .into()
         } else {
-            "the occluders span depths: back-projections overlap, the sum counts them twice".into()
+            "the occluders span depths off one plane: back-projections overlap, the sum \
+             counts them twice"
+                .into()
         },
     });
     let config = if flat {
@@ -321,6 +331,156 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
     }
 }
 
+/// What the planner measures of the occluder maps a union setting will
+/// read (`pipeline/measure.rs`): rasterized once at their resolution and
+/// peeled, before any shading.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OccluderRaster {
+    /// `surfaces[k]`: occluder texels that see a (k+1)-th distinct surface
+    /// along the light's central ray: k = 0 covered, k = 1 a back layer
+    /// behind the front (the peeled layers are counted by the caller).
+    pub surfaces: [usize; 2],
+    /// Covered front texels in features at most `THIN_TEXELS` wide: runs
+    /// along a row or a column with empty texels on both sides.
+    pub thin: usize,
+}
+
+/// Occluder features this narrow (texels) lose a large share of their
+/// width to the texel grid: a connected micro-quad's edge sits up to half
+/// a texel off the true silhouette on each side, an eighth of such a bar.
+pub const THIN_TEXELS: usize = 8;
+/// The share of thin front texels above which a tight target doubles the
+/// occluder maps' resolution. Measured at 256²: all of the fence's texels
+/// (bars 5-8 texels wide), at most 0.3% on the study's scenes and the other
+/// hard surfaces.
+pub const THIN_SHARE: f64 = 0.25;
+/// Targets under this (the fence's measured 0.0051 with thin bars at the
+/// output's resolution; 0.0039 at twice it) refine thin occluders.
+pub const THIN_TARGET: f64 = 0.0051;
+/// A peeled layer "changes nothing" when the shadow it adds moves the
+/// error metric by less than this: under the noise of a 1024-sample
+/// reference (0.0013-0.0041, docs/benchmarks/gaps.md).
+pub const LAYER_CHANGE: f64 = 0.001;
+
+/// The change one more occluder layer makes to a visibility map: the
+/// error metric's form (mean |a - b| over texels shadowed in either).
+pub fn layer_change(a: &[f32], b: &[f32]) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (&x, &y) in a.iter().zip(b) {
+        if x < 1.0 || y < 1.0 {
+            sum += (x - y).abs() as f64;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}
+
+impl Plan {
+    /// The union setting, if that is what the plan runs (the layers and
+    /// the occluder resolution are then measured, see `refine`).
+    pub fn bitmask(&self) -> Option<BitmaskConfig> {
+        match self.config {
+            MethodConfig::Bitmask(c) if !self.hard => Some(c),
+            _ => None,
+        }
+    }
+
+    /// Refines a union plan from its occluder raster (`resolution`: the
+    /// occluder maps' (W, H) it was measured at): one layer where every
+    /// texel sees a single surface; occluder maps at twice the resolution
+    /// where thin features make up more than THIN_SHARE of the front and
+    /// the target is under THIN_TARGET. Returns whether texels see a back
+    /// surface behind the front: then the caller peels the layers between
+    /// them and tries each (`set_layers`).
+    pub fn refine(
+        &mut self,
+        r: &OccluderRaster,
+        resolution: (usize, usize),
+        target: &Target,
+    ) -> bool {
+        let Some(mut c) = self.bitmask() else {
+            return false;
+        };
+        let covered = r.surfaces[0];
+        let share = if covered == 0 {
+            0.0
+        } else {
+            r.thin as f64 / covered as f64
+        };
+        let tight = target.error.is_some_and(|Real(e)| e < THIN_TARGET);
+        let refine = tight && share > THIN_SHARE;
+        self.decisions.push(Decision {
+            name: "thin_occluders",
+            taken: refine,
+            why: format!(
+                "{:.0}% of the {covered} covered occluder texels lie in features at most \
+                 {THIN_TEXELS} texels wide ({} {:.0}%){}",
+                100.0 * share,
+                if share > THIN_SHARE {
+                    "over"
+                } else {
+                    "at most"
+                },
+                100.0 * THIN_SHARE,
+                if refine {
+                    format!(
+                        ": occluder maps at twice the resolution, {}x{}",
+                        2 * resolution.0,
+                        2 * resolution.1
+                    )
+                } else if !tight {
+                    format!(" (targets from {THIN_TARGET} keep the resolution)")
+                } else {
+                    String::new()
+                }
+            ),
+        });
+        if refine {
+            c.occluder_resolution = Some((2 * resolution.0, 2 * resolution.1));
+        }
+        self.config = MethodConfig::Bitmask(c);
+        let single = r.surfaces[1] == 0;
+        if single {
+            self.set_layers(1, &[], &[]);
+        }
+        !single
+    }
+
+    /// The layers the caller measured (`refine` found a back): `passes`
+    /// taken; `peeled[k]` the texels where the (k+3)-th layer holds a
+    /// surface before the back, `changes[k]` what adding it changed.
+    pub fn set_layers(&mut self, passes: u32, peeled: &[usize], changes: &[f64]) {
+        if let MethodConfig::Bitmask(mut c) = self.config {
+            c.passes = Some(passes);
+            self.config = MethodConfig::Bitmask(c);
+        }
+        let list = |v: Vec<String>| v.join(", ");
+        self.decisions.push(Decision {
+            name: "layers",
+            taken: passes != super::config::DEFAULT_PASSES,
+            why: if passes == 1 {
+                "every occluder texel sees one surface: one layer (a back layer would repeat the \
+                 front)"
+                    .into()
+            } else if peeled.first().is_none_or(|&n| n == 0) {
+                "occluder texels see at most two surfaces: front and back".into()
+            } else {
+                format!(
+                    "texels with a surface between front and back, per peeled layer: [{}]; \
+                     what each changed in the shadow: [{}] (under {LAYER_CHANGE} changes \
+                     nothing): {passes} layers",
+                    list(peeled.iter().map(|n| n.to_string()).collect()),
+                    list(changes.iter().map(|c| format!("{c:.4}")).collect()),
+                )
+            },
+        });
+    }
+}
+
 /// Coarser occluder maps for a bitmask setting under a loose target (at
 /// least COARSE_TARGET): halved while the narrowest penumbra spans
 /// COARSE_TEXELS occluder texels, never below 64.
@@ -381,6 +541,7 @@ mod tests {
             rec_w_far: 0.25,
             occ_bounds: [-0.1, 0.1, -0.1, 0.1],
             occ_flat: false,
+            occ_planar: false,
         }
     }
 
@@ -440,6 +601,71 @@ mod tests {
             plan(&s, &t, Some(0.1)).config,
             MethodConfig::Ssm(_)
         ));
+    }
+
+    fn union_plan(target: &Target) -> Plan {
+        let p = plan(&stats(), target, None);
+        assert!(p.bitmask().is_some());
+        p
+    }
+
+    #[test]
+    fn a_single_surface_takes_one_layer_and_a_back_keeps_two_until_measured() {
+        let t = Target::new(Some(0.01), None).unwrap();
+        let mut single = union_plan(&t);
+        let raster = OccluderRaster {
+            surfaces: [1000, 0],
+            thin: 0,
+        };
+        assert!(!single.refine(&raster, (256, 256), &t));
+        assert_eq!(single.config.passes(), 1);
+        assert!(single
+            .decisions
+            .iter()
+            .any(|d| d.name == "layers" && d.taken));
+        let mut closed = union_plan(&t);
+        let raster = OccluderRaster {
+            surfaces: [1000, 900],
+            thin: 0,
+        };
+        assert!(closed.refine(&raster, (256, 256), &t));
+        assert_eq!(closed.config.passes(), 2);
+        closed.set_layers(3, &[40, 0], &[0.004]);
+        assert_eq!(closed.config.passes(), 3);
+        let d = closed
+            .decisions
+            .iter()
+            .find(|d| d.name == "layers")
+            .unwrap();
+        assert!(d.taken && d.why.contains("[40, 0]") && d.why.contains("0.0040"));
+    }
+
+    #[test]
+    fn thin_occluders_double_the_maps_under_the_thin_target_only() {
+        let thin = OccluderRaster {
+            surfaces: [1000, 900],
+            thin: 600,
+        };
+        let occ = |e: f64| {
+            let t = Target::new(Some(e), None).unwrap();
+            let mut p = union_plan(&t);
+            p.refine(&thin, (256, 256), &t);
+            p.config.occluder_resolution()
+        };
+        assert_eq!(occ(0.005), Some((512, 512)));
+        assert_eq!(occ(0.01), None);
+        let t = Target::new(Some(0.005), None).unwrap();
+        let mut p = union_plan(&t);
+        let few = OccluderRaster { thin: 100, ..thin };
+        p.refine(&few, (256, 256), &t);
+        assert_eq!(p.config.occluder_resolution(), None);
+    }
+
+    #[test]
+    fn a_layer_change_is_the_mean_difference_over_shadowed_texels() {
+        assert_eq!(layer_change(&[1.0, 1.0], &[1.0, 1.0]), 0.0);
+        // Texel 0 shadowed in one map only, texel 1 lit in both.
+        assert!((layer_change(&[0.5, 1.0, 0.2], &[1.0, 1.0, 0.3]) - 0.3).abs() < 1e-6);
     }
 
     #[test]

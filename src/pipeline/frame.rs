@@ -179,5 +179,63 @@ pub(crate) fn scene_stats(
         occ_bounds: bounds,
         // One depth to 1e-9 of it: a plane parallel to the light.
         occ_flat: oz1 - oz0 <= 1e-9 * oz1,
+        occ_planar: on_one_plane(&f.occ_ls),
+    }
+}
+
+/// Whether every point lies on one plane, to 1e-9 of the points' span:
+/// the plane through the first point, the farthest from it, and the one
+/// farthest from the line through both.
+fn on_one_plane(v: &[DVec3]) -> bool {
+    let Some(&a) = v.first() else {
+        return true;
+    };
+    let farthest = |key: &dyn Fn(DVec3) -> f64| {
+        v.iter()
+            .copied()
+            .max_by(|p, q| key(*p).total_cmp(&key(*q)))
+            .unwrap_or(a)
+    };
+    let b = farthest(&|p| (p - a).length_squared());
+    let span = (b - a).length();
+    if span == 0.0 {
+        return true;
+    }
+    let axis = (b - a) / span;
+    let c = farthest(&|p| (p - a).cross(axis).length_squared());
+    let n = (b - a).cross(c - a);
+    if n.length() <= 1e-12 * span * span {
+        // Collinear: a line lies on a plane.
+        return true;
+    }
+    let n = n.normalize();
+    v.iter().all(|p| n.dot(*p - a).abs() <= 1e-9 * span)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::on_one_plane;
+    use glam::DVec3;
+
+    #[test]
+    fn points_on_a_tilted_plane_are_planar_and_a_box_is_not() {
+        let n = DVec3::new(0.3, 1.0, -0.2).normalize();
+        let (u, v) = n.any_orthonormal_pair();
+        let plane: Vec<DVec3> = (0..20)
+            .map(|i| {
+                DVec3::new(1.0, 2.0, 3.0) + u * (i as f64).sin() * 5.0 + v * (i as f64 * 0.7).cos()
+            })
+            .collect();
+        assert!(on_one_plane(&plane));
+        let mut off = plane.clone();
+        off[7] += n * 1e-3;
+        assert!(!on_one_plane(&off));
+        let cube: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64))
+            .collect();
+        assert!(!on_one_plane(&cube));
+        // Fewer than three distinct points, or a line: planar.
+        assert!(on_one_plane(&[DVec3::ONE, DVec3::ONE]));
+        assert!(on_one_plane(&[DVec3::ZERO, DVec3::X, DVec3::X * 2.0]));
     }
 }

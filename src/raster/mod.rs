@@ -27,8 +27,7 @@ mod setup;
 
 pub use layers::{rasterize, DepthLayers, Prepared};
 // For the GPU backend, which uploads the CPU's set-up triangles and peels
-// with the same gap.
-#[cfg(feature = "gpu")]
+// with the same gap, and the planner, which counts layers with it.
 pub(crate) use layers::PEEL_GAP;
 #[cfg(feature = "gpu")]
 pub(crate) use setup::{setup_triangles, SetupTri};
