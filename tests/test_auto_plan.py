@@ -166,3 +166,29 @@ def test_the_plan_meets_its_target_against_mitsuba(reference_for, name, target):
     ref = reference_for(name, base, scene.occluders)
     sm = ss.soft_shadow_map(scene, light, resolution=256, extent=base.extent, method=ss.Auto(error=target))
     assert metrics.shadow_error(sm.visibility, ref) <= target, sm.plan
+
+
+@pytest.fixture(scope="module")
+def contact_boxes_eye():
+    """The eye scene where the maps and exact err most, with its Mitsuba
+    reference (1024 samples a pixel) at 160x120."""
+    pytest.importorskip("mitsuba")
+    from softshadow.eye_scenes import EYE_SCENES
+    from softshadow.reference import render_visibility
+
+    scene, light, cam = EYE_SCENES["contact_boxes"]((160, 120))
+    return scene, light, cam, render_visibility(scene, light, cam, samples=1024)
+
+
+@pytest.mark.parametrize(("target", "kind"), [(0.05, ss.Ssm), (0.01, ss.Exact)])
+def test_the_eye_view_plans_for_its_target_and_meets_it(contact_boxes_eye, target, kind):
+    from softshadow.metrics import compare_images
+
+    scene, light, cam, ref = contact_boxes_eye
+    img = ss.render(scene, light, cam, method=ss.Auto(error=target))
+    assert isinstance(img.method, kind) and img.plan is not None and img.plan.method == img.method
+    names = [d.name for d in img.plan.decisions]
+    assert names == ["setting", "focus"] and next(iter(img.timings)) == "plan"
+    assert compare_images(img, ref).mean_abs <= target, img.plan
+    # Without a target: the rule, no plan.
+    assert ss.render(scene, light, cam, method=ss.Auto()).plan is None

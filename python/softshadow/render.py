@@ -21,6 +21,7 @@ from .camera import Camera
 from .light import DirectionalLight, RectLight
 from .methods import MethodConfig
 from .scene import Scene
+from .shadow_map import Decision, Plan
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -59,6 +60,9 @@ class Image:
     """For the sun: a world point on the maps' depth-0 plane."""
     depth_range: float | None = None
     """For the sun: the scene's depth range along the light."""
+    plan: Plan | None = None
+    """What ``Auto(error=...)`` decided for the image (``None`` otherwise);
+    ``print(img.plan)`` lists the decisions."""
 
     @property
     def mask(self) -> np.ndarray:
@@ -144,7 +148,11 @@ def render(
         the surface as Mitsuba's ``spawn_ray_to`` does. The map methods
         (``ssm``, ``bitmask``, ``auto``) rasterize light-view occluder layers
         of every mesh, focused on what the camera sees, and shade each pixel
-        at its own point.
+        at its own point. ``Auto(error=e)`` plans for the eye view's error
+        (mean |V - V_ref| over the pixels, :func:`softshadow.metrics.compare_images`):
+        the rule's maps where their measured error is within ``e``, else
+        ``exact`` with the samples its measured error law asks for;
+        ``img.plan`` says why (docs/methods/auto.md).
     map_resolution
         The light-view maps' (W, H); by default chosen so that a texel
         covers about one pixel's footprint (the median over the image). A
@@ -200,6 +208,7 @@ def render(
         threads=r.threads,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
+        plan=None if r.plan is None else Plan(tuple(Decision(*d) for d in r.plan), r.method),
     )
 
 

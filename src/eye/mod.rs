@@ -133,20 +133,59 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
             }
         }
     };
-    let ((image, method), threads) = threads::run_capped(cap, || match backend {
-        Backend::Cpu => render_cpu(call),
+    // A target plans the setting (`methods/plan.rs`, `plan_eye`); the
+    // planned config then runs as if the user had given it.
+    let t0 = std::time::Instant::now();
+    let mut plan = match call.method {
+        MethodConfig::Auto(given, target) if !target.is_none() => Some(
+            crate::methods::plan::plan_eye(&target, MethodConfig::Auto(given, Default::default())),
+        ),
+        _ => None,
+    };
+    let planned = EyeCall {
+        method: plan.as_ref().map_or(call.method, |p| p.config),
+        ..*call
+    };
+    let planning = t0.elapsed().as_secs_f64();
+    let ((mut image, method), threads) = threads::run_capped(cap, || match backend {
+        Backend::Cpu => render_cpu(&planned),
         #[cfg(feature = "gpu")]
-        Backend::Gpu => crate::gpu::render_gpu(call),
+        Backend::Gpu => crate::gpu::render_gpu(&planned),
         #[cfg(not(feature = "gpu"))]
         Backend::Gpu => Err(crate::backend::not_built()),
     })?;
+    if let Some(p) = plan.as_mut() {
+        p.decisions.push(focus_decision(&image));
+        p.config = method;
+        image.timings.insert(0, ("plan", planning));
+    }
     Ok(Run {
         output: image,
         method,
         backend,
         threads,
-        plan: None,
+        plan,
     })
+}
+
+/// What the eye view shades, reported in a plan: light-view texels only
+/// where pixels need them (the maps fitted to the visible points, focus.rs),
+/// or shadow rays from the visible pixels only.
+fn focus_decision(image: &EyeImage) -> crate::methods::plan::Decision {
+    let pixels = image.gbuffer.hits().len();
+    let why = match &image.maps {
+        Some(m) => format!(
+            "light-view maps {}x{} over the light-space bounds of the {pixels} visible points \
+             only, at about one texel a pixel's footprint",
+            m.grid.width, m.grid.height
+        ),
+        None => format!("shadow rays from the {pixels} pixels that see a surface only"),
+    };
+    crate::methods::plan::Decision {
+        name: "focus",
+        taken: true,
+        why,
+    }
 }
 
 /// What both backends derive from the G-buffer before shading: the visible

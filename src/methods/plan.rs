@@ -481,6 +481,61 @@ impl Plan {
     }
 }
 
+/// The eye view's error (mean |V - V_ref| over the pixels both renderers
+/// see, `softshadow.metrics.compare_images`) of the rule's maps, worst
+/// measured on the eye-view scenes: 0.0237 at 160x120 (contact_boxes,
+/// tests/test_eye.py), 0.023 at 640x480 (docs/benchmarks/eye.md). The map
+/// methods at full resolution do no better there (their biases and the
+/// tangent-plane bound dominate): below it only `exact` helps.
+pub const EYE_RULE_ERROR: f64 = 0.024;
+/// `exact`'s eye-view error at n samples a pixel is about EYE_EXACT / sqrt(n):
+/// the worst measured, contact_boxes' 0.0218 at 16 samples and 0.0078 at 64
+/// (docs/benchmarks/eye.md), gives 0.087 and 0.062.
+pub const EYE_EXACT: f64 = 0.09;
+
+/// The plan of an eye view (`ss.render`) for `target`: the rule's maps
+/// where their measured error is within it, else `exact` with the samples
+/// its measured error law asks for. A time budget runs the rule (budgets
+/// are planned for light-view maps only). `rule`: the call's `Auto`
+/// without its target (the eye view sizes the rule's maps itself).
+pub fn plan_eye(target: &Target, rule: MethodConfig) -> Plan {
+    let (config, why) = match target.error {
+        Some(Real(e)) if e >= EYE_RULE_ERROR => (
+            rule,
+            format!(
+                "the rule's maps (ssm, 2 passes, quarter resolution): eye-view error at most \
+                 {EYE_RULE_ERROR} measured on the eye scenes, within the target {e}"
+            ),
+        ),
+        Some(Real(e)) => {
+            let n = ((EYE_EXACT / e).powi(2).ceil() as u32).clamp(1, super::config::MAX_SAMPLES);
+            (
+                MethodConfig::Exact(ExactConfig { samples: n }),
+                format!(
+                    "no map setting measured within {e} in the eye view (the best: \
+                     {EYE_RULE_ERROR}); exact with {n} samples a pixel (eye-view error about \
+                     {EYE_EXACT}/sqrt(samples), the worst measured)"
+                ),
+            )
+        }
+        None => (
+            rule,
+            "time budgets are planned for light-view maps only: the rule's maps (the eye \
+             view's fastest setting)"
+                .to_string(),
+        ),
+    };
+    Plan {
+        decisions: vec![Decision {
+            name: "setting",
+            taken: true,
+            why,
+        }],
+        hard: false,
+        config,
+    }
+}
+
 /// Coarser occluder maps for a bitmask setting under a loose target (at
 /// least COARSE_TARGET): halved while the narrowest penumbra spans
 /// COARSE_TEXELS occluder texels, never below 64.
@@ -666,6 +721,17 @@ mod tests {
         assert_eq!(layer_change(&[1.0, 1.0], &[1.0, 1.0]), 0.0);
         // Texel 0 shadowed in one map only, texel 1 lit in both.
         assert!((layer_change(&[0.5, 1.0, 0.2], &[1.0, 1.0, 0.3]) - 0.3).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_eye_view_takes_the_rule_for_loose_targets_and_exact_below() {
+        let rule = MethodConfig::Auto(SsmConfig::default(), Target::default());
+        let pick = |e: f64| plan_eye(&Target::new(Some(e), None).unwrap(), rule).config;
+        assert_eq!(pick(0.05), rule);
+        assert!(matches!(pick(0.01), MethodConfig::Exact(c) if c.samples == 81));
+        assert!(matches!(pick(0.005), MethodConfig::Exact(c) if c.samples == 324));
+        let budget = plan_eye(&Target::new(None, Some(1.0)).unwrap(), rule);
+        assert_eq!(budget.config, rule);
     }
 
     #[test]

@@ -102,6 +102,9 @@ pub struct EyeResult {
     backend: &'static str,
     #[pyo3(get)]
     threads: usize,
+    /// What `Auto` with a target decided: (name, taken, why) per decision.
+    #[pyo3(get)]
+    plan: Option<Vec<(&'static str, bool, String)>>,
 }
 
 #[pymethods]
@@ -161,6 +164,7 @@ impl EyeResult {
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),
             threads: run.threads,
+            plan: super::results::plan_tuples(run.plan),
         })
     }
 }

@@ -87,6 +87,18 @@ impl MeshShadowResult {
     }
 }
 
+/// A plan as Python reads it: (name, taken, why) per decision.
+pub(crate) fn plan_tuples(
+    plan: Option<crate::methods::plan::Plan>,
+) -> Option<Vec<(&'static str, bool, String)>> {
+    plan.map(|p| {
+        p.decisions
+            .into_iter()
+            .map(|d| (d.name, d.taken, d.why))
+            .collect()
+    })
+}
+
 impl MeshShadowResult {
     pub fn new(py: Python<'_>, run: Run<ShadowResult>) -> PyResult<Self> {
         let r = run.output;
@@ -110,12 +122,7 @@ impl MeshShadowResult {
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),
             threads: run.threads,
-            plan: run.plan.map(|p| {
-                p.decisions
-                    .into_iter()
-                    .map(|d| (d.name, d.taken, d.why))
-                    .collect()
-            }),
+            plan: plan_tuples(run.plan),
         })
     }
 }
