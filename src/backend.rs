@@ -193,9 +193,9 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
 
 /// A mesh call planned for `target` (`methods/plan.rs`): the scene's stats,
 /// the plan (after a timed probe for a time budget), for a union setting
-/// the occluder raster it will read (layers, thin features) and, where
-/// texels see more than two surfaces, coarse runs that try each peeled
-/// layer; then the planned config resolved for the backend and run. The
+/// what its occluders call for (`pipeline/measure.rs`: thin features, the
+/// layers tried on coarse maps); then the planned config resolved for the
+/// backend and run. The
 /// planning time (the probe excluded) is the result's "plan" stage.
 fn planned(
     call: &MeshCall,
@@ -209,7 +209,7 @@ fn planned(
     MethodConfig,
     Option<crate::methods::plan::Plan>,
 )> {
-    use crate::methods::plan::{layer_change, plan, LAYER_CHANGE};
+    use crate::methods::plan::plan;
     let t0 = std::time::Instant::now();
     // The framing every run starts from (its checks, transform and extent
     // fit), on the rule's settings; the planner reads its depth ranges.
@@ -246,53 +246,47 @@ fn planned(
         }
     }
     if let Some(c) = p.bitmask() {
+        // The occluders as the union setting will read them
+        // (`pipeline/measure.rs`): thin features on the planned maps where
+        // the target asks, the layers tried on coarse maps.
+        use crate::geom::light::MapGrid;
         let occ = c.occluder_resolution.unwrap_or((w, h));
         let fitted = [framed.grid.tx, framed.grid.ty];
-        let grid = crate::geom::light::MapGrid::new(occ.0, occ.1, fitted)?;
-        let (raster, mut peeler) = pipeline::occluder_raster(&framed, call.occluders.faces, &grid);
-        if p.refine(&raster, occ, target) {
-            // Each peeled layer tried on coarse maps (receivers at an eighth
-            // of the output's side, occluders at a quarter of the planned,
-            // 256 samples): kept while it changes the shadow. On the
-            // bunnies the change measured so is within 0.0003 of the full
-            // maps' (0.0005-0.0009), in 5 ms a run instead of 90-240.
-            let MethodConfig::Bitmask(planned) = p.config else {
-                unreachable!("refine keeps a union setting")
-            };
-            let coarse = ((w / 8).clamp(16.min(w), w), (h / 8).clamp(16.min(h), h));
-            let quarter = |n: usize| (n / 4).clamp(64.min(n), n);
-            let with = |passes: u32| {
-                MethodConfig::Bitmask(crate::methods::config::BitmaskConfig {
-                    passes: Some(passes),
-                    samples: 256,
-                    occluder_resolution: Some((quarter(occ.0), quarter(occ.1))),
-                    ..planned
-                })
-                .resolve(ctx)
-            };
-            let (mut passes, mut peeled, mut changes) = (2, vec![], vec![]);
-            let mut previous = None;
-            while passes < crate::methods::config::MAX_PASSES {
-                let n = peeler.next_surfaces();
-                peeled.push(n);
-                if n == 0 {
-                    break;
-                }
-                let before = match previous.take() {
-                    Some(v) => v,
-                    None => run(&with(passes)?, false, coarse, Some(fitted))?.visibility,
-                };
-                let after = run(&with(passes + 1)?, false, coarse, Some(fitted))?.visibility;
-                let change = layer_change(&before, &after);
-                changes.push(change);
-                if change < LAYER_CHANGE {
-                    break;
-                }
-                passes += 1;
-                previous = Some(after);
-            }
-            p.set_layers(passes, &peeled, &changes);
-        }
+        let front = if p.thin_matters(target) {
+            let grid = MapGrid::new(occ.0, occ.1, fitted)?;
+            Some(pipeline::thin_features(
+                &framed,
+                call.occluders.faces,
+                &grid,
+            ))
+        } else {
+            None
+        };
+        p.refine_thin(front, occ);
+        let eighth = |n: usize| (n / 8).clamp(16.min(n), n);
+        let quarter = |n: usize| (n / 4).clamp(64.min(n), n);
+        let coarse = MapGrid::new(eighth(w), eighth(h), fitted)?;
+        let coarse_occ = MapGrid::new(quarter(occ.0), quarter(occ.1), fitted)?;
+        let kernel = MethodConfig::Bitmask(crate::methods::config::BitmaskConfig {
+            samples: 256,
+            passes: Some(2),
+            occluder_resolution: Some((coarse_occ.width, coarse_occ.height)),
+            ..c
+        })
+        .resolve(&CallContext {
+            backend: Backend::Cpu,
+            resolution: (coarse.width, coarse.height),
+            ..*ctx
+        })?
+        .kernel();
+        let tries = pipeline::layer_tries(
+            &framed,
+            (call.occluders.faces, call.receivers.faces),
+            (coarse, coarse_occ),
+            kernel,
+            crate::methods::config::MAX_PASSES,
+        );
+        p.set_layers(tries.passes, tries.surfaces, &tries.peeled, &tries.changes);
     }
     drop(framed);
     let cfg = p.config.resolve(ctx)?;

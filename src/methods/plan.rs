@@ -331,20 +331,6 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
     }
 }
 
-/// What the planner measures of the occluder maps a union setting will
-/// read (`pipeline/measure.rs`): rasterized once at their resolution and
-/// peeled, before any shading.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OccluderRaster {
-    /// `surfaces[k]`: occluder texels that see a (k+1)-th distinct surface
-    /// along the light's central ray: k = 0 covered, k = 1 a back layer
-    /// behind the front (the peeled layers are counted by the caller).
-    pub surfaces: [usize; 2],
-    /// Covered front texels in features at most `THIN_TEXELS` wide: runs
-    /// along a row or a column with empty texels on both sides.
-    pub thin: usize,
-}
-
 /// Occluder features this narrow (texels) lose a large share of their
 /// width to the texel grid: a connected micro-quad's edge sits up to half
 /// a texel off the true silhouette on each side, an eighth of such a bar.
@@ -389,30 +375,34 @@ impl Plan {
         }
     }
 
-    /// Refines a union plan from its occluder raster (`resolution`: the
-    /// occluder maps' (W, H) it was measured at): one layer where every
-    /// texel sees a single surface; occluder maps at twice the resolution
-    /// where thin features make up more than THIN_SHARE of the front and
-    /// the target is under THIN_TARGET. Returns whether texels see a back
-    /// surface behind the front: then the caller peels the layers between
-    /// them and tries each (`set_layers`).
-    pub fn refine(
-        &mut self,
-        r: &OccluderRaster,
-        resolution: (usize, usize),
-        target: &Target,
-    ) -> bool {
+    /// Whether the thin-feature measure can change this plan: a union
+    /// setting under a target tighter than THIN_TARGET.
+    pub fn thin_matters(&self, target: &Target) -> bool {
+        self.bitmask().is_some() && target.error.is_some_and(|Real(e)| e < THIN_TARGET)
+    }
+
+    /// Doubles a union plan's occluder maps (`resolution`: their (W, H))
+    /// where thin features make up more than THIN_SHARE of their front
+    /// layer: `front` holds its (covered, thin) texels, measured where
+    /// `thin_matters` (None: not measured).
+    pub fn refine_thin(&mut self, front: Option<(usize, usize)>, resolution: (usize, usize)) {
         let Some(mut c) = self.bitmask() else {
-            return false;
+            return;
         };
-        let covered = r.surfaces[0];
+        let Some((covered, thin)) = front else {
+            self.decisions.push(Decision {
+                name: "thin_occluders",
+                taken: false,
+                why: format!("targets from {THIN_TARGET} keep the occluder maps' resolution"),
+            });
+            return;
+        };
         let share = if covered == 0 {
             0.0
         } else {
-            r.thin as f64 / covered as f64
+            thin as f64 / covered as f64
         };
-        let tight = target.error.is_some_and(|Real(e)| e < THIN_TARGET);
-        let refine = tight && share > THIN_SHARE;
+        let refine = share > THIN_SHARE;
         self.decisions.push(Decision {
             name: "thin_occluders",
             taken: refine,
@@ -420,11 +410,7 @@ impl Plan {
                 "{:.0}% of the {covered} covered occluder texels lie in features at most \
                  {THIN_TEXELS} texels wide ({} {:.0}%){}",
                 100.0 * share,
-                if share > THIN_SHARE {
-                    "over"
-                } else {
-                    "at most"
-                },
+                if refine { "over" } else { "at most" },
                 100.0 * THIN_SHARE,
                 if refine {
                     format!(
@@ -432,8 +418,6 @@ impl Plan {
                         2 * resolution.0,
                         2 * resolution.1
                     )
-                } else if !tight {
-                    format!(" (targets from {THIN_TARGET} keep the resolution)")
                 } else {
                     String::new()
                 }
@@ -441,38 +425,46 @@ impl Plan {
         });
         if refine {
             c.occluder_resolution = Some((2 * resolution.0, 2 * resolution.1));
+            self.config = MethodConfig::Bitmask(c);
         }
-        self.config = MethodConfig::Bitmask(c);
-        let single = r.surfaces[1] == 0;
-        if single {
-            self.set_layers(1, &[], &[]);
-        }
-        !single
     }
 
-    /// The layers the caller measured (`refine` found a back): `passes`
-    /// taken; `peeled[k]` the texels where the (k+3)-th layer holds a
-    /// surface before the back, `changes[k]` what adding it changed.
-    pub fn set_layers(&mut self, passes: u32, peeled: &[usize], changes: &[f64]) {
+    /// The occluder layers of a union plan, as the caller measured them
+    /// on coarse maps (`pipeline/measure.rs`): `passes` taken (1: no texel
+    /// sees a back surface); `surfaces` the texels that see a surface and a
+    /// back behind it; `peeled[k]` the texels where the (k+3)-th layer holds
+    /// a surface before the back, `changes[k]` what adding it changed.
+    pub fn set_layers(
+        &mut self,
+        passes: u32,
+        surfaces: [usize; 2],
+        peeled: &[usize],
+        changes: &[f64],
+    ) {
         if let MethodConfig::Bitmask(mut c) = self.config {
             c.passes = Some(passes);
             self.config = MethodConfig::Bitmask(c);
         }
         let list = |v: Vec<String>| v.join(", ");
+        let [covered, back] = surfaces;
         self.decisions.push(Decision {
             name: "layers",
             taken: passes != super::config::DEFAULT_PASSES,
             why: if passes == 1 {
-                "every occluder texel sees one surface: one layer (a back layer would repeat the \
-                 front)"
-                    .into()
+                format!(
+                    "none of the {covered} occluder texels sees a second surface: one layer (a \
+                     back layer would repeat the front)"
+                )
             } else if peeled.first().is_none_or(|&n| n == 0) {
-                "occluder texels see at most two surfaces: front and back".into()
+                format!(
+                    "{back} of the {covered} occluder texels see a back surface, none a third: \
+                     front and back"
+                )
             } else {
                 format!(
-                    "texels with a surface between front and back, per peeled layer: [{}]; \
-                     what each changed in the shadow: [{}] (under {LAYER_CHANGE} changes \
-                     nothing): {passes} layers",
+                    "{back} of the {covered} occluder texels see a back surface; texels with a \
+                     surface between front and back, per peeled layer: [{}]; what each changed \
+                     in the shadow: [{}] (under {LAYER_CHANGE} changes nothing): {passes} layers",
                     list(peeled.iter().map(|n| n.to_string()).collect()),
                     list(changes.iter().map(|c| format!("{c:.4}")).collect()),
                 )
@@ -665,27 +657,17 @@ mod tests {
     }
 
     #[test]
-    fn a_single_surface_takes_one_layer_and_a_back_keeps_two_until_measured() {
+    fn layers_are_what_the_caller_measured() {
         let t = Target::new(Some(0.01), None).unwrap();
         let mut single = union_plan(&t);
-        let raster = OccluderRaster {
-            surfaces: [1000, 0],
-            thin: 0,
-        };
-        assert!(!single.refine(&raster, (256, 256), &t));
+        single.set_layers(1, [100, 0], &[], &[]);
         assert_eq!(single.config.passes(), 1);
         assert!(single
             .decisions
             .iter()
             .any(|d| d.name == "layers" && d.taken));
         let mut closed = union_plan(&t);
-        let raster = OccluderRaster {
-            surfaces: [1000, 900],
-            thin: 0,
-        };
-        assert!(closed.refine(&raster, (256, 256), &t));
-        assert_eq!(closed.config.passes(), 2);
-        closed.set_layers(3, &[40, 0], &[0.004]);
+        closed.set_layers(3, [100, 90], &[40, 0], &[0.004]);
         assert_eq!(closed.config.passes(), 3);
         let d = closed
             .decisions
@@ -693,27 +675,23 @@ mod tests {
             .find(|d| d.name == "layers")
             .unwrap();
         assert!(d.taken && d.why.contains("[40, 0]") && d.why.contains("0.0040"));
+        let mut two = union_plan(&t);
+        two.set_layers(2, [100, 90], &[0], &[]);
+        assert!(two.decisions.iter().any(|d| d.name == "layers" && !d.taken));
     }
 
     #[test]
     fn thin_occluders_double_the_maps_under_the_thin_target_only() {
-        let thin = OccluderRaster {
-            surfaces: [1000, 900],
-            thin: 600,
-        };
-        let occ = |e: f64| {
-            let t = Target::new(Some(e), None).unwrap();
-            let mut p = union_plan(&t);
-            p.refine(&thin, (256, 256), &t);
-            p.config.occluder_resolution()
-        };
-        assert_eq!(occ(0.005), Some((512, 512)));
-        assert_eq!(occ(0.01), None);
-        let t = Target::new(Some(0.005), None).unwrap();
-        let mut p = union_plan(&t);
-        let few = OccluderRaster { thin: 100, ..thin };
-        p.refine(&few, (256, 256), &t);
-        assert_eq!(p.config.occluder_resolution(), None);
+        let tight = Target::new(Some(0.005), None).unwrap();
+        let mut p = union_plan(&tight);
+        assert!(p.thin_matters(&tight));
+        p.refine_thin(Some((1000, 600)), (256, 256));
+        assert_eq!(p.config.occluder_resolution(), Some((512, 512)));
+        let mut few = union_plan(&tight);
+        few.refine_thin(Some((1000, 100)), (256, 256));
+        assert_eq!(few.config.occluder_resolution(), None);
+        let loose = Target::new(Some(0.01), None).unwrap();
+        assert!(!union_plan(&loose).thin_matters(&loose));
     }
 
     #[test]

@@ -22,7 +22,7 @@ pub use from_depth::{check_depth, from_depth};
 pub(crate) use from_depth::{check_depth_inputs, DepthInUnit};
 pub use from_meshes::{from_meshes, light_space_triangles, ShadowResult};
 pub use from_scene::from_scene;
-pub(crate) use measure::occluder_raster;
+pub(crate) use measure::{layer_tries, thin_features};
 pub(crate) use points::shade_points;
 pub use points::{receiver_points, sample_points, OccluderSource};
 
