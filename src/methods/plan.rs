@@ -149,6 +149,12 @@ struct Candidate {
     config: fn((usize, usize)) -> MethodConfig,
 }
 
+/// The widest penumbra (output texels) from which the hierarchy pays:
+/// measured at 256² (docs/benchmarks/gaps.md), bitmask 256 with the
+/// hierarchy took 0.14-0.61x the time without it where penumbrae span 97-334
+/// texels (near_light, slanted_receiver, two_spheres), 0.94-1.32x where they
+/// span 51-102 (the bunnies, torus, tilted_plate, fence, contact_box).
+pub const HIERARCHY_TEXELS: f64 = 80.0;
 /// Occluder texels the narrowest penumbra must span before the occluder
 /// maps are coarsened for a loose target.
 pub const COARSE_TEXELS: f64 = 16.0;
@@ -185,8 +191,10 @@ const CANDIDATES: [Candidate; 4] = [
     },
     Candidate {
         label: "bitmask, 1024 samples, gaps closed, no hierarchy",
-        // Worst: the fence, 0.0051 against Mitsuba whose own noise there is
-        // 0.0041 (0.0043 against 4096-sample exact).
+        // Worst: bunny_on_floor's 0.0048. The fence's thin bars give 0.0051
+        // at the output's resolution (Mitsuba's own noise there: 0.0041),
+        // 0.0039 with the maps doubled, which any target under THIN_TARGET
+        // takes (`Plan::refine_thin`).
         worst_error: 0.005,
         time_ratio: 76.0,
         config: |_| bitmask(1024, false),
@@ -260,15 +268,32 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
             ..SsmConfig::default()
         })
     } else if let Some(Real(e)) = target.error {
-        match CANDIDATES.iter().find(|c| c.worst_error <= e) {
-            Some(c) => {
+        match CANDIDATES.iter().position(|c| c.worst_error <= e) {
+            Some(mut k) => {
+                // The hierarchy pays where penumbrae are wide (it skips
+                // occluder blocks a receiver's window would scan); the
+                // setting without it is as accurate or more.
+                let narrow = k == 1 && widest < HIERARCHY_TEXELS;
+                if narrow {
+                    k = 2;
+                }
+                let c = &CANDIDATES[k];
                 d.push(Decision {
                     name: "setting",
                     taken: true,
                     why: format!(
                         "{}: measured error at most {} on the study's scenes and the hard \
-                         surfaces, within the target {e}",
-                        c.label, c.worst_error
+                         surfaces, within the target {e}{}",
+                        c.label,
+                        c.worst_error,
+                        if narrow {
+                            format!(
+                                "; no hierarchy: the widest penumbra spans {widest:.0} texels, \
+                                 under {HIERARCHY_TEXELS}"
+                            )
+                        } else {
+                            String::new()
+                        }
                     ),
                 });
                 coarsen((c.config)(res), stats, e, &mut d)
@@ -608,6 +633,20 @@ mod tests {
         assert!(matches!(pick(0.01), MethodConfig::Bitmask(c) if c.samples == 256));
         assert!(matches!(pick(0.005), MethodConfig::Bitmask(c) if c.samples == 1024));
         assert!(matches!(pick(0.001), MethodConfig::Exact(c) if c.samples == 2500));
+    }
+
+    #[test]
+    fn the_hierarchy_runs_where_penumbrae_are_wide_only() {
+        let t = Target::new(Some(0.01), None).unwrap();
+        let hierarchy = |s: &SceneStats| match plan(s, &t, None).config {
+            MethodConfig::Bitmask(c) => c.hierarchy,
+            other => panic!("{other:?}"),
+        };
+        let mut s = stats();
+        // (1/2 - 1/4) / (0.7 / 256) = 91 texels.
+        assert_eq!(hierarchy(&s), Some(true));
+        s.light_size = [0.5, 0.5];
+        assert_eq!(hierarchy(&s), Some(false));
     }
 
     #[test]
