@@ -364,3 +364,18 @@ def test_gpu_pcss_from_depth_maps_matches_cpu(gpu):
         g = ss.soft_shadow_map_from_depth(sm.occluder_depth, sm.receiver_depth, backend="gpu", **kw)
         assert_visibility_agrees(c.visibility, g.visibility, repr(method))
         assert (c.visibility < 0.5).sum() > 20
+
+
+def test_a_plan_with_measured_layers_and_doubled_maps_runs_the_same_on_the_gpu(gpu):
+    """The planner measures the occluders on the CPU whatever the backend;
+    the GPU then runs what it planned: one layer, three, and maps at twice
+    the output's side, bit for bit the CPU's."""
+    from test_auto_plan import side_by_side, stacked
+
+    for make, target, passes in [(side_by_side, 0.01, 1), (stacked, 0.01, 3), (scenes.fence, 0.005, 2)]:
+        scene, light = make()
+        cpu = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(error=target))
+        dev = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(error=target), backend="gpu")
+        assert dev.backend == "gpu" and dev.method == cpu.method and cpu.method.passes == passes
+        np.testing.assert_array_equal(dev.visibility, cpu.visibility)
+    assert cpu.method.occluder_resolution == (128, 128)
