@@ -477,19 +477,20 @@ impl Plan {
             taken: passes != super::config::DEFAULT_PASSES,
             why: if passes == 1 {
                 format!(
-                    "none of the {covered} occluder texels sees a second surface: one layer (a \
-                     back layer would repeat the front)"
+                    "none of the {covered} texels of the coarse occluder map sees a second \
+                     surface: one layer (a back layer would repeat the front)"
                 )
             } else if peeled.first().is_none_or(|&n| n == 0) {
                 format!(
-                    "{back} of the {covered} occluder texels see a back surface, none a third: \
-                     front and back"
+                    "{back} of the {covered} texels of the coarse occluder map see a back \
+                     surface, none a third: front and back"
                 )
             } else {
                 format!(
-                    "{back} of the {covered} occluder texels see a back surface; texels with a \
-                     surface between front and back, per peeled layer: [{}]; what each changed \
-                     in the shadow: [{}] (under {LAYER_CHANGE} changes nothing): {passes} layers",
+                    "{back} of the {covered} texels of the coarse occluder map see a back \
+                     surface; texels with a surface between front and back, per peeled layer: \
+                     [{}]; what each changed in the coarse shadow: [{}] (under {LAYER_CHANGE} \
+                     changes nothing): {passes} layers",
                     list(peeled.iter().map(|n| n.to_string()).collect()),
                     list(changes.iter().map(|c| format!("{c:.4}")).collect()),
                 )
