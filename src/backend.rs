@@ -195,8 +195,8 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
 /// the plan (after a timed probe for a time budget), for a union setting
 /// what its occluders call for (`pipeline/measure.rs`: thin features, the
 /// layers tried on coarse maps); then the planned config resolved for the
-/// backend and run. The
-/// planning time (the probe excluded) is the result's "plan" stage.
+/// backend and run. The planning time (the probe excluded) is the result's
+/// "plan" stage.
 fn planned(
     call: &MeshCall,
     space: &LightSpace,

@@ -391,8 +391,8 @@ pub fn layer_change(a: &[f32], b: &[f32]) -> f64 {
 }
 
 impl Plan {
-    /// The union setting, if that is what the plan runs (the layers and
-    /// the occluder resolution are then measured, see `refine`).
+    /// The union setting, if that is what the plan runs (its layers and
+    /// thin occluders are then measured: `set_layers`, `refine_thin`).
     pub fn bitmask(&self) -> Option<BitmaskConfig> {
         match self.config {
             MethodConfig::Bitmask(c) if !self.hard => Some(c),
