@@ -219,13 +219,24 @@ impl RankBounds {
     /// The first rank at or above lower bound t, clamped to [0, S].
     #[inline(always)]
     fn lo(&self, t: f32) -> u16 {
-        self.to(t).ceil().clamp(0.0, self.s) as u16
+        self.index(self.to(t).ceil())
     }
 
     /// One past the last rank at or below upper bound t, clamped to [0, S].
     #[inline(always)]
     fn hi(&self, t: f32) -> u16 {
-        (self.to(t).floor() + 1.0).clamp(0.0, self.s) as u16
+        self.index(self.to(t).floor() + 1.0)
+    }
+
+    /// A whole rank clamped to [0, S], NaN to 0 (as `clamp(0, S) as u16`
+    /// gives), in a form that vectorizes: `as u16` saturates lane by lane,
+    /// and kept the tile path's rank arithmetic scalar (profiled at half of
+    /// the whole-tile kernel).
+    #[inline(always)]
+    fn index(&self, k: f32) -> u16 {
+        let k = gather::min(gather::max(k, 0.0), self.s);
+        // SAFETY: k is finite and in [0, S] (max maps NaN to 0), S <= 1024.
+        unsafe { k.to_int_unchecked::<i32>() as u16 }
     }
 }
 
@@ -280,74 +291,109 @@ struct MaskKernel<'a, const W: usize, const QUADS: bool> {
     p: &'a Pattern<W>,
 }
 
+/// A group's masks, word-major: `m[q][l]` is word q of lane l's mask. A row
+/// of a tile (TILE_W lanes) is then TILE_W contiguous words per q, which the
+/// whole-tile path ORs with one word of the row's y-band broadcast (two AVX2
+/// registers per word); lane-major masks made the compiler transpose every
+/// row in and out of registers (profiled: 44% of the two spheres at 512²).
+type Masks<const W: usize> = [[u64; LANES]; W];
+
+/// Per-column x-bands or per-row y-bands of a tile, word-major as `Masks`.
+type Bands<const W: usize> = [[u64; TILE_W]; W];
+const _: () = assert!(TILE_W == ROWS_PER_GROUP);
+
 impl<const W: usize, const QUADS: bool> MaskKernel<'_, W, QUADS> {
-    /// ORs the sample rectangle of ranks [ka, kb) x [kc, kd) into `m`.
+    /// ORs the sample rectangle of ranks [ka, kb) x [kc, kd) into lane l.
     #[inline(always)]
-    fn mark(&self, m: &mut Mask<W>, [ka, kb, kc, kd]: [u16; 4]) {
+    fn mark(&self, m: &mut Masks<W>, l: usize, [ka, kb, kc, kd]: [u16; 4]) {
         let band = and(self.p.x_band(ka, kb), self.p.y_band(kc, kd));
         for q in 0..W {
-            m[q] |= band[q];
+            m[q][l] |= band[q];
         }
     }
 
-    /// ORs a whole tile's rectangles given as rank ranges per column (x)
-    /// and per row (y). The rank arithmetic is done for the 8 columns and 8
-    /// rows before any lookup (so that it vectorizes); a micro-patch whose
-    /// ranges are empty for every column or every row marks nothing.
+    /// ORs a whole tile's rectangles given as rank ranges per column (x:
+    /// [xa, xb)) and per row (y: [ya, yb)). The ranks come from arithmetic
+    /// done for the 8 columns and 8 rows at once (so that it vectorizes); a
+    /// micro-patch whose ranges are empty for every column or every row marks
+    /// nothing.
     #[inline(always)]
-    #[allow(clippy::needless_range_loop)] // one index over two rank arrays
-    fn mark_ranks(
-        &self,
-        acc: &mut [Mask<W>; LANES],
-        xk: &[[u16; 2]; TILE_W],
-        yk: &[[u16; 2]; ROWS_PER_GROUP],
-    ) {
-        if xk.iter().all(|k| k[0] >= k[1]) || yk.iter().all(|k| k[0] >= k[1]) {
+    fn mark_ranks(&self, acc: &mut Masks<W>, x: &Ranks, y: &Ranks) {
+        if x.empty() || y.empty() {
             return;
         }
         let p = self.p;
-        let (mut xb, mut yb) = ([[0u64; W]; TILE_W], [[0u64; W]; ROWS_PER_GROUP]);
+        let (mut xb, mut yb) = ([[0u64; TILE_W]; W], [[0u64; TILE_W]; W]);
         for c in 0..TILE_W {
-            xb[c] = p.x_band(xk[c][0], xk[c][1]);
+            let band = p.x_band(x.lo[c], x.hi[c]);
+            for q in 0..W {
+                xb[q][c] = band[q];
+            }
         }
         for row in 0..ROWS_PER_GROUP {
-            yb[row] = p.y_band(yk[row][0], yk[row][1]);
+            let band = p.y_band(y.lo[row], y.hi[row]);
+            for q in 0..W {
+                yb[q][row] = band[q];
+            }
         }
-        self.mark_tile(acc, &xb, &yb);
+        self.mark_tile(acc, &xb, &yb, y);
     }
 
     /// ORs the per-column x-bands and per-row y-bands of a whole tile.
     #[inline(always)]
-    fn mark_tile(
-        &self,
-        acc: &mut [Mask<W>; LANES],
-        xb: &[Mask<W>; TILE_W],
-        yb: &[Mask<W>; ROWS_PER_GROUP],
-    ) {
-        for (row, y) in yb.iter().enumerate() {
+    fn mark_tile(&self, acc: &mut Masks<W>, xb: &Bands<W>, yb: &Bands<W>, y: &Ranks) {
+        for row in 0..ROWS_PER_GROUP {
             // A row of receivers the micro-patch misses (outside its reach in
             // y) takes no stores: common at the edges of a tile's reach.
-            if y.iter().all(|&q| q == 0) {
+            if y.lo[row] >= y.hi[row] {
                 continue;
             }
-            for (c, x) in xb.iter().enumerate() {
-                let band = and(*x, *y);
-                let m = &mut acc[row * TILE_W + c];
-                for q in 0..W {
-                    m[q] |= band[q];
+            for q in 0..W {
+                let yq = yb[q][row];
+                let m = &mut acc[q][row * TILE_W..(row + 1) * TILE_W];
+                for (m, x) in m.iter_mut().zip(&xb[q]) {
+                    *m |= x & yq;
                 }
             }
         }
     }
 }
 
+/// Rank ranges [lo, hi) for the 8 columns or the 8 rows of a tile.
+struct Ranks {
+    lo: [u16; TILE_W],
+    hi: [u16; TILE_W],
+}
+
+impl Ranks {
+    /// The ranges of the intervals [lo, hi] (sample units before rounding).
+    #[inline(always)]
+    fn new(b: &RankBounds, lo: &[f32; TILE_W], hi: &[f32; TILE_W]) -> Ranks {
+        let mut r = Ranks {
+            lo: [0; TILE_W],
+            hi: [0; TILE_W],
+        };
+        for k in 0..TILE_W {
+            r.lo[k] = b.lo(lo[k]);
+            r.hi[k] = b.hi(hi[k]);
+        }
+        r
+    }
+
+    /// Whether every range is empty.
+    #[inline(always)]
+    fn empty(&self) -> bool {
+        self.lo.iter().zip(&self.hi).all(|(a, b)| a >= b)
+    }
+}
+
 impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS> {
-    type State = [Mask<W>; LANES];
+    type State = Masks<W>;
     const LAYERS_SHARE_STATE: bool = true;
     const CORNERS: bool = QUADS;
 
     fn empty(&self) -> Self::State {
-        [[0; W]; LANES]
+        [[0; LANES]; W]
     }
 
     /// Ranks covered by the back-projection of [x0, x1] (half-light units
@@ -368,8 +414,8 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
                 b.hi(r.ay1[l]),
             ];
         }
-        for (m, k) in acc.iter_mut().zip(&k) {
-            self.mark(m, *k);
+        for (l, k) in k.iter().enumerate() {
+            self.mark(acc, l, *k);
         }
     }
 
@@ -387,17 +433,19 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         r: &RowLanes,
         g: &Group,
     ) {
-        let p = self.p;
-        let b = p.bounds(w - g.wr[0]);
-        let (mut xk, mut yk) = ([[0u16; 2]; TILE_W], [[0u16; 2]; ROWS_PER_GROUP]);
+        let b = self.p.bounds(w - g.wr[0]);
+        let (mut xa, mut xb) = ([0f32; TILE_W], [0f32; TILE_W]);
+        let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for c in 0..TILE_W {
-            xk[c] = [b.lo(x0 - r.xr[c]), b.hi(x1 - r.xr[c])];
+            xa[c] = x0 - r.xr[c];
+            xb[c] = x1 - r.xr[c];
         }
         for row in 0..ROWS_PER_GROUP {
             let l = row * TILE_W;
-            yk[row] = [b.lo(-r.nay0[l]), b.hi(r.ay1[l])];
+            ya[row] = -r.nay0[l];
+            yb[row] = r.ay1[l];
         }
-        self.mark_ranks(acc, &xk, &yk);
+        self.mark_ranks(acc, &Ranks::new(&b, &xa, &xb), &Ranks::new(&b, &ya, &yb));
     }
 
     /// The quad [x0, x1] x (row) with corner 1/depths `c` ([top-left,
@@ -433,8 +481,8 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
             let (ya, yb) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
             k[l] = [b.lo(xa), b.hi(xb), b.lo(ya), b.hi(yb)];
         }
-        for (m, k) in acc.iter_mut().zip(&k) {
-            self.mark(m, *k);
+        for (l, k) in k.iter().enumerate() {
+            self.mark(acc, l, *k);
         }
     }
 
@@ -442,7 +490,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
     /// x-span depends on the column only and the y-span on the row only
     /// (the same bits).
     #[inline(always)]
-    #[allow(clippy::needless_range_loop)] // one index over the ranks and the lanes
+    #[allow(clippy::needless_range_loop)] // one index over the spans and the lanes
     fn add_quad_tile(
         &self,
         acc: &mut Self::State,
@@ -453,38 +501,33 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         r: &RowLanes,
         g: &Group,
     ) {
-        let p = self.p;
-        let b = p.scaled(1.0);
+        let b = self.p.scaled(1.0);
         let wr = g.wr[0];
-        let d = w - wr;
-        let i = corner_invs(c, wr, d);
-        let (mut xk, mut yk) = ([[0u16; 2]; TILE_W], [[0u16; 2]; ROWS_PER_GROUP]);
+        let i = corner_invs(c, wr, w - wr);
+        let (mut xa, mut xb) = ([0f32; TILE_W], [0f32; TILE_W]);
+        let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for col in 0..TILE_W {
             let (a, e) = (x0 - r.xr[col], x1 - r.xr[col]);
-            let (lo, hi) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
-            xk[col] = [b.lo(lo), b.hi(hi)];
+            (xa[col], xb[col]) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
         }
         for row in 0..ROWS_PER_GROUP {
             let l = row * TILE_W;
             let (bottom, top) = (-r.nay0[l], r.ay1[l]);
-            let (lo, hi) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
-            yk[row] = [b.lo(lo), b.hi(hi)];
+            (ya[row], yb[row]) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
         }
-        self.mark_ranks(acc, &xk, &yk);
+        self.mark_ranks(acc, &Ranks::new(&b, &xa, &xb), &Ranks::new(&b, &ya, &yb));
     }
 
     fn full(&self, acc: &Self::State, g: &Group) -> bool {
         let all = self.p.all();
-        acc.iter()
-            .zip(&g.wr)
-            .all(|(m, wr)| !wr.is_finite() || *m == all)
+        (0..LANES).all(|l| !g.wr[l].is_finite() || (0..W).all(|q| acc[q][l] == all[q]))
     }
 
     fn occlusion(&self, acc: &Self::State) -> Lanes {
         let s = self.p.count() as f32;
         let mut o = [0f32; LANES];
-        for (o, m) in o.iter_mut().zip(acc) {
-            *o = m.iter().map(|w| w.count_ones()).sum::<u32>() as f32 / s;
+        for (l, o) in o.iter_mut().enumerate() {
+            *o = (0..W).map(|q| acc[q][l].count_ones()).sum::<u32>() as f32 / s;
         }
         o
     }
