@@ -318,6 +318,7 @@ impl<const W: usize, const QUADS: bool> MaskKernel<'_, W, QUADS> {
     /// micro-patch whose ranges are empty for every column or every row marks
     /// nothing.
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // transposes: one index over two arrays
     fn mark_ranks(&self, acc: &mut Masks<W>, x: &Ranks, y: &Ranks) {
         if x.empty() || y.empty() {
             return;
@@ -368,6 +369,7 @@ struct Ranks {
 impl Ranks {
     /// The ranges of the intervals [lo, hi] (sample units before rounding).
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // one index over three arrays
     fn new(b: &RankBounds, lo: &[f32; TILE_W], hi: &[f32; TILE_W]) -> Ranks {
         let mut r = Ranks {
             lo: [0; TILE_W],
