@@ -267,26 +267,33 @@ fn planned(
         let quarter = |n: usize| (n / 4).clamp(64.min(n), n);
         let coarse = MapGrid::new(eighth(w), eighth(h), fitted)?;
         let coarse_occ = MapGrid::new(quarter(occ.0), quarter(occ.1), fitted)?;
-        let kernel = MethodConfig::Bitmask(crate::methods::config::BitmaskConfig {
-            samples: 256,
-            passes: Some(2),
-            occluder_resolution: Some((coarse_occ.width, coarse_occ.height)),
-            ..c
-        })
-        .resolve(&CallContext {
-            backend: Backend::Cpu,
-            resolution: (coarse.width, coarse.height),
-            ..*ctx
-        })?
-        .kernel();
+        let kernel = |gaps| {
+            MethodConfig::Bitmask(crate::methods::config::BitmaskConfig {
+                samples: 256,
+                passes: Some(2),
+                occluder_resolution: Some((coarse_occ.width, coarse_occ.height)),
+                gaps,
+                ..c
+            })
+            .resolve(&CallContext {
+                backend: Backend::Cpu,
+                resolution: (coarse.width, coarse.height),
+                ..*ctx
+            })
+            .map(|k| k.kernel())
+        };
+        use crate::methods::bitmask::Gaps;
         let tries = pipeline::layer_tries(
             &framed,
             (call.occluders.faces, call.receivers.faces),
             (coarse, coarse_occ),
-            kernel,
+            (kernel(Gaps::Closed)?, kernel(Gaps::Open)?),
             crate::methods::config::MAX_PASSES,
         );
         p.set_layers(tries.passes, tries.surfaces, &tries.peeled, &tries.changes);
+        // Only a plan that chose closed gaps may open them (a user's
+        // Bitmask(gaps="open") never reaches the planner).
+        p.set_gaps((c.gaps == Gaps::Closed).then_some(tries.gap_change));
     }
     drop(framed);
     let cfg = p.config.resolve(ctx)?;

@@ -97,6 +97,26 @@ def test_thin_occluders_refine_the_maps_for_tight_targets_only():
     assert not decision(bunny, "thin_occluders").taken and bunny.method.occluder_resolution == (64, 64)
 
 
+def test_gaps_open_where_closing_them_changes_nothing_and_stay_closed_where_light_leaks():
+    # The contact box's faces are flat and parallel to the light: connecting
+    # neighbours changes no shadow, the flat micro-patches are cheaper.
+    box = planned(scenes.contact_box, res=256)
+    assert decision(box, "gaps").taken and box.method.gaps == "open"
+    closed = ss.soft_shadow_map(
+        *scenes.contact_box(),
+        resolution=256,
+        extent=box.extent,
+        method=ss.Bitmask(**{**box.method.to_dict(), "gaps": "closed"}),
+    )
+    assert np.abs(box.visibility - closed.visibility).max() < 0.01
+    # Near the light the gaps between neighbours at different depths let
+    # light through (0.019 of the shadow), more than a 0.01 target can spare.
+    near = planned(scenes.near_light, res=256)
+    assert not decision(near, "gaps").taken and near.method.gaps == "closed"
+    # Loose targets spend their slack on coarser maps, not on the gaps.
+    assert not decision(planned(scenes.contact_box, target=0.03, res=256), "gaps").taken
+
+
 def test_wide_penumbrae_coarsen_the_occluder_maps_and_contact_does_not():
     floating = planned(scenes.bunny_floating, target=0.02, res=256)
     assert decision(floating, "occluder_resolution").taken

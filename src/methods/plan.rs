@@ -137,6 +137,10 @@ pub struct Plan {
     /// Run the hard shadow map (the light as a point).
     pub hard: bool,
     pub config: MethodConfig,
+    /// For a map setting chosen for an error target under COARSE_TARGET:
+    /// the target less the setting's measured worst error, what `set_gaps`
+    /// may spend (None: nothing to spend).
+    pub slack: Option<f64>,
 }
 
 /// A setting the planner can choose, with its measured worst error and
@@ -238,11 +242,13 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
             decisions: d,
             hard: true,
             config: (CANDIDATES[0].config)(res),
+            slack: None,
         };
     }
     // A plane seen from any point of the light covers each direction once:
     // the back-projections of its micro-patches do not overlap (§3.4).
     let flat = stats.occ_flat || stats.occ_planar;
+    let mut slack = None;
     d.push(Decision {
         name: "union",
         taken: !flat,
@@ -278,6 +284,8 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
                     k = 2;
                 }
                 let c = &CANDIDATES[k];
+                // Coarser maps spend the slack of targets from COARSE_TARGET.
+                slack = (e < COARSE_TARGET).then_some(e - c.worst_error);
                 d.push(Decision {
                     name: "setting",
                     taken: true,
@@ -353,6 +361,7 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
         decisions: d,
         hard: false,
         config,
+        slack,
     }
 }
 
@@ -372,6 +381,13 @@ pub const THIN_TARGET: f64 = 0.0051;
 /// error metric by less than this: under the noise of a 1024-sample
 /// reference (0.0013-0.0041, docs/benchmarks/gaps.md).
 pub const LAYER_CHANGE: f64 = 0.001;
+
+/// What closing the gaps changes in the planned maps' shadow, per unit of
+/// what it changes in the coarse layer tries' shadow (`Plan::set_gaps`).
+/// Measured at 0.01 on the study's scenes and the hard surfaces at 256² and
+/// 512² (docs/methods/auto.md): 0.47-1.02 where the change is 0.002-0.019,
+/// 2.76 on the fence at 512² (0.0007 coarse, 0.0019 full); rounded up.
+pub const GAP_SCALE: f64 = 3.0;
 
 /// The change one more occluder layer makes to a visibility map: the
 /// error metric's form (mean |a - b| over texels shadowed in either).
@@ -450,6 +466,51 @@ impl Plan {
         });
         if refine {
             c.occluder_resolution = Some((2 * resolution.0, 2 * resolution.1));
+            self.config = MethodConfig::Bitmask(c);
+        }
+    }
+
+    /// Opens a union plan's gaps (flat per-texel micro-patches, cheaper
+    /// than connected quads) where closing them changes the shadow by less
+    /// than the plan's slack: `change` is what closing them changed in the
+    /// coarse shadow of the layer tries (`pipeline/measure.rs`, None: not
+    /// measured). The metric is a mean of |differences| over one set of
+    /// texels, so error(open) <= error(closed) + |open - closed|: with the
+    /// coarse change scaled to the full maps' (GAP_SCALE, measured), the
+    /// open setting stays within the target.
+    pub fn set_gaps(&mut self, change: Option<f64>) {
+        let MethodConfig::Bitmask(mut c) = self.config else {
+            return;
+        };
+        let (Some(change), Some(slack)) = (change, self.slack) else {
+            self.decisions.push(Decision {
+                name: "gaps",
+                taken: false,
+                why: format!(
+                    "closed: the gaps are opened only under targets under {COARSE_TARGET} \
+                     (looser ones spend their slack on coarser maps)"
+                ),
+            });
+            return;
+        };
+        let full = GAP_SCALE * change;
+        let open = full <= slack;
+        self.decisions.push(Decision {
+            name: "gaps",
+            taken: open,
+            why: format!(
+                "closing the gaps between micro-patches changed the coarse shadow by \
+                 {change:.4} (about {full:.4} on the planned maps, x{GAP_SCALE} measured); \
+                 the target leaves {slack:.4} over the setting's worst error: gaps {}",
+                if open {
+                    "open (flat micro-patches, cheaper)"
+                } else {
+                    "closed"
+                }
+            ),
+        });
+        if open {
+            c.gaps = super::bitmask::Gaps::Open;
             self.config = MethodConfig::Bitmask(c);
         }
     }
@@ -551,6 +612,7 @@ pub fn plan_eye(target: &Target, rule: MethodConfig) -> Plan {
         }],
         hard: false,
         config,
+        slack: None,
     }
 }
 
@@ -602,6 +664,7 @@ fn coarsen(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::methods::bitmask::Gaps;
 
     fn stats() -> SceneStats {
         SceneStats {
@@ -694,6 +757,37 @@ mod tests {
         let p = plan(&stats(), target, None);
         assert!(p.bitmask().is_some());
         p
+    }
+
+    #[test]
+    fn gaps_open_only_where_closing_them_fits_in_the_slack() {
+        let t = Target::new(Some(0.01), None).unwrap();
+        let gaps = |p: &Plan| match p.config {
+            MethodConfig::Bitmask(c) => c.gaps,
+            _ => unreachable!("a union plan"),
+        };
+        let slack = union_plan(&t).slack.expect("a tight target leaves slack");
+        assert!(slack > 0.0 && slack < 0.01);
+        let mut nothing = union_plan(&t);
+        nothing.set_gaps(Some(0.0));
+        assert_eq!(gaps(&nothing), Gaps::Open);
+        let mut small = union_plan(&t);
+        small.set_gaps(Some(0.99 * slack / GAP_SCALE));
+        assert_eq!(gaps(&small), Gaps::Open);
+        let mut large = union_plan(&t);
+        large.set_gaps(Some(1.01 * slack / GAP_SCALE));
+        assert_eq!(gaps(&large), Gaps::Closed);
+        let mut unmeasured = union_plan(&t);
+        unmeasured.set_gaps(None);
+        assert_eq!(gaps(&unmeasured), Gaps::Closed);
+        // Loose targets spend their slack on coarser maps.
+        let mut loose = union_plan(&Target::new(Some(0.03), None).unwrap());
+        assert_eq!(loose.slack, None);
+        loose.set_gaps(Some(0.0));
+        assert_eq!(gaps(&loose), Gaps::Closed);
+        for p in [&nothing, &large, &loose] {
+            assert!(p.decisions.iter().any(|d| d.name == "gaps"));
+        }
     }
 
     #[test]

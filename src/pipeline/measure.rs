@@ -41,18 +41,23 @@ pub(crate) struct LayerTries {
     /// The layers to keep: 1, 2, or 2 + the peeled layers that changed the
     /// shadow by LAYER_CHANGE or more.
     pub passes: u32,
+    /// What closing the gaps changed in the shadow of the layers kept
+    /// (`layer_change` of the open and the closed kernels' maps).
+    pub gap_change: f64,
 }
 
 /// Tries the occluder layers of `f` on the coarse grids (`receivers` for
-/// the receivers, `occluders` for the occluders) with `method` (a union
-/// kernel), peeling at most `max_layers`.
+/// the receivers, `occluders` for the occluders) with `methods` (a union
+/// kernel with gaps closed, and the same with gaps open), peeling at most
+/// `max_layers`, then what opening the gaps changes with the layers kept.
 pub(crate) fn layer_tries(
     f: &FramedScene,
     faces: (&[[u32; 3]], &[[u32; 3]]),
     grids: (MapGrid, MapGrid),
-    method: Method,
+    methods: (Method, Method),
     max_layers: u32,
 ) -> LayerTries {
+    let (method, open) = methods;
     let (occ_faces, rec_faces) = faces;
     let (grid, occluder_grid) = grids;
     let prepared = Prepared::new(&occluder_grid, &f.occ_ls, occ_faces, f.near);
@@ -72,15 +77,13 @@ pub(crate) fn layer_tries(
         peeled: vec![],
         changes: vec![],
         passes: if surfaces[1] == 0 { 1 } else { 2 },
+        gap_change: 0.0,
     };
-    if tries.passes == 1 {
-        return tries;
-    }
     let receiver = rasterize(&grid, &f.rec_ls, rec_faces, f.near, false).nearest;
-    let shade = |middle: &[Vec<f32>]| {
+    let shade_with = |method: Method, middle: &[Vec<f32>], back: Option<&[f32]>| {
         let mut layers: Vec<&[f32]> = vec![&front];
         layers.extend(middle.iter().map(|m| m.as_slice()));
-        layers.push(&back);
+        layers.extend(back);
         shade_map(
             method,
             &ShadowInputs {
@@ -93,6 +96,12 @@ pub(crate) fn layer_tries(
             },
         )
     };
+    if tries.passes == 1 {
+        let closed = shade_with(method, &[], None);
+        tries.gap_change = layer_change(&closed, &shade_with(open, &[], None));
+        return tries;
+    }
+    let shade = |middle: &[Vec<f32>]| shade_with(method, middle, Some(&back));
     let mut middle: Vec<Vec<f32>> = vec![];
     let mut before = shade(&middle);
     while tries.passes < max_layers {
@@ -116,6 +125,9 @@ pub(crate) fn layer_tries(
         tries.passes += 1;
         before = after;
     }
+    // `before` holds the closed kernel's shadow of the layers kept.
+    let kept = &middle[..(tries.passes - 2) as usize];
+    tries.gap_change = layer_change(&before, &shade_with(open, kept, Some(&back)));
     tries
 }
 
