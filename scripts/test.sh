@@ -3,7 +3,8 @@
 # every feature combination that ships or is documented, a build without the
 # GPU backend, rustdoc, the Rust core's tests (cargo test), ruff, the stubs
 # against the compiled module (stubtest), a type check of the package (mypy),
-# and the package's tests (pytest, against Mitsuba references cached in .cache/).
+# the package's tests (pytest, against Mitsuba references cached in .cache/),
+# the quickstart notebook, and the wheel installed where there is no Rust.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh test
@@ -24,3 +25,7 @@ cargo test --release --quiet --features gpu
 .venv/bin/python -m mypy.stubtest softshadow._core
 .venv/bin/python -m mypy
 .venv/bin/python -m pytest -q "$@"
+# The quickstart notebook, executed (nbmake); the repository keeps it stripped.
+.venv/bin/python -m pytest -q --nbmake examples/quickstart.ipynb
+# The wheel as a user without Rust installs it.
+scripts/check_wheel.sh

@@ -38,6 +38,8 @@ __all__ = [
     "limits",
     "light_frame",
     "render",
+    "light_emission",
+    "irradiance",
     "EyeResult",
     "check_mesh",
     "shadow_map_from_meshes",
@@ -66,6 +68,8 @@ _Light = (
     | tuple[_Vec3, _Vec3, tuple[float, float], _Vec3, float]
 )
 _Resolution = int | tuple[int, int]
+# A grey value or RGB channels.
+_Color = float | list[float] | tuple[float, ...]
 
 @final
 class Ssm:
@@ -434,6 +438,10 @@ class EyeResult:
     @property
     def visibility(self) -> npt.NDArray[np.float32]: ...
     @property
+    def shaded(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def unshadowed(self) -> npt.NDArray[np.float32]: ...
+    @property
     def depth(self) -> npt.NDArray[np.float32]: ...
     @property
     def position(self) -> npt.NDArray[np.float64]: ...
@@ -476,9 +484,25 @@ def render(
     precision: str | None = None,
     backend: str = "cpu",
     threads: int | None = None,
+    emission: _Color | None = None,
+    albedo: _Color | list[_Color] | None = None,
 ) -> EyeResult:
     """The eye view: first hits, then each pixel's visibility with every mesh
-    casting and receiving."""
+    casting and receiving, then the shading (``emission`` the light's
+    radiance or irradiance, ``albedo`` per mesh; the core's defaults for
+    None)."""
+
+def light_emission(arg: str, value: _Color | None = None) -> list[float]:
+    """A light's emission (``arg``: "radiance" or "irradiance") checked:
+    finite and >= 0, a number or 3; None gives the default."""
+
+def irradiance(
+    light: _Light,
+    points: npt.NDArray[np.float64],
+    normals: npt.NDArray[np.float64],
+    emission: _Color | None = None,
+) -> npt.NDArray[np.float64]:
+    """The unshadowed irradiance (N, 3) at points (N, 3) with normals (N, 3)."""
 
 @final
 class DepthShadowResult:

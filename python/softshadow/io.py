@@ -64,6 +64,13 @@ def to_uint8(a: Any, *, lo: float = 0.0, hi: float = 1.0) -> np.ndarray:
 
 def write_png(path: str | os.PathLike[str], image: Any) -> None:
     """Writes an 8-bit grey (H, W) or RGB (H, W, 3) uint8 image as PNG."""
+    png = png_bytes(image)
+    with open(path, "wb") as f:
+        f.write(png)
+
+
+def png_bytes(image: Any) -> bytes:
+    """An 8-bit grey (H, W) or RGB (H, W, 3) uint8 image encoded as PNG."""
     img = np.ascontiguousarray(image)
     if img.dtype != np.uint8:
         raise TypeError(f"image: must be uint8 (see to_uint8), got {img.dtype}")
@@ -83,5 +90,4 @@ def write_png(path: str | os.PathLike[str], image: Any) -> None:
     png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, color, 0, 0, 0))
     png += chunk(b"IDAT", zlib.compress(raw, 6))
     png += chunk(b"IEND", b"")
-    with open(path, "wb") as f:
-        f.write(png)
+    return png

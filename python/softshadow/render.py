@@ -5,7 +5,9 @@ receiving shadows (its own included), lit by a :class:`RectLight` or a
 :class:`DirectionalLight`. The core casts the pixel-centre rays (the
 G-buffer), then shades each pixel's surface point with the method:
 ``exact`` traces shadow rays, the map methods read light-view occluder
-maps focused on what the camera sees. See docs/eye_view.md.
+maps focused on what the camera sees. See docs/eye_view.md. Every image
+also holds the direct lighting of Lambertian surfaces, unshadowed and times
+the visibility (``Image.unshadowed``, ``Image.shaded``; docs/shading.md).
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from . import _core
 from .camera import Camera
-from .light import DirectionalLight, RectLight
+from .light import DirectionalLight, RectLight, _color
 from .methods import MethodConfig
 from .scene import Scene
 from .shadow_map import Decision, Plan
@@ -26,7 +28,8 @@ from .shadow_map import Decision, Plan
 
 @dataclass(frozen=True, eq=False, repr=False)
 class Image:
-    """A rendered image: the visibility and the G-buffer it was shaded from.
+    """A rendered image: the visibility, the shaded images and the G-buffer
+    they were shaded from.
 
     Arrays have shape (H, W) (row 0 at the top), or (H, W, 3).
     """
@@ -34,6 +37,16 @@ class Image:
     visibility: np.ndarray
     """float32: the fraction of the light (area, or directions of the sun)
     seen from the surface in each pixel; 1 where the pixel sees no surface."""
+    shaded: np.ndarray
+    """float32 (H, W, 3) RGB radiance toward the camera, ``unshadowed *
+    visibility``; 0 where no surface. An approximation of the shadowed
+    direct light: the exact one weights each visible part of the light by
+    its cosine (and 1/r^2), the visibility weights them alike (see
+    docs/shading.md for its measured size)."""
+    unshadowed: np.ndarray
+    """float32 (H, W, 3) RGB radiance toward the camera without shadows,
+    ``albedo / pi * E`` with E the light's irradiance in closed form; 0 where
+    no surface."""
     depth: np.ndarray
     """float32 distance along the optical axis; inf where no surface."""
     position: np.ndarray
@@ -87,7 +100,12 @@ class Image:
 
     def channels(self) -> dict[str, np.ndarray]:
         """Every (H, W) channel by name, as :meth:`write_exr` writes them."""
-        out: dict[str, np.ndarray] = {"V": self.visibility, "depth": self.depth}
+        out: dict[str, np.ndarray] = {"V": self.visibility}
+        for k, c in enumerate("RGB"):
+            out[f"shaded.{c}"] = self.shaded[..., k]
+        for k, c in enumerate("RGB"):
+            out[f"unshadowed.{c}"] = self.unshadowed[..., k]
+        out["depth"] = self.depth
         for k, axis in enumerate("xyz"):
             out[f"position.{axis}"] = self.position[..., k]
             out[f"normal.{axis}"] = self.normal[..., k]
@@ -96,8 +114,9 @@ class Image:
         return out
 
     def write_exr(self, path: str | os.PathLike[str]) -> None:
-        """Writes every channel (``V``, ``depth``, ``position.xyz``,
-        ``normal.xyz``, ``mesh_id``, ``mask``) as one float32 EXR file.
+        """Writes every channel (``V``, ``shaded.RGB``, ``unshadowed.RGB``,
+        ``depth``, ``position.xyz``, ``normal.xyz``, ``mesh_id``, ``mask``)
+        as one float32 EXR file.
         Needs ``OpenEXR`` (``pip install softshadow[io]``)."""
         from .io import write_exr
 
@@ -118,6 +137,15 @@ class Image:
         ax.set_axis_off()
         return ax
 
+    def _repr_png_(self) -> bytes | None:
+        """The visibility as a small grey PNG, which Jupyter shows for the
+        image: ``round(255 V)`` per pixel, mid grey (128) where the pixel sees
+        no surface (subsampled beyond 512 a side, enlarged below 256; see
+        ``softshadow._preview``)."""
+        from . import _preview
+
+        return _preview.png(self.visibility, self.mask)
+
 
 def render(
     scene: Scene,
@@ -135,12 +163,23 @@ def render(
     precision: str | None = None,
     backend: str = "cpu",
     threads: int | None = None,
+    albedo: Any = None,
 ) -> Image:
-    """Renders the visibility image of ``scene`` under ``light`` seen by ``camera``.
+    """Renders the visibility and shaded images of ``scene`` under ``light`` seen by ``camera``.
 
     Every mesh casts and receives shadows, its own included (the far side of
     a closed mesh is in its own umbra). A :class:`RectLight` lights its
     ``n`` side only: points at or behind its plane get 0.
+
+    The image also holds the direct lighting of Lambertian surfaces
+    (docs/shading.md): ``unshadowed = albedo / pi * E``, E the irradiance
+    from the light's ``radiance`` (or the sun's ``irradiance``) in closed
+    form at the pixel's point and geometric normal (facing the camera), and
+    ``shaded = unshadowed * visibility``. That product is an approximation:
+    the exact shadowed irradiance weights each visible part of the light by
+    its cosine (and 1/r^2), the visibility counts them alike; the two agree
+    where a pixel is fully lit or in umbra. The shading runs on the CPU
+    after the visibility, on every backend.
 
     method
         A config or name, as for :func:`soft_shadow_map`. ``exact`` traces
@@ -167,6 +206,11 @@ def render(
         hits, the shadow rays, the occluder layers and the gather at the
         pixels' points run on the device, with the same answers (see
         docs/gpu.md; hard lights on the map methods stay on the CPU).
+    albedo
+        Keyword-only. The meshes' diffuse albedo: a number (grey) or an RGB
+        triple for every mesh, or a sequence with one number or triple per
+        mesh of ``scene.meshes`` (three numbers are always one RGB triple).
+        Values in [0, 1]. Default (``None``): 0.8 grey, the core's default.
 
     Bad values raise ValueError or TypeError naming the argument.
     """
@@ -191,9 +235,13 @@ def render(
         precision=precision,
         backend=backend,
         threads=threads,
+        emission=light._emission(),
+        albedo=_color(albedo),
     )
     return Image(
         visibility=r.visibility,
+        shaded=r.shaded,
+        unshadowed=r.unshadowed,
         depth=r.depth,
         position=r.position,
         normal=r.normal,

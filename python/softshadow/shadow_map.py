@@ -192,6 +192,23 @@ class ShadowMap:
         their flat texel indices (M,) into ``visibility.ravel()``."""
         return _core.receiver_points(self.receiver_depth, self._light_args(), self.extent)
 
+    def _repr_png_(self) -> bytes | None:
+        """The visibility as a small grey PNG, which Jupyter shows for the map:
+        ``round(255 V)`` per texel, mid grey (128) where there is no receiver
+        (subsampled beyond 512 a side, enlarged below 256; see
+        ``softshadow._preview``)."""
+        from . import _preview
+
+        return _preview.png(self.visibility, np.isfinite(self.receiver_depth))
+
+    def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
+        """Shows the visibility (grey where there is no receiver) with
+        matplotlib (the ``plot`` extra); returns the axes."""
+        from . import _preview
+
+        surface = np.isfinite(self.receiver_depth)
+        return _preview.plot(self.visibility, surface, ax, f"{self.method!r}" if title is None else title, "ShadowMap")
+
 
 def soft_shadow_map(
     scene: Scene,

@@ -12,6 +12,10 @@
 //! or behind its plane, which exact (no ray start) and the map methods (the
 //! tangent-plane bound) both turn into 0.
 //!
+//! Every backend's visibility is then shaded on the CPU (shading.rs:
+//! Lambertian direct lighting, unshadowed and times the visibility) by
+//! `render_shaded`, so both backends shade a visibility alike.
+//!
 //! Both backends run the same stages: `render_cpu` here, and its GPU twin
 //! `crate::gpu::render_gpu` (src/gpu/eye.rs), which casts the first hits,
 //! the shadow rays, the occluder layers and the gather on the device and
@@ -21,11 +25,13 @@ pub mod focus;
 pub mod gbuffer;
 pub mod maps;
 pub mod rays;
+pub mod shading;
 pub mod shadow_mapping;
 pub mod tangent_plane;
 
 pub use gbuffer::GBuffer;
 pub use maps::{Bias, EyeMaps};
+pub use shading::{Lighting, Shaded};
 
 use crate::backend::{Backend, BackendChoice, Run};
 use crate::error::{Error, Result};
@@ -166,6 +172,39 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         threads,
         plan,
     })
+}
+
+/// `render`, then the direct lighting of every pixel under `lighting`
+/// (shading.rs) on the CPU whatever the backend, timed as `shading`.
+/// `lighting` is checked against the call's light and meshes
+/// (`Lighting::new`).
+pub fn render_shaded(call: &EyeCall, lighting: &Lighting) -> Result<(Run<EyeImage>, Shaded)> {
+    if lighting.albedo.len() != call.meshes.len() {
+        return Err(Error::shape(
+            "albedo",
+            format!(
+                "{} albedos for {} meshes",
+                lighting.albedo.len(),
+                call.meshes.len()
+            ),
+        ));
+    }
+    let cap = threads::resolve(call.threads)?;
+    let mut run = render(call)?;
+    let t0 = std::time::Instant::now();
+    let img = &run.output;
+    let (shaded, _) = threads::run_capped(cap, || {
+        Ok(shading::shade(
+            call.light,
+            lighting,
+            &img.gbuffer,
+            &img.visibility,
+        ))
+    })?;
+    run.output
+        .timings
+        .push(("shading", t0.elapsed().as_secs_f64()));
+    Ok((run, shaded))
 }
 
 /// What the eye view shades, reported in a plan: light-view texels only

@@ -9,7 +9,7 @@ use std::sync::OnceLock;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct GpuInfo {
     pub name: String,
-    /// The graphics API wgpu drives it through ("vulkan").
+    /// The graphics API wgpu drives it through ("vulkan", "metal" or "dx12").
     pub backend: String,
     /// "discrete_gpu", "integrated_gpu", "virtual_gpu", "cpu" or "other".
     pub device_type: String,
@@ -63,18 +63,31 @@ fn rank(t: wgpu::DeviceType) -> u32 {
     }
 }
 
+/// The graphics APIs asked for. wgpu skips those not compiled in: Cargo.toml
+/// turns on Metal only for Apple targets and DX12 only for Windows, so on
+/// Linux this is Vulkan alone.
+const BACKENDS: wgpu::Backends = wgpu::Backends::VULKAN
+    .union(wgpu::Backends::METAL)
+    .union(wgpu::Backends::DX12);
+
 fn open() -> std::result::Result<Gpu, String> {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
-        backends: wgpu::Backends::VULKAN,
+        backends: BACKENDS,
         ..wgpu::InstanceDescriptor::new_without_display_handle()
     });
-    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+    let adapters = pollster::block_on(instance.enumerate_adapters(BACKENDS));
+    // Among adapters of the same kind (one GPU seen through Vulkan and DX12
+    // on Windows) Vulkan first: it is the API the tests run.
     let adapter = adapters
         .into_iter()
-        .min_by_key(|a| rank(a.get_info().device_type))
+        .min_by_key(|a| {
+            let i = a.get_info();
+            (rank(i.device_type), i.backend != wgpu::Backend::Vulkan)
+        })
         .ok_or_else(|| {
-            "no Vulkan adapter found (install a GPU driver, or Mesa's lavapipe: \
-             apt-get install mesa-vulkan-drivers libvulkan1)"
+            "no GPU adapter found through Vulkan, Metal or DX12 (install a GPU \
+             driver, or on Linux Mesa's lavapipe: apt-get install \
+             mesa-vulkan-drivers libvulkan1)"
                 .to_string()
         })?;
     let ai = adapter.get_info();

@@ -1,24 +1,99 @@
 //! The eye view's entry point and its result: converts the arguments, runs
-//! `eye::render` without the GIL, moves the G-buffer and maps into arrays.
+//! `eye::render_shaded` without the GIL, moves the G-buffer, the shaded
+//! images and the maps into arrays. Also the shading's own entry points
+//! (`light_emission`, `irradiance`: the lights' checks and closed forms).
 
 use super::camera::PyCamera;
 use super::configs::{self, method_arg, Loose};
-use super::convert::{light_of, mesh, opt_int, opt_resolution, Light};
+use super::convert::{light_of, mesh, opt_float, opt_int, opt_resolution, triples, Light};
 use super::errors;
 use super::results::{map, sun_depth};
 use crate::backend::{BackendChoice, Run};
-use crate::eye::{self, Bias, EyeCall, EyeImage};
+use crate::eye::shading::{self, ColorValue};
+use crate::eye::{self, Bias, EyeCall, EyeImage, Lighting, Shaded};
 use crate::geom::mesh::MeshRef;
 use crate::pipeline::Timings;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+/// Nesting beyond this is refused as a type (a colour list is at most a
+/// list of triples).
+const MAX_COLOR_DEPTH: usize = 2;
+
+/// A number or a (nested) list or tuple of numbers, for the core to read as
+/// colours (`shading::ColorValue`); `arg` names it in a TypeError.
+fn color_value(arg: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<ColorValue> {
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        if depth >= MAX_COLOR_DEPTH {
+            return Err(PyTypeError::new_err(format!(
+                "{arg}: must be a number or a sequence of numbers or triples, got deeper nesting"
+            )));
+        }
+        let items = v
+            .try_iter()?
+            .map(|item| color_value(arg, &item?, depth + 1))
+            .collect::<PyResult<_>>()?;
+        return Ok(ColorValue::List(items));
+    }
+    match opt_float(arg, Some(v)) {
+        Ok(Some(x)) => Ok(ColorValue::Number(x)),
+        _ => Err(PyTypeError::new_err(format!(
+            "{arg}: must be a number or a sequence of numbers, got {}",
+            v.get_type().name()?
+        ))),
+    }
+}
+
+fn opt_color(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<ColorValue>> {
+    v.filter(|v| !v.is_none())
+        .map(|v| color_value(arg, v, 0))
+        .transpose()
+}
+
+/// A light's emission checked by the core: `arg` ("radiance" or
+/// "irradiance") is a number or an RGB triple, or None for the default.
+#[pyfunction]
+#[pyo3(signature = (arg, value=None))]
+pub fn light_emission(arg: &str, value: Option<Bound<'_, PyAny>>) -> PyResult<[f64; 3]> {
+    errors::guard(|| {
+        Ok(shading::emission(
+            arg,
+            opt_color(arg, value.as_ref())?.as_ref(),
+        )?)
+    })
+}
+
+/// The unshadowed irradiance (N, 3) at world points (N, 3) with normals
+/// (N, 3), the light's emission (RGB) included.
+#[pyfunction]
+#[pyo3(signature = (light, points, normals, emission=None))]
+pub fn irradiance<'py>(
+    py: Python<'py>,
+    light: Light,
+    points: PyReadonlyArray2<'py, f64>,
+    normals: PyReadonlyArray2<'py, f64>,
+    emission: Option<Bound<'py, PyAny>>,
+) -> PyResult<Py<PyAny>> {
+    errors::guard(|| {
+        let light = light_of(light)?;
+        let arg = shading::emission_arg(&light);
+        let emission = shading::emission(arg, opt_color(arg, emission.as_ref())?.as_ref())?;
+        let p = triples("points", &points)?;
+        let n = triples("normals", &normals)?;
+        let e = py.detach(|| shading::irradiance_at(&light, emission, p, n))?;
+        let rows = e.len();
+        let a = Array2::from_shape_vec((rows, 3), e.into_flattened())
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py).into_any().unbind())
+    })
+}
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.
 #[pyfunction]
-#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -36,6 +111,8 @@ pub fn render<'py>(
     precision: Option<Bound<'py, PyAny>>,
     backend: &str,
     threads: Option<Bound<'py, PyAny>>,
+    emission: Option<Bound<'py, PyAny>>,
+    albedo: Option<Bound<'py, PyAny>>,
 ) -> PyResult<EyeResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -61,8 +138,15 @@ pub fn render<'py>(
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
         };
-        let run = py.detach(|| eye::render(&call))?;
-        EyeResult::new(py, run)
+        let arg = shading::emission_arg(&light);
+        let lighting = Lighting::new(
+            &light,
+            opt_color(arg, emission.as_ref())?.as_ref(),
+            opt_color("albedo", albedo.as_ref())?.as_ref(),
+            refs.len(),
+        )?;
+        let (run, shaded) = py.detach(|| eye::render_shaded(&call, &lighting))?;
+        EyeResult::new(py, run, shaded)
     })
 }
 
@@ -72,6 +156,13 @@ pub struct EyeResult {
     /// (H, W) float32; 1 where no surface.
     #[pyo3(get)]
     visibility: Py<PyAny>,
+    /// (H, W, 3) float32 outgoing radiance, unshadowed times visibility; 0
+    /// where no surface.
+    #[pyo3(get)]
+    shaded: Py<PyAny>,
+    /// (H, W, 3) float32 outgoing radiance without shadows; 0 where no surface.
+    #[pyo3(get)]
+    unshadowed: Py<PyAny>,
     /// (H, W) float32 distance along the optical axis; inf where no surface.
     #[pyo3(get)]
     depth: Py<PyAny>,
@@ -132,7 +223,7 @@ fn image2<T: numpy::Element>(py: Python<'_>, h: usize, w: usize, v: Vec<T>) -> P
 }
 
 impl EyeResult {
-    fn new(py: Python<'_>, run: Run<EyeImage>) -> PyResult<Self> {
+    fn new(py: Python<'_>, run: Run<EyeImage>, shaded: Shaded) -> PyResult<Self> {
         let img = run.output;
         let g = img.gbuffer;
         let (w, h) = (g.width, g.height);
@@ -152,6 +243,8 @@ impl EyeResult {
         let (depth_origin, depth_range) = sun_depth(&img.light_space);
         Ok(EyeResult {
             visibility: image2(py, h, w, img.visibility)?,
+            shaded: image3(py, h, w, shaded.shaded.into_flattened())?,
+            unshadowed: image3(py, h, w, shaded.unshadowed.into_flattened())?,
             depth: image2(py, h, w, g.depth)?,
             position: image3(py, h, w, g.position.into_flattened())?,
             normal: image3(py, h, w, g.normal.into_flattened())?,

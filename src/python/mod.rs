@@ -41,6 +41,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<results::DepthShadowResult>()?;
     m.add_class::<eye::EyeResult>()?;
     m.add_function(wrap_pyfunction!(eye::render, m)?)?;
+    m.add_function(wrap_pyfunction!(eye::light_emission, m)?)?;
+    m.add_function(wrap_pyfunction!(eye::irradiance, m)?)?;
     m.add_class::<capabilities::MethodInfo>()?;
     m.add_class::<capabilities::OptionInfo>()?;
     m.add_function(wrap_pyfunction!(capabilities::capabilities, m)?)?;

@@ -47,6 +47,11 @@ Modules
     surface seen through each pixel of a camera, under a rectangular or a
     directional light, every mesh casting shadows (itself included), with
     the first hits' mask, depth, position, normal and mesh index.
+``shading``
+    :func:`render_direct`: the radiance toward the camera at each pixel
+    centre from Mitsuba's ``direct`` integrator (two-sided diffuse meshes,
+    the light as an area or directional emitter): the ground truth of
+    ``softshadow.render``'s shaded images.
 """
 
 from __future__ import annotations
@@ -62,6 +67,7 @@ from ._rays import MAX_RAYS_PER_BATCH as MAX_RAYS_PER_BATCH
 from .camera import camera_sensor
 from .eye import ReferenceImage, render_visibility
 from .render import render_image
+from .shading import render_direct
 from .visibility import ReferenceScene, TraceStats, reference_map, visibility_at_points
 
 __all__ = [
@@ -69,6 +75,7 @@ __all__ = [
     "ReferenceImage",
     "ReferenceScene",
     "TraceStats",
+    "render_direct",
     "render_image",
     "render_visibility",
     "reference_map",

@@ -1,0 +1,183 @@
+"""One dataset item: sample, build, render, write (what a worker runs).
+
+Item k's files, under ``outputs.folder`` in subfolders of 1000 items
+(``items/00000/00000042.*``):
+
+* ``.exr``: the requested channels, float32, as :meth:`softshadow.Image.channels`
+  names them (``V``, ``shaded.*``, ``unshadowed.*``, ``depth``, ``normal.x/y/z``,
+  ``position.x/y/z``, ``mesh_id``, ``mask``);
+* ``.maps.exr`` on request: the light-view occluder layers (``layer0`` front,
+  ``layer1`` back), planar depth from the light or the sun's orthographic depth;
+* ``.png`` (visibility) and ``.shaded.png`` on request: 8-bit previews;
+* ``.json``: the record: every sampled parameter, the seed, k, the spec's
+  hash, the resolved method and the versions. Nothing in it depends on the
+  machine or the time, so the files are the same bit for bit wherever and
+  whenever item k is made; the time it took goes to the manifest.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import json
+import os
+import time
+from typing import Any
+
+import numpy as np
+
+from .. import io as ssio
+from . import limits as L
+from .build import build_camera, build_light, build_scene
+from .files import write_item_files
+from .sampling import item_seed, sample_item
+from .spec import REFERENCE, Spec, shading_available
+
+
+def item_base(folder: str, k: int) -> str:
+    """The relative path of item k's files without extension."""
+    return f"{folder}/{k // L.SHARD:05d}/{k:0{L.ITEM_DIGITS}d}"
+
+
+def item_files(spec: Spec, k: int) -> dict[str, str]:
+    """Item k's files by role (``exr``, ``json``, ``maps``, ``preview``, ``shaded_preview``), relative to --out."""
+    base = item_base(spec.outputs.folder, k)
+    files = {"exr": base + ".exr", "json": base + ".json"}
+    if spec.outputs.light_maps:
+        files["maps"] = base + ".maps.exr"
+    if spec.outputs.previews:
+        files["preview"] = base + ".png"
+        if "shaded" in spec.outputs.channels:
+            files["shaded_preview"] = base + ".shaded.png"
+    return files
+
+
+def versions(spec: Spec) -> dict[str, str | None]:
+    """The versions that made the item (mitsuba only for the reference)."""
+    import softshadow
+
+    names = ["trimesh", "OpenEXR"] + (["mitsuba"] if spec.method.name == REFERENCE else [])
+    out: dict[str, str | None] = {"softshadow": softshadow.__version__, "numpy": np.__version__}
+    for name in names:
+        try:
+            out[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+def select_channels(all_channels: dict[str, np.ndarray], groups: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """The channels of the requested groups (``visibility`` is ``V``; a group
+    ``g`` is the channel ``g`` or the channels ``g.*``), in the groups' order."""
+    out = {}
+    for g in groups:
+        name = "V" if g == "visibility" else g
+        found = {k: v for k, v in all_channels.items() if k == name or k.startswith(name + ".")}
+        if not found:
+            raise RuntimeError(f"outputs.channels: the render gave no {g!r} channel (it gave {sorted(all_channels)})")
+        out.update(found)
+    return out
+
+
+def render_item(
+    spec: Spec, k: int, threads: int | None
+) -> tuple[dict[str, np.ndarray], list[np.ndarray], dict[str, Any]]:
+    """Item k's channels (all of them), light-view maps and record (without file names)."""
+    params = sample_item(spec, k)
+    scene, albedo = build_scene(params, spec.folder)
+    camera = build_camera(params["camera"])
+    m = spec.method
+    record: dict[str, Any] = {"k": k, "seed": spec.seed, "spec_hash": spec.hash, "versions": versions(spec)}
+    record.update(params)
+    maps: list[np.ndarray] = []
+    if m.name == REFERENCE:
+        from ..reference import render_visibility
+
+        if threads is not None:
+            _cap_drjit_threads(threads)
+        samples = int(m.options.get("samples", 256))
+        jitter_seed = item_seed(spec.seed, k)
+        light = build_light(params["light"], shading=False)
+        ref = render_visibility(scene, light, camera, samples, seed=jitter_seed)
+        channels: dict[str, np.ndarray] = {"V": ref.visibility, "depth": ref.depth}
+        for i, axis in enumerate("xyz"):
+            channels[f"position.{axis}"] = ref.position[..., i]
+            channels[f"normal.{axis}"] = ref.normal[..., i]
+        channels["mesh_id"] = ref.mesh_id.astype(np.float32)
+        channels["mask"] = ref.mask.astype(np.float32)
+        record["method"] = {"name": REFERENCE, "samples": ref.samples, "jitter_seed": jitter_seed}
+    else:
+        from ..render import render
+        from .spec import make_config
+
+        shading = shading_available()
+        light = build_light(params["light"], shading=shading)
+        extra: dict[str, Any] = {"albedo": [tuple(float(c) for c in a) for a in albedo]} if shading else {}
+        img = render(
+            scene, light, camera, make_config(m),
+            map_resolution=m.map_resolution, normal_offset=m.normal_offset, depth_bias=m.depth_bias,
+            backend=m.backend, threads=threads, **extra,
+        )  # fmt: skip
+        channels = img.channels()
+        maps = list(img.shadow_maps)
+        record["method"] = {"name": m.name, "config": repr(img.method), "backend": img.backend}
+        if spec.outputs.light_maps:
+            record["light_maps"] = {
+                "layers": len(maps),
+                "extent": None if img.map_extent is None else list(img.map_extent),
+                "depth_origin": None if img.depth_origin is None else list(img.depth_origin),
+                "depth_range": img.depth_range,
+            }
+    record["shading"] = {"albedo": "per mesh, scene order", "applied": m.name != REFERENCE and shading_available()}
+    return channels, maps, record
+
+
+def make_item(spec: Spec, out: str, k: int, threads: int | None = None) -> dict[str, Any]:
+    """Renders item k and writes its files under ``out`` (all or nothing);
+    returns its manifest entry: ``k``, each file's sha256, the seconds taken."""
+    t0 = time.perf_counter()
+    all_channels, maps, record = render_item(spec, k, threads)
+    channels = select_channels(all_channels, spec.outputs.channels)
+    files = item_files(spec, k)
+    h, w = next(iter(channels.values())).shape
+    record["channels"] = list(channels)
+    record["shape"] = [h, w]
+    record["files"] = {role: os.path.basename(rel) for role, rel in files.items()}
+    writers: dict[str, Any] = {files["exr"]: lambda p: ssio.write_exr(p, channels)}
+    if "maps" in files:
+        if not maps:
+            raise RuntimeError(f"outputs.light_maps: method {spec.method.name!r} gave no light-view maps")
+        writers[files["maps"]] = lambda p: ssio.write_exr(p, {f"layer{i}": a for i, a in enumerate(maps)})
+    if "preview" in files:
+        writers[files["preview"]] = lambda p: ssio.write_png(p, ssio.to_uint8(all_channels["V"]))
+    if "shaded_preview" in files:
+        shaded = np.stack([channels[n] for n in channels if n.startswith("shaded.")], axis=-1)
+        writers[files["shaded_preview"]] = lambda p: ssio.write_png(p, _tone_map(shaded))
+    text = json.dumps(record, indent=1, sort_keys=True) + "\n"
+    writers[files["json"]] = lambda p: _write_text(p, text)
+    hashes = write_item_files(out, writers)
+    return {"k": k, "files": hashes, "seconds": round(time.perf_counter() - t0, 6)}
+
+
+_drjit_threads: int | None = None
+
+
+def _cap_drjit_threads(threads: int) -> None:
+    """Dr.Jit's pool takes every core unless told; ``threads=`` caps it as it caps the core's."""
+    global _drjit_threads
+    if _drjit_threads != threads:
+        from ..reference._mitsuba import _mitsuba
+
+        _, dr = _mitsuba()
+        dr.set_thread_count(threads)
+        _drjit_threads = threads
+
+
+def _tone_map(rgb: np.ndarray) -> np.ndarray:
+    """Linear RGB to 8-bit with a 2.2 gamma, clipped at 1 (previews only)."""
+    x = np.clip(np.nan_to_num(rgb, nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0) ** (1.0 / 2.2)
+    return ssio.to_uint8(x)
+
+
+def _write_text(path: str, text: str) -> None:
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)

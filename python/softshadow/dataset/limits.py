@@ -1,0 +1,37 @@
+"""The limits a dataset spec and a run must respect, in one place.
+
+A spec that exceeds one is refused on load, before any work, with the field
+named (docs/dataset.md lists them). They bound what a hostile or mistyped
+spec can make the machine do: allocate absurd images, loop for ever, or
+write outside ``--out``.
+"""
+
+from __future__ import annotations
+
+MAX_COUNT = 100_000_000
+"""Items per dataset (``count``, ``--count``); item names have 8 digits."""
+MAX_SIDE = 8192
+"""Pixels per side of the eye view and of the light-view maps."""
+MAX_SEED = 2**63 - 1
+"""The largest ``seed``."""
+MAX_OBJECT_ENTRIES = 64
+"""``[[objects]]`` tables per spec."""
+MAX_INSTANCES = 1000
+"""Instances one ``[[objects]]`` table may place per item (``count``, ``grid``)."""
+MAX_LIGHT_ENTRIES = 16
+"""``[[lights]]`` tables per spec."""
+MAX_MESH_FILES = 100_000
+"""Mesh files one folder may hold."""
+MAX_COORDINATE = 1.0e6
+"""Largest absolute world coordinate, distance, size or scale."""
+MAX_RETRIES = 100
+"""``--retries``."""
+MAX_WORKERS = 1024
+"""``--workers``."""
+MAX_NAME = 64
+"""Characters of ``outputs.folder``."""
+
+ITEM_DIGITS = 8
+"""Digits of an item's file name (``00000042``)."""
+SHARD = 1000
+"""Items per subfolder of ``outputs.folder`` (``00000`` holds items 0-999)."""

@@ -1,0 +1,281 @@
+"""``softshadow-dataset run``: make the items of a spec that ``--out`` lacks.
+
+The client (this process) opens the output folder (:class:`.manifest.Output`),
+lists the items still to make (the manifest's done items whose files exist
+are skipped; ``verify`` also re-hashes them), and hands them out with a
+bounded window of tasks in flight: to itself (one worker), to local
+processes (``ProcessPoolExecutor``, forkserver), or to Dask. Workers render
+and write their item's files (:func:`.item.make_item`); the client appends
+each result to the manifest, retries a failed item up to ``retries`` times
+on any worker, then records it as failed and goes on. A worker process that
+dies costs only the items it held: they are handed out again (the local
+pool is rebuilt; Dask's scheduler reschedules by itself). Errors of the
+output's storage (full disk, read-only or forbidden folder) stop the run:
+every further item would fail the same way.
+"""
+
+from __future__ import annotations
+
+import errno
+import multiprocessing
+import os
+import sys
+import time
+from collections import deque
+from collections.abc import Iterable
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from typing import Any
+
+from . import limits as L
+from .check import check_item
+from .files import sweep_temporaries
+from .item import item_files, make_item
+from .manifest import Output, StorageError, read_dataset, read_manifest
+from .spec import Spec
+
+STORAGE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOTDIR, errno.EFBIG}
+
+
+@dataclass
+class Summary:
+    done: int = 0
+    """Items made by this run."""
+    skipped: int = 0
+    """Items already complete."""
+    failed: dict[int, str] = field(default_factory=dict)
+    """Items that failed every attempt, with their last error."""
+    retried: int = 0
+    seconds: float = 0.0
+    workers: str = ""
+
+    @property
+    def items_per_second(self) -> float:
+        return self.done / self.seconds if self.seconds > 0 else 0.0
+
+    def __str__(self) -> str:
+        s = (
+            f"{self.done} items made, {self.skipped} skipped (already complete), {len(self.failed)} failed, "
+            f"{self.retried} retries; {self.seconds:.1f} s, {self.items_per_second:.2f} items/s ({self.workers})"
+        )
+        for k, err in list(self.failed.items())[:20]:
+            s += f"\n  item {k} failed: {err}"
+        return s
+
+
+def _error_text(e: BaseException) -> str:
+    return f"{type(e).__name__}: {e}"
+
+
+def storage_problem(e: BaseException) -> bool:
+    return isinstance(e, OSError) and e.errno in STORAGE_ERRNOS
+
+
+class _Book:
+    """The client's accounting: manifest lines, attempts, progress."""
+
+    def __init__(self, output: Output, retries: int, bar: Any, summary: Summary) -> None:
+        self.output, self.retries, self.bar, self.summary = output, retries, bar, summary
+        self.attempts: dict[int, int] = {}
+        self.finished: set[int] = set()
+
+    def done(self, k: int, result: dict[str, Any]) -> None:
+        if k in self.finished:  # a duplicate result (a task run twice): already counted
+            return
+        self.finished.add(k)
+        self.output.append({**result, "status": "done", "attempts": self.attempts.get(k, 0) + 1})
+        self.summary.done += 1
+        self.bar.update(1)
+
+    def failed_attempt(self, k: int, e: BaseException) -> bool:
+        """Records a failed attempt; True if item k should be tried again."""
+        if storage_problem(e):
+            assert isinstance(e, OSError)
+            where = f" writing {e.filename!r}" if e.filename else ""
+            raise StorageError(
+                f"out: cannot write{where}: {e.strerror or e} ({errno.errorcode.get(e.errno or 0, '?')}); "
+                f"{self.summary.done} items made by this run are complete; fix the folder and rerun to resume"
+            ) from e
+        n = self.attempts[k] = self.attempts.get(k, 0) + 1
+        if n <= self.retries:
+            self.summary.retried += 1
+            return True
+        self.finished.add(k)
+        self.summary.failed[k] = _error_text(e)
+        self.output.append({"k": k, "status": "failed", "error": _error_text(e), "attempts": n})
+        self.bar.update(1)
+        self.bar.set_postfix(failed=len(self.summary.failed))
+        return False
+
+
+def parse_items(text: str, count: int) -> list[int]:
+    """``"0-9,15"`` -> the sorted items, each below ``count``; ValueError naming ``items``."""
+    ks: set[int] = set()
+    for part in text.split(","):
+        lo_s, _, hi_s = part.strip().partition("-")
+        try:
+            lo = int(lo_s)
+            hi = int(hi_s) if hi_s else lo
+        except ValueError as e:
+            raise ValueError(f"items: {part!r} is not an item number or a range like 3-7") from e
+        if not 0 <= lo <= hi < count:
+            raise ValueError(f"items: {part!r} must lie within 0..{count - 1}")
+        if hi - lo >= L.MAX_COUNT:
+            raise ValueError(f"items: {part!r} is too long a range")
+        ks.update(range(lo, hi + 1))
+    return sorted(ks)
+
+
+def _item_folders(output: Output) -> list[str]:
+    folder = os.path.join(output.root, output.spec.outputs.folder)
+    try:
+        return [os.path.join(folder, d) for d in os.listdir(folder)]
+    except FileNotFoundError:
+        return []
+
+
+def complete_items(out: str, spec: Spec, *, verify: bool) -> set[int]:
+    """Items the manifest lists as done whose files are all there (and, with ``verify``, sound)."""
+    info = read_dataset(out)
+    done = set()
+    for k, rec in read_manifest(out).items():
+        if rec.get("status") != "done":
+            continue
+        if verify:
+            if check_item(out, info, k, rec) is None:
+                done.add(k)
+        elif set(rec.get("files", {})) == set(item_files(spec, k).values()) and all(
+            os.path.isfile(os.path.join(out, rel)) for rel in rec["files"]
+        ):
+            done.add(k)
+    return done
+
+
+def run(
+    spec: Spec,
+    out: str | os.PathLike[str],
+    *,
+    count: int | None = None,
+    items: Iterable[int] | None = None,
+    workers: int = 1,
+    threads: int | None = None,
+    dask: Any = None,
+    retries: int = 2,
+    window: int | None = None,
+    verify: bool = False,
+    progress: bool = True,
+) -> Summary:
+    """Makes the missing items of ``spec`` in ``out``; returns the summary.
+
+    ``dask``: None (local), ``"local"`` (a LocalCluster of ``workers``
+    processes), a scheduler address, or a ``distributed.Client``.
+    ``threads``: the core's threads per item (default: the cores divided
+    among the local workers; 1 per Dask task on a cluster you give).
+    Raises StorageError when the folder cannot take files, OutputError or
+    SpecError when it cannot be used at all.
+    """
+    count = spec.count if count is None else count
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= L.MAX_COUNT:
+        raise ValueError(f"count: must be an integer in [1, {L.MAX_COUNT}], got {count!r}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= L.MAX_WORKERS:
+        raise ValueError(f"workers: must be an integer in [1, {L.MAX_WORKERS}], got {workers!r}")
+    if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= L.MAX_RETRIES:
+        raise ValueError(f"retries: must be an integer in [0, {L.MAX_RETRIES}], got {retries!r}")
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
+        raise ValueError(f"threads: must be a positive integer, got {threads!r}")
+    wanted = list(range(count)) if items is None else sorted(set(items))
+    if wanted and not 0 <= wanted[0] <= wanted[-1] < count:
+        raise ValueError(f"items: must lie within 0..{count - 1}")
+    from tqdm import tqdm  # type: ignore[import-untyped]
+
+    with Output(os.fspath(out), spec, count) as output:
+        sweep_temporaries(_item_folders(output))  # the lock is ours: no writer is running
+        done = complete_items(output.root, spec, verify=verify)
+        todo = [k for k in wanted if k not in done]
+        summary = Summary(skipped=len(wanted) - len(todo))
+        t0 = time.perf_counter()
+        with tqdm(total=len(todo), unit="item", desc="items", disable=not progress, file=sys.stderr) as bar:
+            book = _Book(output, retries, bar, summary)
+            try:
+                if dask is not None:
+                    from .dask_runner import run_dask
+
+                    summary.workers = run_dask(book, spec, output.root, todo, dask, workers, threads, window)
+                elif workers == 1:
+                    summary.workers = _run_serial(book, spec, output.root, todo, threads)
+                else:
+                    summary.workers = _run_pool(book, spec, output.root, todo, workers, threads, window)
+            finally:
+                summary.seconds = time.perf_counter() - t0
+        sweep_temporaries(_item_folders(output))
+    return summary
+
+
+def _run_serial(book: _Book, spec: Spec, out: str, todo: list[int], threads: int | None) -> str:
+    for k in todo:
+        while True:
+            try:
+                book.done(k, make_item(spec, out, k, threads))
+            except Exception as e:
+                if book.failed_attempt(k, e):
+                    continue
+            break
+    return "1 local worker"
+
+
+def default_threads(workers: int) -> int:
+    """The cores shared among the workers (at least 1 each)."""
+    return max(1, (os.cpu_count() or 1) // workers)
+
+
+def _init_worker(threads: int) -> None:
+    os.environ["SOFTSHADOW_THREADS"] = str(threads)
+
+
+def _run_pool(
+    book: _Book, spec: Spec, out: str, todo: list[int], workers: int, threads: int | None, window: int | None
+) -> str:
+    threads = threads or default_threads(workers)
+    window = window or 2 * workers
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    context = multiprocessing.get_context(method)
+    pending = deque(todo)
+    inflight: dict[Future[dict[str, Any]], int] = {}
+
+    def new_pool() -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(threads,))
+
+    pool = new_pool()
+    try:
+        while pending or inflight:
+            while pending and len(inflight) < window:
+                k = pending.popleft()
+                inflight[pool.submit(make_item, spec, out, k, threads)] = k
+            finished, _ = wait(inflight, return_when=FIRST_COMPLETED)
+            broken = False
+            for fut in finished:
+                k = inflight.pop(fut)
+                try:
+                    result = fut.result()
+                except BrokenProcessPool as e:
+                    broken = True
+                    if book.failed_attempt(k, RuntimeError(f"a worker process died ({e})")):
+                        pending.appendleft(k)
+                except Exception as e:
+                    if book.failed_attempt(k, e):
+                        pending.appendleft(k)
+                else:
+                    book.done(k, result)
+            if broken:  # every task still held by the dead pool is lost: hand them out again
+                pool.shutdown(wait=True, cancel_futures=True)
+                for fut, k in list(inflight.items()):
+                    if fut.done() and not fut.cancelled() and fut.exception() is None:
+                        book.done(k, fut.result())
+                    else:
+                        pending.appendleft(k)
+                inflight.clear()
+                pool = new_pool()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+    return f"{workers} local processes x {threads} threads"
