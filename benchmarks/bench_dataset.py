@@ -1,10 +1,11 @@
 """Dataset items per second: softshadow's methods against the Mitsuba reference as a teacher, at equal error.
 
     python benchmarks/bench_dataset.py [--spec examples/shadows_ground.toml] [--count 40] [--workers 2]
-        [--error-items 4] [--reference-samples 1024] [--resolution 640 480] [--map-resolution 256] [--no-write]
+        [--error-items 4] [--reference-samples 1024] [--resolution 640 480] [--map-resolution 0] [--no-write]
 
 The items of an example spec (``--resolution`` eye view, light-view maps of
-``--map-resolution``²), made by ``softshadow.dataset.run`` as the command
+``--map-resolution``², or by default sized from the pixels' footprint as
+``render`` sizes them), made by ``softshadow.dataset.run`` as the command
 makes them (EXR and JSON written, manifest fsynced), with the default
 method (``auto``) and with ``bitmask``, and by the Mitsuba reference
 (``method.name = "reference"``, the teacher) at several sample counts; each
@@ -131,19 +132,31 @@ def main() -> None:
     p.add_argument("--error-items", type=int, default=4)
     p.add_argument("--reference-samples", type=int, default=1024)
     p.add_argument("--resolution", type=int, nargs=2, default=(640, 480), metavar=("W", "H"))
-    p.add_argument("--map-resolution", type=int, default=256)
+    p.add_argument(
+        "--map-resolution",
+        type=int,
+        default=0,
+        help="the map methods' light-view maps (side); 0: sized from the pixels' footprint, as render does by default",
+    )
     add_output_arguments(p, DOCS / "dataset.md")
     args = p.parse_args()
     res = (args.resolution[0], args.resolution[1])
     threads = default_threads(args.workers)
     report = Report(
-        f"Dataset items per second ({res[0]}×{res[1]}, maps {args.map_resolution}²)", command_line(__file__)
+        f"Dataset items per second ({res[0]}×{res[1]}, "
+        + (f"maps {args.map_resolution}²)" if args.map_resolution else "maps sized from the pixels' footprint)"),
+        command_line(__file__),
     )
     text = args.spec.read_text()
     with tempfile.TemporaryDirectory(prefix="bench_specs_") as tmp:
         folder = Path(tmp)
+        maps = f"\nmap_resolution = {args.map_resolution}" if args.map_resolution else ""
         specs = {
-            name: spec_for(variant(text, f"{block}\nmap_resolution = {args.map_resolution}", res), folder, name)
+            name: spec_for(
+                variant(text, block + maps, res),
+                folder,
+                name,
+            )
             for name, block in METHODS.items()
         }
         teachers = {
