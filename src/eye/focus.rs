@@ -7,6 +7,9 @@
 //!   (size L) lies within tangent r + (L/2)(1/zO - 1/zR) of the axis
 //!   (extent.rs), so `fit_extent` over the occluders in front of the light
 //!   and the visible points bounds every texel that can shadow a pixel.
+//!   The occluders are the meshes that can shadow a visible point
+//!   (casters.rs), and the extent holds them and their reach only: a point
+//!   beyond every occluder's reach finds no texel near it and is lit.
 //!   Occluders nearer the light than `NEAREST_OCCLUDER` of the nearest
 //!   visible point's depth would widen it without bound (a wall meeting a
 //!   ceiling light): the reach is cut there, and such occluders are seen
@@ -78,11 +81,18 @@ pub fn focused_extent(
             }
         })
         .collect();
-    let mut e = fit_extent_within(&occ, &points.bounds, light_size)?;
-    // The points themselves, with a texel's margin for the bias (mod.rs).
-    for (e, t) in e.iter_mut().zip(points.bounds.tangent) {
-        *e = e.max(t);
+    if occ.is_empty() {
+        // Nothing casts a shadow (casters.rs): the points' own extent.
+        return Ok(points
+            .bounds
+            .tangent
+            .map(|t| (t * 1.01).clamp(1e-6, MAX_EXTENT)));
     }
+    // Only the occluders and their reach: a visible point beyond every
+    // occluder's reach finds no texel near it and is lit, so points need no
+    // texels of their own (visible ground reaching toward the light's plane
+    // once widened the maps to tangents of 40-56, docs/eye_view.md).
+    let e = fit_extent_within(&occ, &points.bounds, light_size)?;
     Ok(e.map(|t| (t * 1.01).min(MAX_EXTENT)))
 }
 

@@ -213,11 +213,12 @@ pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
         }
         sw.lap("shadow");
     } else if !f.points.is_empty() {
-        let (grid, m) = eye::map_grid(call, &gb, &f, Backend::Gpu)?;
+        let casting = eye::casting_faces(call, &scene, &f, &gb);
+        let (grid, m) = eye::map_grid(call, &gb, &f, &casting, Backend::Gpu)?;
         method = m;
         check_side("map_resolution", (grid.width, grid.height))?;
         sw.lap("extent");
-        let tris = eye::light_triangles(&mut f, &scene);
+        let tris = eye::light_triangles(&mut f, &casting);
         let kernel = method.kernel();
         let (v, m, t) = match (kernel, super::smoothies::options(kernel)) {
             // The one-layer methods' own kernels after the front layer
