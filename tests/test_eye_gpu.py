@@ -13,8 +13,6 @@ renders on the CPU.
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 
@@ -35,15 +33,6 @@ LIGHTS = {
     "rect": ss.RectLight(center=(0.3, 4.0, 0.2), normal=(0.0, -1.0, 0.0), up=(0.0, 0.0, 1.0), size=(1.0, 0.6)),
     "sun": ss.DirectionalLight(direction=(0.8, -0.7, -0.3), up=(0.0, 0.0, 1.0), angular_size=(2.0, 2.0)),
 }
-
-
-@pytest.fixture(scope="module")
-def gpu():
-    if not ss.gpu_available():
-        if os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1":
-            pytest.fail("SOFTSHADOW_REQUIRE_GPU=1 but no GPU adapter opens (is mesa-vulkan-drivers installed?)")
-        pytest.skip("no GPU adapter")
-    return ss.gpu_info()
 
 
 @pytest.fixture(scope="module")

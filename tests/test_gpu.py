@@ -8,7 +8,6 @@ renders on the CPU.
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -19,15 +18,6 @@ import softshadow as ss
 from softshadow import scenes
 
 SCENES = ["bunny_floating", "bunny_on_floor", "square_plate", "torus_floating", "two_spheres"]
-
-
-@pytest.fixture(scope="module")
-def gpu():
-    if not ss.gpu_available():
-        if os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1":
-            pytest.fail("SOFTSHADOW_REQUIRE_GPU=1 but no GPU adapter opens (is mesa-vulkan-drivers installed?)")
-        pytest.skip("no GPU adapter")
-    return ss.gpu_info()
 
 
 def silhouette_texels(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -1,10 +1,10 @@
 """EXR/PNG writing and the demo (the README's main job: the eye view beside Mitsuba) end to end."""
 
 import struct
-import zlib
 
 import numpy as np
 import pytest
+from _png import decode_grey_png
 
 from softshadow import io
 from softshadow.experiments.demo import main
@@ -12,23 +12,7 @@ from softshadow.experiments.demo import main
 
 def read_png_grey(path):
     with open(path, "rb") as f:
-        data = f.read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    pos, idat, ihdr = 8, b"", None
-    while pos < len(data):
-        (n,) = struct.unpack(">I", data[pos : pos + 4])
-        tag, body = data[pos + 4 : pos + 8], data[pos + 8 : pos + 8 + n]
-        crc = struct.unpack(">I", data[pos + 8 + n : pos + 12 + n])[0]
-        assert crc == zlib.crc32(tag + body) & 0xFFFFFFFF
-        if tag == b"IHDR":
-            ihdr = struct.unpack(">IIBBBBB", body)
-        elif tag == b"IDAT":
-            idat += body
-        pos += 12 + n
-    w, h = ihdr[:2]
-    raw = zlib.decompress(idat)
-    rows = [raw[j * (w + 1) + 1 : (j + 1) * (w + 1)] for j in range(h)]
-    return np.frombuffer(b"".join(rows), np.uint8).reshape(h, w)
+        return decode_grey_png(f.read())
 
 
 def test_png_round_trip(tmp_path):

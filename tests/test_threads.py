@@ -9,14 +9,12 @@ SOFTSHADOW_REQUIRE_GPU rule.
 
 from __future__ import annotations
 
-import os
 import random
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
-import pytest
 
 import softshadow as ss
 from softshadow import eye_scenes, scenes
@@ -105,15 +103,6 @@ def run_concurrently(calls: list[tuple[str, Callable[[], Any]]]) -> dict[str, An
 def test_concurrent_calls_on_the_cpu_match_serial_ones():
     first = run_concurrently(light_view_calls("cpu") + eye_view_calls("cpu"))
     assert {r.backend for r in first.values()} == {"cpu"}
-
-
-@pytest.fixture(scope="module")
-def gpu():
-    if not ss.gpu_available():
-        if os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1":
-            pytest.fail("SOFTSHADOW_REQUIRE_GPU=1 but no GPU adapter opens (is mesa-vulkan-drivers installed?)")
-        pytest.skip("no GPU adapter")
-    return ss.gpu_info()
 
 
 def test_concurrent_calls_on_the_gpu_match_serial_ones(gpu):

@@ -49,20 +49,14 @@ pub(crate) fn casters(
             planes[m] = Some((t[0], c / a, 0.0));
         }
     }
-    // Planar: every corner within the tolerance of that plane.
+    // Planar: every corner within the tolerance of that plane (and the
+    // mesh's size, which scales the tolerance).
     let mut size = vec![0f64; meshes];
-    for (t, &m) in scene.corners.iter().zip(&scene.mesh_of) {
-        let m = m as usize;
-        if let Some((p0, _, _)) = planes[m] {
-            for c in t {
-                size[m] = size[m].max((*c - p0).length());
-            }
-        }
-    }
     for (t, &m) in scene.corners.iter().zip(&scene.mesh_of) {
         let m = m as usize;
         if let Some((p0, n, off)) = planes[m] {
             let d = t.iter().map(|c| n.dot(*c - p0).abs()).fold(off, f64::max);
+            size[m] = t.iter().map(|c| (*c - p0).length()).fold(size[m], f64::max);
             planes[m] = Some((p0, n, d));
         }
     }
@@ -94,11 +88,7 @@ pub(crate) fn casters(
 fn lit_side(light: &Light, p0: DVec3, n: DVec3, tol: f64) -> Option<DVec3> {
     match light {
         Light::Rect(l) => {
-            let (hu, hv) = (0.5 * l.size[0] * l.u, 0.5 * l.size[1] * l.v);
-            let d: Vec<f64> = [hu + hv, hu - hv, -hu + hv, -hu - hv]
-                .iter()
-                .map(|o| n.dot(l.center + *o - p0))
-                .collect();
+            let d = l.corners().map(|c| n.dot(c - p0));
             if d.iter().all(|&x| x > tol) {
                 Some(n)
             } else if d.iter().all(|&x| x < -tol) {

@@ -49,6 +49,7 @@ use crate::threads;
 use gbuffer::SceneTriangles;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// The default biases of the map methods (texels), measured by
 /// `benchmarks/bench_bias.py` (docs/benchmarks/bias.md) on the four
@@ -332,17 +333,17 @@ pub(crate) fn traced_triangles(f: &Framed, scene: &SceneTriangles) -> Vec<[Vec3;
 /// reads the depth of the receiver behind each silhouette from the map
 /// (without the floor there, its error on contact_boxes went from under
 /// 0.1 to 0.26).
-pub(crate) fn casting_faces(
+pub(crate) fn casting_faces<'s>(
     call: &EyeCall,
-    scene: &SceneTriangles,
+    scene: &'s SceneTriangles,
     f: &Framed,
     g: &GBuffer,
-) -> Vec<[u32; 3]> {
+) -> Cow<'s, [[u32; 3]]> {
     if matches!(
         call.method.kernel(),
         crate::methods::Method::Smoothies { .. }
     ) {
-        return scene.faces.clone();
+        return Cow::Borrowed(&scene.faces);
     }
     let point_mesh: Vec<i32> = f.hits.iter().map(|&k| g.mesh_id[k]).collect();
     let casts = casters::casters(scene, call.light, &f.points, &point_mesh);
@@ -352,7 +353,8 @@ pub(crate) fn casting_faces(
         .zip(&scene.mesh_of)
         .filter(|(_, &m)| casts[m as usize])
         .map(|(t, _)| *t)
-        .collect()
+        .collect::<Vec<_>>()
+        .into()
 }
 
 /// The map methods' occluder grid (focused on what the occluders `faces`

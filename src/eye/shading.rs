@@ -197,18 +197,6 @@ impl Lighting {
     }
 }
 
-/// The rectangle's corners in the order of the module doc.
-fn corners(l: &RectLight) -> [DVec3; 4] {
-    let hu = 0.5 * l.size[0] * l.u;
-    let hv = 0.5 * l.size[1] * l.v;
-    [
-        l.center - hu - hv,
-        l.center + hu - hv,
-        l.center + hu + hv,
-        l.center - hu + hv,
-    ]
-}
-
 /// Irradiance at `x` (normal `n`, unit) from a rectangle of unit radiance:
 /// Lambert's polygon formula after horizon clipping (module doc).
 pub fn rect_irradiance(l: &RectLight, x: DVec3, n: DVec3) -> f64 {
@@ -218,7 +206,7 @@ pub fn rect_irradiance(l: &RectLight, x: DVec3, n: DVec3) -> f64 {
     // Sutherland–Hodgman against n · p >= 0, p relative to x.
     let mut clipped = [DVec3::ZERO; 8];
     let mut m = 0;
-    let p = corners(l).map(|c| c - x);
+    let p = l.corners().map(|c| c - x);
     for i in 0..4 {
         let (a, b) = (p[i], p[(i + 1) % 4]);
         let (da, db) = (n.dot(a), n.dot(b));

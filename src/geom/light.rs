@@ -93,6 +93,19 @@ pub(crate) fn light_frame(
 }
 
 impl RectLight {
+    /// The rectangle's corners, counter-clockwise seen from the side it
+    /// lights (−u−v, +u−v, +u+v, −u+v).
+    pub fn corners(&self) -> [DVec3; 4] {
+        let hu = 0.5 * self.size[0] * self.u;
+        let hv = 0.5 * self.size[1] * self.v;
+        [
+            self.center - hu - hv,
+            self.center + hu - hv,
+            self.center + hu + hv,
+            self.center - hu + hv,
+        ]
+    }
+
     /// Builds the light frame, refusing degenerate input.
     pub fn new(center: [f64; 3], normal: [f64; 3], up: [f64; 3], size: [f64; 2]) -> Result<Self> {
         let c = finite3("center", center)?;
