@@ -25,6 +25,7 @@ from typing import Any
 
 from . import limits as L
 from .fields import IntRange, Range, SpecError, Table
+from .files import sha256_file
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -204,7 +205,7 @@ def parse_spec(data: dict[str, Any], *, text: str = "", folder: str = ".") -> Sp
     method = _method(top.table("method"))
     outputs = _outputs(top.table("outputs"), method)
     top.done()
-    hashes = {f: _sha256_file(f) for o in objects for f in o.files}
+    hashes = {f: sha256_file(f) for o in objects for f in o.files}
     return Spec(seed, count, ground, objects, lights, camera, method, outputs, text, folder, hashes)
 
 
@@ -312,14 +313,6 @@ def _mesh_files(name: str, path: str, folder: str) -> tuple[str, ...]:
             raise SpecError(f"{name}: folder {path!r} holds no mesh file ({sorted(MESH_EXTENSIONS)})")
         return tuple(found)
     raise SpecError(f"{name}: no such file or folder {path!r} (relative paths start at the spec's folder {folder!r})")
-
-
-def _sha256_file(path: str) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _light(t: Table) -> LightSpec:
