@@ -1,11 +1,13 @@
 """Dataset items per second: softshadow's methods against the Mitsuba reference as a teacher, at equal error.
 
     python benchmarks/bench_dataset.py [--spec examples/shadows_ground.toml] [--count 40] [--workers 2]
-        [--error-items 4] [--reference-samples 1024] [--resolution 640 480] [--map-resolution 0] [--no-write]
+        [--error-items 4] [--reference-samples 1024] [--resolution 640 480] [--map-resolution 0]
+        [--light-maps] [--out docs/benchmarks/dataset.md] [--no-write]
 
 The items of an example spec (``--resolution`` eye view, light-view maps of
 ``--map-resolution``², or by default sized from the pixels' footprint as
-``render`` sizes them), made by ``softshadow.dataset.run`` as the command
+``render`` sizes them; with ``--light-maps`` every item of a map method also
+holds those maps, the spec's ``light_maps = true``), made by ``softshadow.dataset.run`` as the command
 makes them (EXR and JSON written, manifest fsynced), with the default
 method (``auto``) and with ``bitmask``, and by the Mitsuba reference
 (``method.name = "reference"``, the teacher) at several sample counts; each
@@ -47,15 +49,21 @@ TEACHER_SAMPLES = (1, 4, 16, 64, 256)
 METHODS = {"auto": 'name = "auto"', "bitmask": 'name = "bitmask"'}
 
 
-def variant(text: str, method_block: str, resolution: tuple[int, int]) -> str:
-    """The example's text with another [method] table, the resolution and no previews."""
+def variant(text: str, method_block: str, resolution: tuple[int, int], light_maps: bool = False) -> str:
+    """The example's text with another [method] table, the resolution, no
+    previews and, with ``light_maps``, the light-view maps in every item."""
     head, sep, rest = text.partition("\n[method]\n")
     if not sep:
         raise SystemExit("spec: the example needs a [method] table")
     rest = rest[rest.find("\n[") + 1 :] if "\n[" in rest else ""
     text = f"{head}\n[method]\n{method_block}\n\n{rest}"
     text = re.sub(r"(?m)^resolution = \[.*\]", f"resolution = [{resolution[0]}, {resolution[1]}]", text)
-    return re.sub(r"(?m)^previews = true", "previews = false", text)
+    text = re.sub(r"(?m)^previews = true", "previews = false", text)
+    if light_maps:
+        if "\n[outputs]\n" not in text:
+            text += "\n[outputs]\n"
+        text = text.replace("\n[outputs]\n", "\n[outputs]\nlight_maps = true\n", 1)
+    return text
 
 
 def spec_for(text: str, folder: Path, name: str) -> Spec:
@@ -138,13 +146,19 @@ def main() -> None:
         default=0,
         help="the map methods' light-view maps (side); 0: sized from the pixels' footprint, as render does by default",
     )
+    p.add_argument(
+        "--light-maps",
+        action="store_true",
+        help="the map methods' items also hold their light-view maps (the teacher makes none)",
+    )
     add_output_arguments(p, DOCS / "dataset.md")
     args = p.parse_args()
     res = (args.resolution[0], args.resolution[1])
     threads = default_threads(args.workers)
     report = Report(
         f"Dataset items per second ({res[0]}×{res[1]}, "
-        + (f"maps {args.map_resolution}²)" if args.map_resolution else "maps sized from the pixels' footprint)"),
+        + (f"maps {args.map_resolution}²" if args.map_resolution else "maps sized from the pixels' footprint")
+        + (", light-view maps written)" if args.light_maps else ")"),
         command_line(__file__),
     )
     text = args.spec.read_text()
@@ -153,7 +167,7 @@ def main() -> None:
         maps = f"\nmap_resolution = {args.map_resolution}" if args.map_resolution else ""
         specs = {
             name: spec_for(
-                variant(text, block + maps, res),
+                variant(text, block + maps, res, args.light_maps),
                 folder,
                 name,
             )

@@ -137,6 +137,27 @@ def test_record_rebuilds_the_item_and_files_hold_the_channels(tmp_path):
     assert int(channels["mesh_id"].max()) == len(record["objects"])
 
 
+def test_zstd_items_hold_the_zip_items_pixels_and_only_that_spec_hash_changes(tmp_path):
+    zip_spec = load_spec(write_spec(tmp_path, name="zip.toml"))
+    zstd_spec = load_spec(
+        write_spec(tmp_path, SMALL.replace("[outputs]\n", '[outputs]\ncompression = "zstd"\n'), "zstd.toml")
+    )
+    assert zstd_spec.outputs.compression == "zstd" and zip_spec.outputs.compression == "zip"
+    # Different bytes, so another spec; the default leaves the hash it had before the field.
+    assert zstd_spec.hash != zip_spec.hash
+    assert "compression" not in zip_spec.canonical()["outputs"]
+    for name, spec in (("zip", zip_spec), ("zstd", zstd_spec)):
+        run(spec, tmp_path / name, count=1, progress=False)
+        assert check_output(str(tmp_path / name)).ok
+    base = Path("items") / "00000" / "00000000"
+    a, b = (io.read_exr(tmp_path / n / base.with_suffix(".exr")) for n in ("zip", "zstd"))
+    assert sorted(a) == sorted(b)
+    for name in a:
+        np.testing.assert_array_equal(a[name], b[name])
+    maps = [io.read_exr(tmp_path / n / (str(base) + ".maps.exr")) for n in ("zip", "zstd")]
+    np.testing.assert_array_equal(maps[0]["layer0"], maps[1]["layer0"])
+
+
 def test_spec_is_stored_and_another_spec_is_refused(tmp_path):
     spec = load_spec(write_spec(tmp_path))
     out = tmp_path / "out"

@@ -147,12 +147,12 @@ def test_a_full_or_forbidden_disk_stops_the_run_and_nothing_half_written_counts(
     real = softshadow.io.write_exr
     writes = []
 
-    def failing(path, channels):
+    def failing(path, channels, **kw):
         writes.append(path)
         if len(writes) == 3:
             Path(path).write_bytes(b"\x76\x2f\x31\x01 half")  # a partial file, then the error
             raise OSError(code, os.strerror(code), str(path))
-        real(path, channels)
+        real(path, channels, **kw)
 
     monkeypatch.setattr(softshadow.io, "write_exr", failing)
     out = tmp_path / "out"
@@ -173,7 +173,7 @@ def test_a_full_or_forbidden_disk_stops_the_run_and_nothing_half_written_counts(
 def test_the_cli_reports_a_full_disk(tmp_path, monkeypatch, capsys):
     spec_path = write_spec(tmp_path)
 
-    def full(path, channels):
+    def full(path, channels, **kw):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
 
     monkeypatch.setattr(softshadow.io, "write_exr", full)
@@ -302,6 +302,8 @@ HOSTILE = [
     (_set("outputs.folder", "manifest.jsonl"), "outputs.folder"),
     (_set("outputs.channels", ["visibility", "colour"]), "outputs.channels: unknown channel 'colour'"),
     (_set("outputs.previews", "yes"), "outputs.previews: must be true or false"),
+    (_set("outputs.compression", "lzma"), r"outputs.compression: must be one of \['none', 'zip', 'zstd'\], got 'lzma'"),
+    (_set("outputs.compression", 3), "outputs.compression: must be a string"),
     (_set("method.name", "fastest"), r"method.name: must be one of \['ssm', 'bitmask'"),
     (_set("method.options", {"samples": 3}), "method.options.samples: bitmask takes one of"),
     (_set("method.options", {"sample": 3}), "method.options.sample: unknown option of 'bitmask'"),

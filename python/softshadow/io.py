@@ -17,23 +17,52 @@ def _as_map(name: str, a: Any) -> np.ndarray:
     return arr
 
 
-def write_exr(path: str | os.PathLike[str], channels: dict[str, Any] | Any) -> None:
+#: EXR compressions by the name ``compression=`` takes, each lossless:
+#: OpenEXR's attribute for it and the first OpenEXR version that reads it.
+EXR_COMPRESSIONS = {
+    "zip": ("ZIP_COMPRESSION", "1.0"),
+    "zstd": ("ZSTD_COMPRESSION", "3.5"),
+    "none": ("NO_COMPRESSION", "1.0"),
+}
+
+
+def exr_compression(compression: str) -> Any:
+    """OpenEXR's constant for ``compression`` (a key of ``EXR_COMPRESSIONS``),
+    or ValueError naming ``compression`` when the name or the installed
+    OpenEXR does not have it."""
+    import OpenEXR
+
+    if compression not in EXR_COMPRESSIONS:
+        raise ValueError(f"compression: must be one of {sorted(EXR_COMPRESSIONS)}, got {compression!r}")
+    attr, since = EXR_COMPRESSIONS[compression]
+    if not hasattr(OpenEXR, attr):
+        raise ValueError(
+            f"compression: {compression!r} needs OpenEXR >= {since}, "
+            f"installed {getattr(OpenEXR, '__version__', 'unknown')}"
+        )
+    return getattr(OpenEXR, attr)
+
+
+def write_exr(path: str | os.PathLike[str], channels: dict[str, Any] | Any, *, compression: str = "zip") -> None:
     """Writes one or more (H, W) maps as float32 channels of an EXR file.
 
     ``channels`` is a map (written as channel ``"Y"``) or a dict of name -> map.
-    Needs the ``OpenEXR`` package (``pip install softshadow[io]``).
+    ``compression`` (lossless): ``"zip"`` (read by every EXR reader),
+    ``"zstd"`` (smaller and faster to write; read by OpenEXR 3.5 and later
+    only) or ``"none"``. Needs the ``OpenEXR`` package (``pip install softshadow[io]``).
     """
     try:
         import OpenEXR
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise ImportError("write_exr needs OpenEXR: pip install softshadow[io]") from e
+    mode = exr_compression(compression)
     if not isinstance(channels, dict):
         channels = {"Y": channels}
     data = {k: np.ascontiguousarray(_as_map(f"channels[{k!r}]", v), dtype=np.float32) for k, v in channels.items()}
     shapes = {v.shape for v in data.values()}
     if len(shapes) != 1:
         raise ValueError(f"channels: all maps must share one shape, got {sorted(shapes)}")
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    header = {"compression": mode, "type": OpenEXR.scanlineimage}
     folder = os.path.dirname(os.path.abspath(os.fspath(path)))
     if not os.path.isdir(folder):
         raise FileNotFoundError(f"path: folder {folder!r} does not exist")

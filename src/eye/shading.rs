@@ -203,10 +203,20 @@ pub fn rect_irradiance(l: &RectLight, x: DVec3, n: DVec3) -> f64 {
     if (x - l.center).dot(l.n) <= 0.0 || l.size[0] * l.size[1] == 0.0 {
         return 0.0;
     }
-    // Sutherland–Hodgman against n · p >= 0, p relative to x.
+    let p = l.corners().map(|c| c - x);
+    if p.iter().all(|&q| n.dot(q) >= 0.0) {
+        // The whole light above the horizon (most pixels): no clipping.
+        return unclipped_quad(&p, n);
+    }
+    clipped_quad(&p, n)
+}
+
+/// The polygon formula for the quad with corners `p` (relative to the
+/// point) clipped to the point's upper hemisphere (normal `n`).
+fn clipped_quad(p: &[DVec3; 4], n: DVec3) -> f64 {
+    // Sutherland–Hodgman against n · p >= 0.
     let mut clipped = [DVec3::ZERO; 8];
     let mut m = 0;
-    let p = l.corners().map(|c| c - x);
     for i in 0..4 {
         let (a, b) = (p[i], p[(i + 1) % 4]);
         let (da, db) = (n.dot(a), n.dot(b));
@@ -227,11 +237,80 @@ pub fn rect_irradiance(l: &RectLight, x: DVec3, n: DVec3) -> f64 {
         // An edge through x's line of sight (or of no length) subtends no
         // solid angle.
         if s > 0.0 {
-            let theta = s.atan2(a.dot(b));
-            sum += theta * n.dot(c) / s;
+            sum += angle(s, a.dot(b)) * n.dot(c) / s;
         }
     }
     (0.5 * sum).max(0.0)
+}
+
+/// The polygon formula for a quad wholly above the horizon (corners `p`
+/// relative to the point, normal `n`), its four edges side by side: the
+/// same terms as the general loop, in arrays that the compiler keeps in
+/// vector registers (the edges' square roots and divisions issue together
+/// instead of one after the other: profiled, they were the shading stage's
+/// latency).
+#[inline]
+#[allow(clippy::needless_range_loop)] // one index over several edge arrays
+fn unclipped_quad(p: &[DVec3; 4], n: DVec3) -> f64 {
+    let (mut s, mut d, mut nc) = ([0f64; 4], [0f64; 4], [0f64; 4]);
+    for i in 0..4 {
+        let (a, b) = (p[i], p[(i + 1) % 4]);
+        let c = a.cross(b);
+        s[i] = c.length_squared();
+        d[i] = a.dot(b);
+        nc[i] = n.dot(c);
+    }
+    let mut sum = 0.0;
+    for i in 0..4 {
+        let len = s[i].sqrt();
+        // An edge through the point's line of sight subtends no solid angle.
+        let term = angle(len, d[i]) * nc[i] / len;
+        sum += if len > 0.0 { term } else { 0.0 };
+    }
+    (0.5 * sum).max(0.0)
+}
+
+/// atan(u) ≈ u · P(u²) on |u| <= tan(π/8): P's coefficients, a minimax
+/// fit of degree 4 (iteratively reweighted least squares on 200 001
+/// points; the largest error is 7.3e-9, far under the f32 images'
+/// resolution; `the_polynomial_angle_matches_atan2_in_every_octant`).
+const ATAN_P: [f64; 5] = [
+    0.999_999_982_479_900_4,
+    -0.333_328_083_409_261_5,
+    0.199_747_393_895_807_3,
+    -0.138_546_190_472_136_37,
+    0.079_941_733_917_503_21,
+];
+
+/// `s.atan2(c)` for s >= 0 (an angle in [0, π]) to within 1e-8: the
+/// polygon formula takes one per edge and pixel, and libm's atan2 was a
+/// third of the shading stage (profiled, 640×480). The octant of (c, s)
+/// brings the angle to atan(x/y) with 0 <= x <= y, and atan t = π/4 +
+/// atan((t-1)/(t+1)) to an argument within tan(π/8), one division either way.
+#[inline(always)]
+fn angle(s: f64, c: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+    // Selects rather than branches, so that edges side by side vectorize.
+    let ac = c.abs();
+    let swap = s > ac;
+    let (x, y) = (if swap { ac } else { s }, if swap { s } else { ac });
+    let big = x > (std::f64::consts::SQRT_2 - 1.0) * y;
+    let num = if big { x - y } else { x };
+    let den = if big { x + y } else { y };
+    // den = 0 only where s = c = 0: the angle 0.
+    let u = if den > 0.0 { num / den } else { 0.0 };
+    let z = u * u;
+    let p = ATAN_P[0] + z * (ATAN_P[1] + z * (ATAN_P[2] + z * (ATAN_P[3] + z * ATAN_P[4])));
+    // atan(x/y), in [0, π/4].
+    let a = if big { FRAC_PI_4 } else { 0.0 } + u * p;
+    if swap {
+        // |c| < s: θ within π/4 of π/2.
+        FRAC_PI_2 - a.copysign(c)
+    } else if c >= 0.0 {
+        a
+    } else {
+        PI - a
+    }
 }
 
 /// Irradiance on normal `n` (unit) from a sun of unit irradiance: the
@@ -306,22 +385,39 @@ pub struct Shaded {
 /// Shades every pixel of `g` that sees a surface (the G-buffer's position
 /// and camera-facing geometric normal) with its visibility `visibility`.
 pub fn shade(light: &Light, lighting: &Lighting, g: &GBuffer, visibility: &[f32]) -> Shaded {
-    let (unshadowed, shaded): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (0..g.len())
-        .into_par_iter()
-        .map(|k| {
-            let Ok(mesh) = usize::try_from(g.mesh_id[k]) else {
-                return ([0.0; 3], [0.0; 3]);
-            };
-            let x = DVec3::from_array(g.position[k]);
-            let n = DVec3::from_array(g.normal[k].map(f64::from)).normalize_or_zero();
-            let e = irradiance(light, x, n) / std::f64::consts::PI;
-            let v = f64::from(visibility[k]);
-            let rho = lighting.albedo[mesh];
-            let out: [f64; 3] = std::array::from_fn(|c| rho[c] * lighting.emission[c] * e);
-            (out.map(|o| o as f32), out.map(|o| (o * v) as f32))
-        })
-        .unzip();
-    Shaded { shaded, unshadowed }
+    /// Pixels per parallel task: a few rows of a 640-wide image.
+    const CHUNK: usize = 2048;
+    let n = g.len();
+    // Written in place, chunk by chunk: collecting a pair of outputs per
+    // pixel (`unzip`) went through rayon's linked lists of vectors.
+    let mut out = Shaded {
+        shaded: vec![[0.0; 3]; n],
+        unshadowed: vec![[0.0; 3]; n],
+    };
+    out.unshadowed
+        .par_chunks_mut(CHUNK)
+        .zip(out.shaded.par_chunks_mut(CHUNK))
+        .enumerate()
+        .for_each(|(chunk, (unshadowed, shaded))| {
+            let start = chunk * CHUNK;
+            for (i, (u, s)) in unshadowed.iter_mut().zip(shaded).enumerate() {
+                let k = start + i;
+                let Ok(mesh) = usize::try_from(g.mesh_id[k]) else {
+                    continue;
+                };
+                let x = DVec3::from_array(g.position[k]);
+                let normal = DVec3::from_array(g.normal[k].map(f64::from)).normalize_or_zero();
+                let e = irradiance(light, x, normal) / std::f64::consts::PI;
+                let v = f64::from(visibility[k]);
+                let rho = lighting.albedo[mesh];
+                for c in 0..3 {
+                    let o = rho[c] * lighting.emission[c] * e;
+                    u[c] = o as f32;
+                    s[c] = (o * v) as f32;
+                }
+            }
+        });
+    out
 }
 
 #[cfg(test)]
@@ -385,6 +481,47 @@ mod tests {
                 "{x} {n}: {got} vs {want}"
             );
         }
+    }
+
+    #[test]
+    fn the_polynomial_angle_matches_atan2_in_every_octant() {
+        let mut worst = 0f64;
+        for i in 0..=20_000 {
+            let phi = std::f64::consts::PI * i as f64 / 20_000.0;
+            for r in [1e-6, 0.3, 1.0, 7.0, 1e6] {
+                let (s, c) = (r * phi.sin().abs(), r * phi.cos());
+                worst = worst.max((angle(s, c) - s.atan2(c)).abs());
+            }
+        }
+        assert!(worst < 1e-8, "{worst}");
+        assert_eq!(angle(0.0, 0.0), 0.0);
+        assert_eq!(angle(0.0, -2.0), std::f64::consts::PI);
+        assert_eq!(angle(3.0, 0.0), std::f64::consts::FRAC_PI_2);
+    }
+
+    #[test]
+    fn the_unclipped_fast_path_agrees_with_the_clipping_loop() {
+        let l = light();
+        let mut checked = 0;
+        for i in 0..400 {
+            let f = i as f64;
+            let x = DVec3::new(
+                (f * 0.37).sin() * 3.0,
+                (f * 0.11).cos() - 0.5,
+                (f * 0.73).sin() * 2.0,
+            );
+            let n = DVec3::new((f * 1.3).sin() * 0.4, 1.0, (f * 0.7).cos() * 0.4).normalize();
+            let p = l.corners().map(|c| c - x);
+            if p.iter().all(|&q| n.dot(q) >= 0.0) {
+                let (fast, general) = (unclipped_quad(&p, n), clipped_quad(&p, n));
+                assert!(
+                    (fast - general).abs() <= 1e-12 * general.abs(),
+                    "{x} {n}: {fast} vs {general}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 100, "{checked}");
     }
 
     #[test]

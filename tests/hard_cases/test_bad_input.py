@@ -304,3 +304,6 @@ def test_io_errors_name_the_path_or_channel(tmp_path):
         io.read_exr(tmp_path / "text.exr")
     with pytest.raises(FileNotFoundError, match="path: .*no_dir"):
         io.write_exr(tmp_path / "no_dir" / "a.exr", np.zeros((2, 2)))
+    with pytest.raises(ValueError, match=r"compression: must be one of \['none', 'zip', 'zstd'\], got 'lzw'"):
+        io.write_exr(tmp_path / "a.exr", np.zeros((2, 2)), compression="lzw")
+    assert not (tmp_path / "a.exr").exists()

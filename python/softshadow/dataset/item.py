@@ -17,6 +17,7 @@ Item k's files, under ``outputs.folder`` in subfolders of 1000 items
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import json
 import os
@@ -53,16 +54,22 @@ def item_files(spec: Spec, k: int) -> dict[str, str]:
 
 def versions(spec: Spec) -> dict[str, str | None]:
     """The versions that made the item (mitsuba only for the reference)."""
+    return dict(_versions(spec.method.name == REFERENCE))
+
+
+@functools.lru_cache(maxsize=2)
+def _versions(mitsuba: bool) -> tuple[tuple[str, str | None], ...]:
+    """Read once per process: the package metadata took 4 ms an item."""
     import softshadow
 
-    names = ["trimesh", "OpenEXR"] + (["mitsuba"] if spec.method.name == REFERENCE else [])
+    names = ["trimesh", "OpenEXR"] + (["mitsuba"] if mitsuba else [])
     out: dict[str, str | None] = {"softshadow": softshadow.__version__, "numpy": np.__version__}
     for name in names:
         try:
             out[name] = importlib.metadata.version(name)
         except importlib.metadata.PackageNotFoundError:
             out[name] = None
-    return out
+    return tuple(out.items())
 
 
 def select_channels(all_channels: dict[str, np.ndarray], groups: tuple[str, ...]) -> dict[str, np.ndarray]:
@@ -142,11 +149,13 @@ def make_item(spec: Spec, out: str, k: int, threads: int | None = None) -> dict[
     record["channels"] = list(channels)
     record["shape"] = [h, w]
     record["files"] = {role: os.path.basename(rel) for role, rel in files.items()}
-    writers: dict[str, Any] = {files["exr"]: lambda p: ssio.write_exr(p, channels)}
+    mode = spec.outputs.compression
+    writers: dict[str, Any] = {files["exr"]: lambda p: ssio.write_exr(p, channels, compression=mode)}
     if "maps" in files:
         if not maps:
             raise RuntimeError(f"outputs.light_maps: method {spec.method.name!r} gave no light-view maps")
-        writers[files["maps"]] = lambda p: ssio.write_exr(p, {f"layer{i}": a for i, a in enumerate(maps)})
+        layers = {f"layer{i}": a for i, a in enumerate(maps)}
+        writers[files["maps"]] = lambda p: ssio.write_exr(p, layers, compression=mode)
     if "preview" in files:
         writers[files["preview"]] = lambda p: ssio.write_png(p, ssio.to_uint8(all_channels["V"]))
     if "shaded_preview" in files:

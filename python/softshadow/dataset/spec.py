@@ -13,6 +13,7 @@ horizontal plane.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import inspect
@@ -23,6 +24,7 @@ import sys
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from ..io import exr_compression
 from . import limits as L
 from .fields import IntRange, Range, SpecError, Table
 from .files import sha256_file
@@ -122,6 +124,7 @@ class OutputSpec:
     light_maps: bool
     previews: bool
     folder: str
+    compression: str = "zip"
 
 
 @dataclass(frozen=True)
@@ -150,11 +153,16 @@ class Spec:
             d.pop(name)
         for obj in d["objects"]:
             obj["files"] = [[self.relative(f), self.mesh_hashes[f]] for f in obj["files"]]
+        if d["outputs"]["compression"] == "zip":
+            # The default, left out so that specs from before the field
+            # keep their hash (and their output folders resume).
+            del d["outputs"]["compression"]
         return json.loads(json.dumps(d))
 
-    @property
+    @functools.cached_property
     def hash(self) -> str:
-        """sha256 of :meth:`canonical` (the spec's identity in ``--out``)."""
+        """sha256 of :meth:`canonical` (the spec's identity in ``--out``);
+        computed once per spec object (every item's record names it)."""
         text = json.dumps(self.canonical(), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()
 
@@ -482,6 +490,13 @@ def _outputs(t: Table, method: MethodSpec) -> OutputSpec:
             f"must be one plain folder name inside --out (letters, digits, '_', '-', '.'; not starting with '.'; "
             f"at most {L.MAX_NAME} characters; not one of {sorted(RESERVED_NAMES)}), got {folder!r}",
         )
-    o = OutputSpec(tuple(channels), light_maps, t.boolean("previews", False), folder)
+    compression = t.string("compression", "zip")
+    try:
+        exr_compression(compression)
+    except ValueError as e:
+        raise t.fail("compression", str(e).removeprefix("compression: ")) from None
+    except ImportError:
+        pass  # no OpenEXR: writing the first item says so
+    o = OutputSpec(tuple(channels), light_maps, t.boolean("previews", False), folder, compression)
     t.done()
     return o
