@@ -156,6 +156,12 @@ def test_zstd_items_hold_the_zip_items_pixels_and_only_that_spec_hash_changes(tm
         np.testing.assert_array_equal(a[name], b[name])
     maps = [io.read_exr(tmp_path / n / (str(base) + ".maps.exr")) for n in ("zip", "zstd")]
     np.testing.assert_array_equal(maps[0]["layer0"], maps[1]["layer0"])
+    # Each file says the compression it was written with.
+    openexr = pytest.importorskip("OpenEXR")
+    for name in ("zip", "zstd"):
+        for f in (base.with_suffix(".exr"), Path(str(base) + ".maps.exr")):
+            with openexr.File(str(tmp_path / name / f)) as exr:
+                assert exr.header()["compression"] == io.exr_compression(name), (name, f)
 
 
 def test_spec_is_stored_and_another_spec_is_refused(tmp_path):

@@ -375,13 +375,17 @@ pub(crate) fn map_grid(
             used[i as usize] = true;
         }
     }
-    let occluders: Vec<DVec3> = f
-        .verts
-        .iter()
-        .zip(&used)
-        .filter(|(_, &u)| u)
-        .map(|(q, _)| *q)
-        .collect();
+    // Every vertex in use (Smoothies, or every mesh can cast): no copy.
+    let occluders: Cow<[DVec3]> = if used.iter().all(|&u| u) {
+        Cow::Borrowed(&f.verts)
+    } else {
+        f.verts
+            .iter()
+            .zip(&used)
+            .filter(|(_, &u)| u)
+            .map(|(q, _)| *q)
+            .collect()
+    };
     let extent = match &visible {
         None => [1.0, 1.0],
         Some(v) => focus::focused_extent(&occluders, v, f.light_size)?,

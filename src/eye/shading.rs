@@ -244,11 +244,12 @@ fn clipped_quad(p: &[DVec3; 4], n: DVec3) -> f64 {
 }
 
 /// The polygon formula for a quad wholly above the horizon (corners `p`
-/// relative to the point, normal `n`), its four edges side by side: the
-/// same terms as the general loop, in arrays that the compiler keeps in
-/// vector registers (the edges' square roots and divisions issue together
-/// instead of one after the other: profiled, they were the shading stage's
-/// latency).
+/// relative to the point, normal `n`): the same terms as `clipped_quad`'s
+/// loop, computed edge by edge into arrays first, so that the four edges'
+/// square roots and divisions (the stage's latency, profiled) overlap
+/// instead of waiting on the running sum. The code stays scalar; on 300 000
+/// points it took 14.3 ms against the shared loop's 16.7 (a one-off timing
+/// test, three rounds, 2026-12-03).
 #[inline]
 #[allow(clippy::needless_range_loop)] // one index over several edge arrays
 fn unclipped_quad(p: &[DVec3; 4], n: DVec3) -> f64 {
@@ -290,7 +291,6 @@ const ATAN_P: [f64; 5] = [
 #[inline(always)]
 fn angle(s: f64, c: f64) -> f64 {
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
-    // Selects rather than branches, so that edges side by side vectorize.
     let ac = c.abs();
     let swap = s > ac;
     let (x, y) = (if swap { ac } else { s }, if swap { s } else { ac });
