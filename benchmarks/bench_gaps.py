@@ -172,8 +172,9 @@ def main(argv: list[str] | None = None) -> int:
                 f"{a.reference_samples}-sample Mitsuba references; *reference noise* is the same metric between "
                 "two such references with different seeds. *open*: the flat per-texel micro-patches; *closed* (the "
                 "default): connected micro-quads ([bitmask](../methods/bitmask.md#gaps)). *auto rule*: "
-                "`ss.Auto()`, the probe `ss.Auto(time=...)` times first; the planner's error bounds and time "
-                "ratios (`src/methods/plan.rs`) are this table's worst errors and largest ratios. Scenes: "
+                "`ss.Auto()`, the probe `ss.Auto(time=...)` times first; the planner's error bounds "
+                "(`src/methods/plan.rs`) are this table's worst errors, and its time ratios for `time=` were "
+                "read from this table's largest ratios (they move by up to 40% between runs). Scenes: "
                 "`softshadow.scenes.SCENES` and `softshadow.scenes.HARD_SURFACES`."
             ),
         )

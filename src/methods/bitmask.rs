@@ -25,6 +25,7 @@ use super::gather::{
     self, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
 use super::{LightPoint, ShadowInputs, ShadowMethod};
+use glam::Vec4;
 
 /// A set of up to 64 W light samples.
 type Mask<const W: usize> = [u64; W];
@@ -255,28 +256,6 @@ fn corner_inv(wc: f32, wr: f32, d: f32) -> f32 {
     }
 }
 
-/// `corner_inv` for the four corners, the same values, as one 4-wide
-/// division: written per corner, the compiler computed both candidates'
-/// reciprocals with 8 scalar divisions, which profiled at a fifth of the
-/// whole-tile kernel.
-#[inline(always)]
-fn corner_invs(c: &[f32; 4], wr: f32, d: f32) -> [f32; 4] {
-    let mut den = [1f32; 4];
-    for k in 0..4 {
-        let dc = c[k] - wr;
-        den[k] = if dc > 0.0 { dc } else { d };
-    }
-    let mut inv = [0f32; 4];
-    for k in 0..4 {
-        inv[k] = 1.0 / den[k];
-    }
-    if d > 0.0 {
-        inv
-    } else {
-        [0.0; 4]
-    }
-}
-
 /// The bounding interval of a quad's projected corners along one axis: the
 /// corners' coordinates (relative to the receiver) times their 1/d.
 #[inline(always)]
@@ -284,6 +263,14 @@ fn span(t: [f32; 4]) -> (f32, f32) {
     let lo = gather::min(gather::min(t[0], t[1]), gather::min(t[2], t[3]));
     let hi = gather::max(gather::max(t[0], t[1]), gather::max(t[2], t[3]));
     (lo, hi)
+}
+
+/// `span` for four columns (or rows) at once, one corner per argument.
+/// `Vec4::min` and `max` are x86's minps and maxps, as `gather::min` and
+/// `max`: the same bits.
+#[inline(always)]
+fn span_v(t0: Vec4, t1: Vec4, t2: Vec4, t3: Vec4) -> (Vec4, Vec4) {
+    (t0.min(t1).min(t2.min(t3)), t0.max(t1).max(t2.max(t3)))
 }
 
 /// The accumulator: masks of W words, flat micro-patches or (QUADS) quads.
@@ -315,12 +302,13 @@ impl<const W: usize, const QUADS: bool> MaskKernel<'_, W, QUADS> {
     /// ORs a whole tile's rectangles given as rank ranges per column (x:
     /// [xa, xb)) and per row (y: [ya, yb)). The ranks come from arithmetic
     /// done for the 8 columns and 8 rows at once (so that it vectorizes); a
-    /// micro-patch whose ranges are empty for every column or every row marks
-    /// nothing.
+    /// micro-patch whose ranges are empty for every row marks nothing (the
+    /// callers leave out one that is empty for every column before they
+    /// compute its rows').
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // transposes: one index over two arrays
     fn mark_ranks(&self, acc: &mut Masks<W>, x: &Ranks, y: &Ranks) {
-        if x.empty() || y.empty() {
+        if y.empty() {
             return;
         }
         let p = self.p;
@@ -437,17 +425,22 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
     ) {
         let b = self.p.bounds(w - g.wr[0]);
         let (mut xa, mut xb) = ([0f32; TILE_W], [0f32; TILE_W]);
-        let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for c in 0..TILE_W {
             xa[c] = x0 - r.xr[c];
             xb[c] = x1 - r.xr[c];
         }
+        // The rows' ranges only for a micro-patch that reaches a column.
+        let x = Ranks::new(&b, &xa, &xb);
+        if x.empty() {
+            return;
+        }
+        let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for row in 0..ROWS_PER_GROUP {
             let l = row * TILE_W;
             ya[row] = -r.nay0[l];
             yb[row] = r.ay1[l];
         }
-        self.mark_ranks(acc, &Ranks::new(&b, &xa, &xb), &Ranks::new(&b, &ya, &yb));
+        self.mark_ranks(acc, &x, &Ranks::new(&b, &ya, &yb));
     }
 
     /// The quad [x0, x1] x (row) with corner 1/depths `c` ([top-left,
@@ -488,36 +481,62 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         }
     }
 
-    /// `add_quad` for a tile on one depth: the corners' 1/d are shared, the
-    /// x-span depends on the column only and the y-span on the row only
-    /// (the same bits).
+    /// `add_quad` for a tile on one depth: the corners' 1/d are shared
+    /// (`inv`, from `corner_invs`), the x-span depends on the column only and
+    /// the y-span on the row only (the same bits).
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // one index over the spans and the lanes
     fn add_quad_tile(
         &self,
         acc: &mut Self::State,
-        w: f32,
-        c: &[f32; 4],
+        _w: f32,
+        _c: &[f32; 4],
+        inv: &[f32; 4],
         x0: f32,
         x1: f32,
         r: &RowLanes,
-        g: &Group,
+        _g: &Group,
     ) {
         let b = self.p.scaled(1.0);
-        let wr = g.wr[0];
-        let i = corner_invs(c, wr, w - wr);
+        // The corners' projections per column, then per row, four columns
+        // (rows) to a vector: written column by column, the compiler packed
+        // them corner by corner and took the spans apart with a branch per
+        // column (profiled: a fifth of the closed kernel on the floating
+        // bunny).
+        let i = inv.map(Vec4::splat);
         let (mut xa, mut xb) = ([0f32; TILE_W], [0f32; TILE_W]);
+        for h in 0..TILE_W / 4 {
+            let xr = Vec4::from_slice(&r.xr[4 * h..4 * h + 4]);
+            let (a, e) = (Vec4::splat(x0) - xr, Vec4::splat(x1) - xr);
+            let (lo, hi) = span_v(a * i[0], e * i[1], a * i[2], e * i[3]);
+            lo.write_to_slice(&mut xa[4 * h..]);
+            hi.write_to_slice(&mut xb[4 * h..]);
+        }
+        // The rows' spans only for a quad that reaches a column.
+        let x = Ranks::new(&b, &xa, &xb);
+        if x.empty() {
+            return;
+        }
         let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
-        for col in 0..TILE_W {
-            let (a, e) = (x0 - r.xr[col], x1 - r.xr[col]);
-            (xa[col], xb[col]) = span([a * i[0], e * i[1], a * i[2], e * i[3]]);
+        for h in 0..ROWS_PER_GROUP / 4 {
+            let l = 4 * h * TILE_W;
+            let top = Vec4::new(
+                r.ay1[l],
+                r.ay1[l + TILE_W],
+                r.ay1[l + 2 * TILE_W],
+                r.ay1[l + 3 * TILE_W],
+            );
+            let bottom = -Vec4::new(
+                r.nay0[l],
+                r.nay0[l + TILE_W],
+                r.nay0[l + 2 * TILE_W],
+                r.nay0[l + 3 * TILE_W],
+            );
+            let (lo, hi) = span_v(top * i[0], top * i[1], bottom * i[2], bottom * i[3]);
+            lo.write_to_slice(&mut ya[4 * h..]);
+            hi.write_to_slice(&mut yb[4 * h..]);
         }
-        for row in 0..ROWS_PER_GROUP {
-            let l = row * TILE_W;
-            let (bottom, top) = (-r.nay0[l], r.ay1[l]);
-            (ya[row], yb[row]) = span([top * i[0], top * i[1], bottom * i[2], bottom * i[3]]);
-        }
-        self.mark_ranks(acc, &Ranks::new(&b, &xa, &xb), &Ranks::new(&b, &ya, &yb));
+        self.mark_ranks(acc, &x, &Ranks::new(&b, &ya, &yb));
     }
 
     fn full(&self, acc: &Self::State, g: &Group) -> bool {

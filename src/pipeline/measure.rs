@@ -5,7 +5,8 @@
 //! the front layer lies in features at most `THIN_TEXELS` wide.
 //!
 //! The layers are tried on coarse maps (receivers at an eighth of the
-//! output's side, occluders at a quarter of the planned maps', 256 samples),
+//! output's side, occluders at a quarter of the planned maps', 256 samples,
+//! no hierarchy),
 //! rasterized once (one `Prepared` serves every peel) and shaded on the CPU
 //! whatever the backend: on the bunnies the change measured so is within
 //! 0.0003 of the full maps' (0.0005-0.0009). The thin features need the

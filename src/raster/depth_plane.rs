@@ -32,9 +32,17 @@ fn round_to_limb(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() || v.abs() < f32::MIN_POSITIVE as f64 {
         return 0.0;
     }
-    let e = v.abs().log2().floor() as i32;
-    let s = 2f64.powi(LIMB_BITS - 1 - e);
+    // floor(log2 |v|) read from the exponent field (v is normal here) and
+    // the power of two built from bits: the libm log2 and powi they replace
+    // were a quarter of the rasterizer's time on the bunny at 64².
+    let e = ((v.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    let s = pow2(LIMB_BITS - 1 - e);
     (v * s).round() / s
+}
+
+/// 2^n for n in f64's normal range (here -1016..=133).
+fn pow2(n: i32) -> f64 {
+    f64::from_bits(((n + 1023) as u64) << 52)
 }
 
 /// Three limbs whose sum is `v` to about 24 bits.
@@ -90,6 +98,21 @@ mod tests {
             }
             let sum: f64 = l.iter().map(|&x| x as f64).sum();
             assert!((sum - v).abs() <= v.abs() * 2f64.powi(-22), "{v}: {sum}");
+        }
+    }
+
+    #[test]
+    fn the_exponent_is_log2s_floor() {
+        // Away from a power of two (where log2 may round up to it) the
+        // exponent field and libm agree; at one, both give the power.
+        let mut x = 1.0e-30f64;
+        while x < 1.0e30 {
+            for v in [x, -x, x * 1.000001, 2f64.powi(x.log2().round() as i32)] {
+                let e = ((v.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+                assert_eq!(e, v.abs().log2().floor() as i32, "{v}");
+                assert_eq!(pow2(7 - e), 2f64.powi(7 - e), "{v}");
+            }
+            x *= 1.37;
         }
     }
 

@@ -185,6 +185,12 @@ impl Projector {
         // 1/Z at the center of texel (i0, j0) from the exact edge functions
         // there (barycentric, well conditioned), and its gradient per texel.
         let (cx, cy) = (i0 as i64 * ONE + ONE / 2, j0 as i64 * ONE + ONE / 2);
+        // A triangle whose box holds one texel center and misses it writes
+        // nothing: left out before its depth plane (most of a fine mesh's
+        // triangles on a coarse map).
+        if i0 == i1 && j0 == j1 && !super::scan::covers(&x, &y, cx, cy) {
+            return;
+        }
         let mut w_ref = 0f64;
         for (k, wk) in w.iter().enumerate() {
             let (s, e) = ((k + 1) % 3, (k + 2) % 3);

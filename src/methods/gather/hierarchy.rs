@@ -30,6 +30,10 @@ pub(super) struct Layer {
     /// Corner 1/depths of the connected micro-quads (`corners.rs`), when the
     /// method reads them; empty otherwise.
     pub(super) corners: Vec<[f32; 4]>,
+    /// `corner_invs` of each quad seen from the kernel's `plane_wr` (empty
+    /// without one): whole tiles on that plane read them instead of
+    /// dividing per (quad, tile).
+    pub(super) plane_invs: Vec<[f32; 4]>,
 }
 
 #[derive(Clone, Copy)]
@@ -138,6 +142,7 @@ impl Layer {
         Layer {
             row_batch,
             corners: vec![],
+            plane_invs: vec![],
             w,
             w_far,
             w_near,
@@ -317,7 +322,53 @@ impl Kernel {
             levels,
             texel_per_d: (4.0 * (hw / lx).max(hh / ly)) as f32,
             max_on_light: 2.0 * hierarchy.map_or(0.0, |h| h.max_texel_on_light),
+            plane_wr: None,
         }
+    }
+
+    /// Picks the receiver 1/depth the most whole tiles of `receiver` (the
+    /// output map's depths) share, as `Group` computes it, and gives every
+    /// connected layer its quads' corner reciprocals from there: on the
+    /// study's floors most tiles are such, and the per-(quad, tile) 4-wide
+    /// division was the closed kernel's largest cost over the open one's.
+    pub(super) fn set_plane(&mut self, receiver: &[f32]) {
+        use super::{ROWS_PER_GROUP, TILE_W};
+        let w = self.rec_width;
+        let h = receiver.len() / w.max(1);
+        let mut counts: std::collections::HashMap<u32, usize> = Default::default();
+        for tj in 0..h / ROWS_PER_GROUP {
+            for ti in 0..w / TILE_W {
+                let z = receiver[tj * ROWS_PER_GROUP * w + ti * TILE_W];
+                let same = (0..ROWS_PER_GROUP).all(|r| {
+                    let row = (tj * ROWS_PER_GROUP + r) * w + ti * TILE_W;
+                    receiver[row..row + TILE_W]
+                        .iter()
+                        .all(|v| v.to_bits() == z.to_bits())
+                });
+                if same && z.is_finite() && z > 0.0 {
+                    *counts.entry((1.0 / z).to_bits()).or_default() += 1;
+                }
+            }
+        }
+        // The most tiles; ties to the smaller bits (no hash-order dependence).
+        let Some((bits, _)) = counts
+            .into_iter()
+            .max_by_key(|&(b, n)| (n, std::cmp::Reverse(b)))
+        else {
+            return;
+        };
+        let wr = f32::from_bits(bits);
+        for lv in &mut self.levels {
+            for layer in &mut lv.layers {
+                layer.plane_invs = layer
+                    .w
+                    .par_iter()
+                    .zip(&layer.corners)
+                    .map(|(&wo, c)| super::corners::corner_invs(c, wr, wo - wr))
+                    .collect();
+            }
+        }
+        self.plane_wr = Some(wr);
     }
 
     /// Continuous row coordinate of tangent y at level `lv`, in units where

@@ -95,7 +95,8 @@ pub(super) trait Accumulator: Sync {
     ) {
         self.add_texel(acc, w, x0, x1, row, g)
     }
-    /// `add_quad` for a whole tile on one depth (as `add_texel_tile`).
+    /// `add_quad` for a whole tile on one depth (as `add_texel_tile`), with
+    /// the corners' `corners::corner_invs` for the tile's receiver depth.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn add_quad_tile(
@@ -103,6 +104,7 @@ pub(super) trait Accumulator: Sync {
         acc: &mut Self::State,
         w: f32,
         c: &[f32; 4],
+        _inv: &[f32; 4],
         x0: f32,
         x1: f32,
         row: &RowLanes,
@@ -181,6 +183,10 @@ struct Kernel {
     texel_per_d: f32,
     /// 2 x the hierarchy's `max_texel_on_light` (half-light units).
     max_on_light: f32,
+    /// The receiver 1/depth most whole tiles share (a floor facing the
+    /// light), for which every layer holds its quads' corner reciprocals
+    /// (`Layer::plane_invs`); None: none computed.
+    plane_wr: Option<f32>,
 }
 
 /// Shades every receiver texel of the output map with accumulator `a`.
@@ -189,7 +195,10 @@ pub(super) fn visibility_map<A: Accumulator>(
     inputs: &ShadowInputs,
     hierarchy: Option<Hierarchy>,
 ) -> Vec<f32> {
-    let k = Kernel::new(inputs, hierarchy, A::CORNERS);
+    let mut k = Kernel::new(inputs, hierarchy, A::CORNERS);
+    if A::CORNERS {
+        k.set_plane(inputs.receiver);
+    }
     let w = k.rec_width;
     let mut out = vec![1f32; inputs.grid.len()];
     out.par_chunks_mut(w * ROWS_PER_GROUP)

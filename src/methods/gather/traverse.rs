@@ -128,15 +128,31 @@ impl Kernel {
         let (s, e) = ((b_lo * BLOCK).max(i_lo), (b_hi * BLOCK).min(i_hi));
         // w <= wr_min: empty, or behind every lane's receiver.
         if A::CORNERS {
-            let corners = &layer.corners[j * lv.width + s..j * lv.width + e];
+            let (r0, r1) = (j * lv.width + s, j * lv.width + e);
+            let corners = &layer.corners[r0..r1];
             let quads = row[s..e]
                 .iter()
                 .zip(&lv.col_x0_scaled[s..e])
                 .zip(corners)
                 .filter(|((&w, _), _)| w > g.wr_min);
-            if g.uniform_tile {
+            let on_plane = self
+                .plane_wr
+                .is_some_and(|p| p.to_bits() == g.wr[0].to_bits());
+            if g.uniform_tile && on_plane {
+                // The corners' reciprocals for this depth, computed once.
+                let quads = row[s..e]
+                    .iter()
+                    .zip(&lv.col_x0_scaled[s..e])
+                    .zip(&layer.plane_invs[r0..r1])
+                    .filter(|((&w, _), _)| w > g.wr_min);
+                for ((&w, &x0), inv) in quads {
+                    a.add_quad_tile(acc, w, &[0.0; 4], inv, x0, x0 + wx, &rl, g);
+                }
+            } else if g.uniform_tile {
+                let wr = g.wr[0];
                 for ((&w, &x0), c) in quads {
-                    a.add_quad_tile(acc, w, c, x0, x0 + wx, &rl, g);
+                    let inv = super::corners::corner_invs(c, wr, w - wr);
+                    a.add_quad_tile(acc, w, c, &inv, x0, x0 + wx, &rl, g);
                 }
             } else {
                 for ((&w, &x0), c) in quads {
