@@ -177,6 +177,26 @@ impl Method {
         self.reads().contains(&input)
     }
 
+    /// f32 maps the kernel keeps per occluder layer, each of the occluder
+    /// grid's size: the 1/depth copy, and for connected micro-quads their
+    /// corner 1/depths and those corners' reciprocals from the receivers'
+    /// common plane (4 each, `gather/hierarchy.rs`); a hierarchy adds a
+    /// third.
+    pub fn kernel_maps_per_layer(&self) -> usize {
+        let (maps, hierarchy): (usize, bool) = match *self {
+            Method::Bitmask {
+                hierarchy, gaps, ..
+            } => (if gaps == bitmask::Gaps::Closed { 9 } else { 1 }, hierarchy),
+            Method::Ssm { hierarchy, .. } => (1, hierarchy),
+            _ => (1, false),
+        };
+        if hierarchy {
+            maps + maps.div_ceil(3)
+        } else {
+            maps
+        }
+    }
+
     pub fn implementation(&self) -> Box<dyn ShadowMethod> {
         match *self {
             Method::Ssm {

@@ -88,8 +88,8 @@ pub(crate) fn frame_scene(
     let (ow, oh) = s.occluder_resolution.unwrap_or((s.width, s.height));
     MapGrid::new(ow, oh, s.extent.unwrap_or([1.0, 1.0]))
         .map_err(|e| Error::invalid("occluder_resolution", e.to_string()))?;
-    // Receiver and visibility maps; each occluder layer and the kernels'
-    // 1/depth copy of it.
+    // Receiver and visibility maps; each occluder layer and what the
+    // kernel keeps of it (its 1/depth copy, corners).
     let layers = if s.method.reads_input(Input::OccluderLayers) {
         s.passes as usize
     } else {
@@ -101,7 +101,8 @@ pub(crate) fn frame_scene(
             "{}x{} with {}x{} occluder maps and {} layers",
             s.width, s.height, ow, oh, layers
         ),
-        map_bytes(s.width * s.height, 2) + map_bytes(ow * oh, 2 * layers),
+        map_bytes(s.width * s.height, 2)
+            + map_bytes(ow * oh, (1 + s.method.kernel_maps_per_layer()) * layers),
     )?;
     occluders.validate("occluders")?;
     receivers.validate("receivers")?;

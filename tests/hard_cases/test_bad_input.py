@@ -62,6 +62,18 @@ def test_maps_larger_than_the_memory_available_are_refused_before_allocating(mon
     assert ss.soft_shadow_map(scene, light, resolution=1024, method="exact", samples=1).visibility.min() == 0.0
 
 
+def test_the_memory_check_counts_what_closed_gaps_keep_per_layer(monkeypatch):
+    # Connected micro-quads keep 8 more f32 per occluder texel and layer
+    # (corner depths and their reciprocals): 64² maps with the hierarchy,
+    # two layers, need 131072 bytes with open gaps and 458752 with closed.
+    scene, light = scenes.square_plate()
+    monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "200000")
+    open_gaps = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Bitmask(gaps="open"))
+    assert open_gaps.visibility.min() == 0.0
+    with pytest.raises(ss.TooLargeError, match=r"^resolution: 64x64 .* 458752 bytes"):
+        ss.soft_shadow_map(scene, light, resolution=64, method=ss.Bitmask())
+
+
 @pytest.mark.parametrize(
     "kwargs, exc, words",
     [
