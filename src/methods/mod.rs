@@ -178,16 +178,20 @@ impl Method {
     }
 
     /// f32 maps the kernel keeps per occluder layer, each of the occluder
-    /// grid's size: the 1/depth copy, and for connected micro-quads their
-    /// corner 1/depths and those corners' reciprocals from the receivers'
-    /// common plane (4 each, `gather/hierarchy.rs`); a hierarchy adds a
-    /// third.
+    /// grid's size: for the gather methods the 1/depth copy and its nearest
+    /// and farthest bounds (`gather/hierarchy.rs`), and for connected
+    /// micro-quads their corner 1/depths and those corners' reciprocals
+    /// from the receivers' common plane (4 each); a hierarchy's levels add
+    /// a third. Other methods: one map.
     pub fn kernel_maps_per_layer(&self) -> usize {
         let (maps, hierarchy): (usize, bool) = match *self {
             Method::Bitmask {
                 hierarchy, gaps, ..
-            } => (if gaps == bitmask::Gaps::Closed { 9 } else { 1 }, hierarchy),
-            Method::Ssm { hierarchy, .. } => (1, hierarchy),
+            } => (
+                if gaps == bitmask::Gaps::Closed { 11 } else { 3 },
+                hierarchy,
+            ),
+            Method::Ssm { hierarchy, .. } => (3, hierarchy),
             _ => (1, false),
         };
         if hierarchy {

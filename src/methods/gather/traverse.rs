@@ -143,10 +143,10 @@ impl Kernel {
                 let quads = row[s..e]
                     .iter()
                     .zip(&lv.col_x0_scaled[s..e])
-                    .zip(&layer.plane_invs[r0..r1])
+                    .zip(corners.iter().zip(&layer.plane_invs[r0..r1]))
                     .filter(|((&w, _), _)| w > g.wr_min);
-                for ((&w, &x0), inv) in quads {
-                    a.add_quad_tile(acc, w, &[0.0; 4], inv, x0, x0 + wx, &rl, g);
+                for ((&w, &x0), (c, inv)) in quads {
+                    a.add_quad_tile(acc, w, c, inv, x0, x0 + wx, &rl, g);
                 }
             } else if g.uniform_tile {
                 let wr = g.wr[0];
