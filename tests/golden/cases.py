@@ -130,6 +130,199 @@ def cases(backends: list[str]) -> Iterator[tuple[str, Callable[[], dict[str, np.
             f"point/two_spheres/{label}/cpu",
             lambda kw=kw: {"visibility": ss.soft_shadow_map(scene, point, resolution=RES, **kw).visibility},
         )
+    yield from _more_light_view_cases(backends)
+    yield from _eye_view_cases(backends)
+
+
+# The eye view (`render`): every method family and option group, both
+# backends where they run; the G-buffer, the shaded images, the maps and the
+# resolved config are hashed with the visibility.
+EYE_RES = (48, 36)
+EYE_SCENE_NAMES = ("bunny_on_floor", "torus", "contact_boxes", "city")
+ALL = ("cpu", "gpu")
+
+
+def _eye_cases() -> list[tuple[str, Callable[[], object], tuple[str, ...]]]:
+    return [
+        ("default", lambda: "auto", ALL),
+        ("ssm", lambda: "ssm", ALL),
+        ("ssm-p3", lambda: ss.Ssm(passes=3), ALL),
+        ("bitmask64", lambda: ss.Bitmask(samples=64), ALL),
+        ("bitmask-open", lambda: ss.Bitmask(samples=64, gaps="open"), ALL),
+        ("exact16", lambda: ss.Exact(samples=16), ALL),
+        ("auto-error", lambda: ss.Auto(error=0.02), ALL),
+        ("pcss", lambda: ss.PCSS(), ALL),
+        ("pcss-taps", lambda: ss.PCSS(max_taps=16, occluder_resolution=32), ALL),
+        ("smoothies", lambda: ss.Smoothies(), ALL),
+        ("smoothies-linear", lambda: ss.Smoothies(width=0.05, falloff="linear"), ALL),
+        ("sm", lambda: ss.ShadowMapping(), ALL),
+        ("sm-pcf", lambda: ss.ShadowMapping(filter=ss.PCF(size=3)), ALL),
+        ("sm-slope", lambda: ss.ShadowMapping(bias=ss.SlopeScaleBias(constant=1.0, slope=2.0)), ALL),
+        ("sm-linear", lambda: ss.ShadowMapping(bias=ss.LinearDepthBias()), ALL),
+        ("sm-back", lambda: ss.ShadowMapping(bias=ss.BackFaces()), ALL),
+        ("sm-mid", lambda: ss.ShadowMapping(bias=ss.MidpointBias()), ALL),
+        ("sm-const", lambda: ss.ShadowMapping(bias=ss.ConstantBias(constant=0.01)), ALL),
+        ("sm-lispsm", lambda: ss.ShadowMapping(warp=ss.LiSPSM(), resolution=64), ALL),
+        ("sm-lispsm-view", lambda: ss.ShadowMapping(warp=ss.LiSPSM(n=2.0, vector="camera")), ALL),
+        ("sm-blur", lambda: ss.ShadowMapping(blur=ss.EyeSpaceBlur(iterations=2, radius=1.5)), ALL),
+        ("sm-nofocus", lambda: ss.ShadowMapping(focus=False), ALL),
+    ]
+
+
+# Keyword variants of `render` on one method (biases, map resolution,
+# albedo, loose options).
+EYE_KW_CASES: list[tuple[str, dict, tuple[str, ...]]] = [
+    ("bias", {"method": "bitmask", "samples": 64, "normal_offset": 1.0, "depth_bias": 0.0}, ALL),
+    ("mapres", {"method": "ssm", "map_resolution": (40, 24)}, ALL),
+    ("albedo", {"method": "ssm", "albedo": [0.2, 0.5, 0.9]}, ALL),
+    ("loose", {"method": "bitmask", "samples": 16, "passes": 3, "hierarchy": False}, ALL),
+]
+
+
+def _image(img: ss.Image) -> dict[str, np.ndarray | None]:
+    out: dict[str, np.ndarray | None] = {
+        "visibility": img.visibility,
+        "shaded": img.shaded,
+        "unshadowed": img.unshadowed,
+        "depth": img.depth,
+        "position": img.position,
+        "normal": img.normal,
+        "mesh_id": img.mesh_id,
+        "map_extent": None if img.map_extent is None else np.asarray(img.map_extent, np.float64),
+        "depth_origin": None if img.depth_origin is None else np.asarray(img.depth_origin, np.float64),
+        "depth_range": None if img.depth_range is None else np.asarray([img.depth_range], np.float64),
+        "method": np.frombuffer(repr(img.method).encode(), np.uint8),
+    }
+    for k, m in enumerate(img.shadow_maps):
+        out[f"map{k}"] = m
+    if img.plan is not None:
+        out["plan"] = np.frombuffer(str(img.plan).encode(), np.uint8)
+    return out
+
+
+def _light_view_sun() -> ss.DirectionalLight:
+    return ss.DirectionalLight(direction=(0.3, -1.0, 0.2), up=(0.0, 0.0, 1.0), angular_size=(2.0, 2.0))
+
+
+def _eye_view_cases(backends: list[str]) -> Iterator[tuple[str, Callable[[], dict[str, np.ndarray | None]]]]:
+    from softshadow.eye_scenes import EYE_SCENES
+
+    for name in EYE_SCENE_NAMES:
+        scene, light, cam = EYE_SCENES[name](EYE_RES)
+        for label, method, where in _eye_cases():
+            if label.startswith("sm-lispsm") and name != "city":
+                continue  # LiSPSM warps the sun's maps only
+            for b in backends:
+                if b in where:
+                    yield (
+                        f"eye/{name}/{label}/{b}",
+                        lambda scene=scene, light=light, cam=cam, method=method, b=b: _image(
+                            ss.render(scene, light, cam, method(), backend=b)
+                        ),
+                    )
+        for label, kw, where in EYE_KW_CASES:
+            for b in backends:
+                if b in where:
+                    yield (
+                        f"eye/{name}/{label}/{b}",
+                        lambda scene=scene, light=light, cam=cam, kw=kw, b=b: _image(
+                            ss.render(scene, light, cam, backend=b, **kw)
+                        ),
+                    )
+    # A hard light: exact's one ray, ShadowMapping on either backend.
+    scene, light, cam = EYE_SCENES["bunny_on_floor"](EYE_RES)
+    point = ss.RectLight(center=light.center, normal=light.normal, up=light.up, size=(0.0, 0.0))
+    for label, method, where in (("exact", "exact", ALL), ("ssm", "ssm", ("cpu",)), ("sm", "shadow_mapping", ALL)):
+        for b in backends:
+            if b in where:
+                yield (
+                    f"eye-point/bunny_on_floor/{label}/{b}",
+                    lambda method=method, b=b: _image(ss.render(scene, point, cam, method, backend=b)),
+                )
+
+
+# Light-view maps of a scene shadowing itself (CPU only) and under a sun.
+SELF_CASES: list[tuple[str, dict, tuple[str, ...]]] = [
+    ("ssm", {}, ("cpu",)),
+    ("bitmask64", {"method": "bitmask", "samples": 64}, ("cpu",)),
+    ("exact16", {"method": "exact", "samples": 16}, ("cpu",)),
+    ("bias", {"method": "ssm", "normal_offset": 1.0, "depth_bias": 2.0}, ("cpu",)),
+]
+SUN_CASES: list[tuple[str, dict, tuple[str, ...]]] = [
+    ("ssm", {}, ALL),
+    ("bitmask64", {"method": "bitmask", "samples": 64}, ALL),
+    ("exact16", {"method": "exact", "samples": 16}, ALL),
+    ("extent", {"method": "ssm", "extent": (3.0, 2.0)}, ALL),
+]
+# Planned light-view maps (an error target: no timing in the decisions).
+PLAN_CASES: list[tuple[str, Callable[[], object], tuple[str, ...]]] = [
+    ("auto-error01", lambda: ss.Auto(error=0.01), ALL),
+    ("auto-error005", lambda: ss.Auto(error=0.005), ALL),
+]
+
+
+def _planned(sm: ss.ShadowMap) -> dict[str, np.ndarray | None]:
+    out = _maps(sm)
+    out["method"] = np.frombuffer(repr(sm.method).encode(), np.uint8)
+    if sm.plan is not None:
+        out["plan"] = np.frombuffer(str(sm.plan).encode(), np.uint8)
+    return out
+
+
+def _more_light_view_cases(backends: list[str]) -> Iterator[tuple[str, Callable[[], dict[str, np.ndarray | None]]]]:
+    from softshadow.eye_scenes import EYE_SCENES
+
+    for name in ("bunny_on_floor", "contact_boxes"):
+        scene, _, _ = EYE_SCENES[name](EYE_RES)
+        light = scenes.default_light()
+        for label, kw, where in SELF_CASES:
+            for b in backends:
+                if b in where:
+                    yield (
+                        f"self/{name}/{label}/{b}",
+                        lambda scene=scene, light=light, kw=kw: _maps(
+                            ss.soft_shadow_map(scene, light, resolution=RES, **kw)
+                        ),
+                    )
+    for name in ("bunny_on_floor", "two_spheres"):
+        scene, _ = scenes.SCENES[name]()
+        sun = _light_view_sun()
+        for label, kw, where in SUN_CASES:
+            for b in backends:
+                if b in where:
+                    yield (
+                        f"sun/{name}/{label}/{b}",
+                        lambda scene=scene, sun=sun, kw=kw, b=b: _maps(
+                            ss.soft_shadow_map(scene, sun, resolution=RES, backend=b, **kw)
+                        ),
+                    )
+        base = ss.soft_shadow_map(scene, sun, resolution=RES)
+        for b in backends:
+            yield (
+                f"sun-depth/{name}/ssm/{b}",
+                lambda base=base, sun=sun, b=b: {
+                    "visibility": ss.soft_shadow_map_from_depth(
+                        base.occluder_depth,
+                        base.receiver_depth,
+                        occluder_depth_back=base.occluder_depth_back,
+                        angular_size=sun.angular_size,
+                        extent=base.extent,
+                        backend=b,
+                    ).visibility
+                },
+            )
+        yield (f"sun-sample/{name}/ssm/cpu", lambda base=base: {"visibility": base.sample(_points(base))})
+    for name in ("bunny_floating", "square_plate"):
+        scene, light = scenes.SCENES[name]()
+        for label, method, where in PLAN_CASES:
+            for b in backends:
+                if b in where:
+                    yield (
+                        f"plan/{name}/{label}/{b}",
+                        lambda scene=scene, light=light, method=method, b=b: _planned(
+                            ss.soft_shadow_map(scene, light, resolution=64, method=method(), backend=b)
+                        ),
+                    )
 
 
 def all_hashes(backends: list[str]) -> dict[str, str]:
