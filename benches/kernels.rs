@@ -7,7 +7,7 @@
 //!
 //! Three groups:
 //! - `shadow_map`: the whole CPU call (framing, rasterization, shading) of
-//!   each method through `softshadow::backend::shadow_map`;
+//!   each method through `softshadow::api::shadow_map`;
 //! - `kernel`: the shading kernels alone on light-view maps rasterized once
 //!   beforehand (front and back layers, flat receiver: whole tiles on one
 //!   depth take the tile path);
@@ -22,12 +22,12 @@ use std::time::Duration;
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
-use softshadow::backend::{shadow_map, MeshCall};
+use softshadow::api::{shadow_map, MeshCall};
+use softshadow::frame::{light_space_triangles, ShadowResult};
 use softshadow::geom::mesh::MeshRef;
 use softshadow::methods::bitmask::Gaps;
 use softshadow::methods::ssm::Precision;
 use softshadow::methods::{Method, ShadowInputs};
-use softshadow::pipeline::{light_space_triangles, ShadowResult};
 use softshadow::raster::rasterize;
 use softshadow::{BackendChoice, BitmaskConfig, ExactConfig, MethodConfig, RectLight, SsmConfig};
 

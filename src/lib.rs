@@ -6,7 +6,7 @@
 //! the backend with [`BackendChoice`]:
 //!
 //! ```
-//! use softshadow::backend::{shadow_map, MeshCall};
+//! use softshadow::api::{shadow_map, MeshCall};
 //! use softshadow::geom::mesh::MeshRef;
 //! use softshadow::{BackendChoice, BitmaskConfig, Light, MethodConfig, RectLight};
 //!
@@ -40,10 +40,13 @@
 // The stages, in the order the data flows: geometry in light space,
 // rasterized light-view maps, the shadow methods that read them, and the
 // pipelines that chain them; `gpu` mirrors raster and methods on the device.
+pub mod api;
+pub mod auto;
 pub mod backend;
 pub mod block_cache;
 pub mod error;
 pub mod eye;
+pub mod frame;
 pub mod geom;
 #[cfg(feature = "gpu")]
 pub mod gpu;
@@ -52,7 +55,10 @@ pub mod methods;
 pub mod pipeline;
 pub mod raster;
 pub mod threads;
+pub mod timing;
 
+#[cfg(test)]
+mod layering;
 #[cfg(feature = "python")]
 mod python;
 

@@ -148,7 +148,7 @@ pub fn rasterized_hits(camera: &Camera, scene: &SceneTriangles) -> Vec<Option<u3
         Ok(g) => g,
         Err(_) => return vec![None; camera.width * camera.height],
     };
-    let near = crate::pipeline::near_plane(&verts);
+    let near = crate::raster::near_plane(&verts);
     Prepared::with_faces(&grid, &verts, faces, near)
         .nearest_faces()
         .1

@@ -24,12 +24,12 @@
 //! an occluder touches a receiver (`docs/benchmarks/bias.md` measures both).
 
 use super::tangent_plane;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
 use crate::methods::{Input, LightPoint, Method, ShadowInputs};
-pub(crate) use crate::pipeline::Stopwatch;
 use crate::raster::Prepared;
+pub(crate) use crate::timing::Stopwatch;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -47,6 +47,37 @@ pub struct EyeMaps {
     /// Front first, back last, in the user's depth (planar from the light,
     /// or orthographic from the sun's depth origin).
     pub layers: Vec<Vec<f32>>,
+}
+
+/// The default biases of the map methods (texels), measured by
+/// `benchmarks/bench_bias.py` (docs/benchmarks/bias.md) on the four
+/// eye-view scenes: without either bias up to 55% of the lit pixels shadow
+/// themselves; a quarter texel of normal offset and half a texel of depth
+/// bias bring that to 0.3% (the map's penumbra edges), and every further
+/// texel of either lets more light leak into the shadows.
+pub const DEFAULT_BIAS: Bias = Bias {
+    normal_offset: 0.25,
+    depth_bias: 0.5,
+};
+/// The largest bias accepted, in texels.
+pub const MAX_BIAS: f64 = 64.0;
+
+impl Bias {
+    /// Checks user biases (finite, in [0, MAX_BIAS]); `None` keeps a default.
+    pub fn new(normal_offset: Option<f64>, depth_bias: Option<f64>) -> Result<Bias> {
+        let check = |arg: &str, v: Option<f64>, d: f64| match v {
+            None => Ok(d),
+            Some(v) if v.is_finite() && (0.0..=MAX_BIAS).contains(&v) => Ok(v),
+            Some(v) => Err(Error::invalid(
+                arg,
+                format!("must be a number of texels in [0, {MAX_BIAS}], got {v}"),
+            )),
+        };
+        Ok(Bias {
+            normal_offset: check("normal_offset", normal_offset, DEFAULT_BIAS.normal_offset)?,
+            depth_bias: check("depth_bias", depth_bias, DEFAULT_BIAS.depth_bias)?,
+        })
+    }
 }
 
 /// The largest slope the depth bias scales with (about 83 degrees).
@@ -86,7 +117,7 @@ pub struct LightTriangles<'a> {
 /// The occluder layers of every mesh on `grid` (kernel depths, unit-scaled),
 /// front first, the peeled ones, back last.
 pub fn occluder_layers(grid: &MapGrid, tris: &LightTriangles, passes: u32) -> Vec<Vec<f32>> {
-    let near = crate::pipeline::near_plane(&tris.verts);
+    let near = crate::raster::near_plane(&tris.verts);
     let prepared = Prepared::new(grid, &tris.verts, tris.faces, near);
     let o = prepared.nearest_farthest(passes >= 2);
     let mut layers = vec![o.nearest];
@@ -208,7 +239,7 @@ pub(crate) fn shade(
             falloff,
         }
         .shade(&inputs, &tris.verts, tris.faces, &sp.points),
-        _ => crate::pipeline::shade_points(method, &inputs, &sp.points),
+        _ => crate::methods::shade_points(method, &inputs, &sp.points),
     };
     sw.lap("shadow");
     finish(&mut v, &sp.bound);

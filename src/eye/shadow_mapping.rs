@@ -26,7 +26,7 @@ use crate::methods::shadow_mapping::lookup::Lookup;
 use crate::methods::shadow_mapping::raster::{
     scan, setup_triangles, DepthMap, Faces, SetupTri, Toward,
 };
-use crate::pipeline::{Stopwatch, Timings};
+use crate::timing::{Stopwatch, Timings};
 use glam::DVec3;
 use rayon::prelude::*;
 

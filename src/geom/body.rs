@@ -14,8 +14,8 @@
 //! one of them, so clipping each one's faces by the other's planes
 //! (Sutherland-Hodgman) gives a point set whose convex hull is B.
 
+use super::clip::{clip_polygon, Plane};
 use crate::geom::camera::Camera;
-use crate::raster::clip::{clip_polygon, Plane};
 use glam::DVec3;
 
 /// An axis-aligned box.

@@ -3,6 +3,7 @@
 
 pub mod body;
 pub mod camera;
+pub(crate) mod clip;
 pub mod extent;
 pub mod light;
 pub mod light_space;

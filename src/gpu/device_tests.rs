@@ -2,10 +2,11 @@
 //! an adapter these tests say so and pass, unless SOFTSHADOW_REQUIRE_GPU=1
 //! (set by scripts/test.sh, which installs lavapipe) makes that a failure.
 
+use crate::frame::{MapSettings, ShadowResult};
 use crate::geom::light::RectLight;
 use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
-use crate::pipeline::{self, MapSettings, ShadowResult};
+use crate::pipeline;
 
 fn device_or_skip() -> bool {
     match super::info() {
@@ -420,7 +421,7 @@ mod eye {
     use super::{device_or_skip, floor, sphere};
     use crate::backend::{Backend, BackendChoice};
     use crate::eye::gbuffer::{self, SceneTriangles};
-    use crate::eye::{self, EyeCall, EyeImage, DEFAULT_BIAS};
+    use crate::eye::{EyeCall, EyeImage, DEFAULT_BIAS};
     use crate::geom::camera::Camera;
     use crate::geom::light::RectLight;
     use crate::geom::light_space::Light;
@@ -527,7 +528,7 @@ mod eye {
         camera: &Camera,
         method: MethodConfig,
         backend: BackendChoice,
-    ) -> crate::error::Result<crate::backend::Run<EyeImage>> {
+    ) -> crate::error::Result<crate::api::Run<EyeImage>> {
         let refs: Vec<MeshRef> = meshes
             .iter()
             .map(|(v, f)| MeshRef {
@@ -535,7 +536,7 @@ mod eye {
                 faces: f,
             })
             .collect();
-        eye::render(&EyeCall {
+        crate::api::render(&EyeCall {
             meshes: &refs,
             light,
             camera,
@@ -799,7 +800,7 @@ mod eye {
                         faces: f,
                     })
                     .collect();
-                eye::render(&EyeCall {
+                crate::api::render(&EyeCall {
                     meshes: &refs,
                     light: &light,
                     camera: &cam,
@@ -931,7 +932,7 @@ mod eye {
         use crate::methods::shadow_mapping::config::{
             DepthBias, EyeSpaceBlur, LiSPSM, Pcf, Real, ShadowMappingConfig,
         };
-        use crate::pipeline::Stopwatch;
+        use crate::timing::Stopwatch;
 
         fn configs() -> Vec<(&'static str, ShadowMappingConfig)> {
             let base = ShadowMappingConfig {
@@ -1445,7 +1446,8 @@ mod pcss {
     use crate::gpu::timing::StageTimer;
     use crate::methods::pcss::{Pcss, MAX_TAPS};
     use crate::methods::{LightPoint, Method, ShadowInputs, ShadowMethod};
-    use crate::pipeline::{self, Stopwatch};
+    use crate::pipeline;
+    use crate::timing::Stopwatch;
 
     fn lcg(seed: &mut u64) -> f64 {
         *seed = seed

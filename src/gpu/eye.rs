@@ -44,28 +44,29 @@
 use super::context::{gpu, Gpu};
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
 use super::exact::{ExactParams, BUDGET, SAMPLES_PER_CHUNK};
-use super::from_depth::point_light_on_gpu;
-use super::from_meshes::check_side;
 use super::gather::{
     self, GatherBuffers, GpuGroup, GpuPoint, PointsBuffers, PointsParams, POINT_GROUP,
 };
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::refusals::{check_side, point_light_on_gpu};
 use super::shading::gather_params;
 use super::timing::{merged, StageTimer};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
-use crate::eye::gbuffer::{self, SceneTriangles};
+use crate::eye::framing::resolve_at_camera;
+use crate::eye::gbuffer::{self, GBuffer, SceneTriangles};
 use crate::eye::maps::{self, LightTriangles};
 use crate::eye::rays::{self, RayStart};
-use crate::eye::{self, Bias, EyeCall, EyeImage, EyeMaps, Framed};
+use crate::eye::{Bias, EyeCall, EyeMaps, EyeStages, Framed};
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
 use crate::methods::exact::{sample_grid, Bvh, RAY_EPS};
 use crate::methods::gather::{point_group, point_order, POINTS_PER_GROUP};
+use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::{Input, LightPoint, Method, MethodConfig};
-use crate::pipeline::{Stopwatch, Timings};
 use crate::raster::setup_triangles;
+use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -165,103 +166,114 @@ fn budget_error() -> Error {
     )
 }
 
-/// Renders `call` on the GPU: `eye::render_cpu`'s image and config, and its
-/// stage names plus the device's.
-pub fn render_gpu(call: &EyeCall) -> Result<(EyeImage, MethodConfig)> {
-    // ShadowMapping has its own stages (a hard shadow: any light).
-    if let MethodConfig::ShadowMapping(cfg) = call.method {
-        return super::shadow_mapping::render_eye(call, &cfg);
-    }
-    // Refuse what the GPU cannot run before any GPU work: a config that does
-    // not resolve there, a hard light for the map methods.
-    eye::resolve_at_camera(call, Backend::Gpu)?;
-    let traced = call.method.kernel().traces();
-    if !traced {
-        if call.light.is_hard() {
-            return Err(point_light_on_gpu("size"));
-        }
-        let kernel = eye::resolve_at_camera(call, Backend::Gpu)?.kernel();
-        if !matches!(kernel, Method::Pcss { .. }) {
-            gather::check_method(kernel)?;
-        }
-    }
-    let g = gpu()?;
-    let mut sw = Stopwatch::new();
-    let scene = SceneTriangles::new(call.meshes)?;
-    let (hit, mut device_timings) = first_hits(g, call.camera, &scene)?;
-    let gb = gbuffer::from_hits(call.camera, &scene, &hit);
-    sw.lap("first_hits");
-    let mut f = eye::frame(call, &scene, &gb)?;
-    sw.lap("transform");
+/// The eye view's stages on the GPU (`eye::EyeStages`): the first hits,
+/// the shadow rays, the occluder layers and the gather on the device, the
+/// framing shared with the CPU; the device's stage times are kept here
+/// until the orchestrator asks for them.
+#[derive(Default)]
+pub struct GpuEye {
+    device_timings: Timings,
+}
 
-    let mut vis = vec![1f32; gb.len()];
-    let mut maps = None;
-    let method;
-    if traced {
-        method = eye::resolve_at_camera(call, Backend::Gpu)?;
-        let samples = eye::exact_samples(call, &method);
-        let tris = eye::traced_triangles(&f, &scene);
-        sw.lap("triangles");
+impl EyeStages for GpuEye {
+    const BACKEND: Backend = Backend::Gpu;
+
+    // Refuses what the GPU cannot run before any GPU work: a config that
+    // does not resolve there, a hard light for the map methods.
+    fn check(&self, call: &EyeCall) -> Result<()> {
+        let kernel = resolve_at_camera(call, Backend::Gpu)?.kernel();
+        if !kernel.traces() {
+            if call.light.is_hard() {
+                return Err(point_light_on_gpu("size"));
+            }
+            if !matches!(kernel, Method::Pcss { .. }) {
+                gather::check_method(kernel)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn first_hits(&mut self, camera: &Camera, scene: &SceneTriangles) -> Result<GBuffer> {
+        let (hit, t) = first_hits(gpu()?, camera, scene)?;
+        self.device_timings.extend(t);
+        Ok(gbuffer::from_hits(camera, scene, &hit))
+    }
+
+    fn shadow_mapping(
+        &mut self,
+        call: &EyeCall,
+        cfg: &ShadowMappingConfig,
+        scene: &SceneTriangles,
+        g: &GBuffer,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<f32>> {
+        let (v, _) = super::shadow_mapping::render_prepared(
+            gpu()?,
+            call,
+            cfg,
+            scene,
+            g,
+            false,
+            sw,
+            &mut self.device_timings,
+        )?;
+        Ok(v)
+    }
+
+    fn trace(
+        &mut self,
+        f: &Framed,
+        tris: Vec<[Vec3; 3]>,
+        _camera: &Camera,
+        samples: u32,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<f32>> {
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()
             .map(GpuRayStart::new)
             .collect();
-        let (v, t) = exact_visibility(g, tris, &starts, samples, f.light_size, &mut sw)?;
-        device_timings.extend(t);
-        for (&k, v) in f.hits.iter().zip(v) {
-            vis[k] = v;
-        }
-        sw.lap("shadow");
-    } else if !f.points.is_empty() {
-        let casting = eye::casting_faces(call, &scene, &f, &gb);
-        let (grid, m) = eye::map_grid(call, &gb, &f, &casting, Backend::Gpu)?;
-        method = m;
+        let (v, t) = exact_visibility(gpu()?, tris, &starts, samples, f.light_size, sw)?;
+        self.device_timings.extend(t);
+        Ok(v)
+    }
+
+    fn shade_maps(
+        &mut self,
+        call: &EyeCall,
+        f: &Framed,
+        tris: &LightTriangles,
+        grid: MapGrid,
+        method: &MethodConfig,
+        sw: &mut Stopwatch,
+    ) -> Result<(Vec<f32>, EyeMaps)> {
         check_side("map_resolution", (grid.width, grid.height))?;
-        sw.lap("extent");
-        let tris = eye::light_triangles(&mut f, &casting);
+        let g = gpu()?;
         let kernel = method.kernel();
         let (v, m, t) = match (kernel, super::smoothies::options(kernel)) {
             // The one-layer methods' own kernels after the front layer
             // (front_layer.rs).
             (Method::Pcss { max_taps }, _) => {
-                super::pcss::shade_points(g, &f, &tris, grid, max_taps, &call.bias, &mut sw)?
+                super::pcss::shade_points(g, f, tris, grid, max_taps, &call.bias, sw)?
             }
-            (_, Some(s)) => {
-                super::smoothies::shade_eye(g, &f, &tris, grid, &s, &call.bias, &mut sw)?
+            (_, Some(s)) => super::smoothies::shade_eye(g, f, tris, grid, &s, &call.bias, sw)?,
+            (kernel, None) => {
+                shade_maps(g, f, tris, grid, method.passes(), kernel, &call.bias, sw)?
             }
-            (kernel, None) => shade_maps(
-                g,
-                &f,
-                &tris,
-                grid,
-                method.passes(),
-                kernel,
-                &call.bias,
-                &mut sw,
-            )?,
         };
-        device_timings.extend(t);
-        for (&k, v) in f.hits.iter().zip(v) {
-            vis[k] = v;
-        }
-        maps = Some(m);
-        sw.lap("maps_out");
-    } else {
-        method = eye::resolve_at_camera(call, Backend::Gpu)?;
+        self.device_timings.extend(t);
+        Ok((v, m))
     }
-    let mut timings = sw.timings;
-    timings.extend(device_timings);
-    Ok((
-        EyeImage {
-            gbuffer: gb,
-            visibility: vis,
-            maps,
-            light_space: f.space,
+
+    fn timings(&mut self, host: Timings, method: &MethodConfig) -> Timings {
+        let mut timings = host;
+        timings.extend(std::mem::take(&mut self.device_timings));
+        if matches!(method, MethodConfig::ShadowMapping(_)) {
+            timings
+        } else {
             // Several submissions time some stages more than once: summed.
-            timings: merged(timings),
-        },
-        method,
-    ))
+            merged(timings)
+        }
+    }
 }
 
 /// The triangle (input index) each pixel's ray hits first, cast on the
@@ -626,7 +638,7 @@ fn shade_maps(
     }
     fits(g, "map_resolution", texels * 4)?;
     // maps::occluder_layers' near plane.
-    let near = crate::pipeline::near_plane(&tris.verts);
+    let near = crate::raster::near_plane(&tris.verts);
     let occ_tris: Vec<GpuTri> = setup_triangles(&grid, &tris.verts, tris.faces, near)
         .iter()
         .map(GpuTri::from_setup)

@@ -5,26 +5,18 @@
 
 use super::context::gpu;
 use super::dispatch::upload;
-use super::from_meshes::check_side;
 use super::gather;
 use super::pcss::PcssShading;
 use super::readback::{submit_and_read, visibility, with_error_scopes};
+use super::refusals::{check_side, point_light_on_gpu};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::frame::{check_depth_inputs, DepthInUnit};
 use crate::geom::light::{is_point, MapGrid};
 use crate::geom::units::{depth_unit, farthest};
 use crate::methods::Method;
-use crate::pipeline::{check_depth_inputs, DepthInUnit, Stopwatch, Timings};
-
-/// A point light (size 0) has no GPU kernel: its hard shadow map is the
-/// CPU's (`point_light.rs`).
-pub(super) fn point_light_on_gpu(arg: &str) -> Error {
-    Error::invalid(
-        arg,
-        "a point light (size 0) runs on the CPU backend only; use backend=\"cpu\"",
-    )
-}
+use crate::timing::{Stopwatch, Timings};
 
 /// `pipeline::from_depth` on the GPU: the same checks, result and stage
 /// names (plus the device's).

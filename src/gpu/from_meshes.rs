@@ -13,43 +13,22 @@
 use super::context::gpu;
 use super::dispatch::storage;
 use super::exact::ExactShading;
-use super::from_depth::point_light_on_gpu;
 use super::gather;
 use super::pcss::PcssShading;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::refusals::{check_side, point_light_on_gpu};
 use super::shading::{check_size, Shading};
 use super::smoothies::{self, Receivers, SmoothieShading};
 use super::timing::{merged, StageTimer};
 use crate::error::{Error, Result};
+use crate::frame::{frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult};
 use crate::geom::light::is_point;
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
-use crate::pipeline::{
-    frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult, Stopwatch,
-};
 use crate::raster::setup_triangles;
-
-/// The largest map side on the GPU: fixed-point coordinates ((side + 2
-/// guard bands) x 256) must fit in i32 for the shader's edge functions,
-/// texel offsets below 2^16 keep the depth plane's limb products exact, and
-/// a row's statistics (one invocation a row) stay within lavapipe's 65535
-/// loop iterations.
-pub const MAX_SIDE: usize = 1 << 14;
-
-pub fn check_side(arg: &str, g: (usize, usize)) -> Result<()> {
-    if g.0 > MAX_SIDE || g.1 > MAX_SIDE {
-        return Err(Error::too_large(
-            arg,
-            format!(
-                "{}x{} exceeds the GPU backend's largest side {MAX_SIDE}; use backend=\"cpu\"",
-                g.0, g.1
-            ),
-        ));
-    }
-    Ok(())
-}
+use crate::timing::Stopwatch;
 
 /// The shading stage of a method: over occluder maps, or over triangles.
 enum Stage {

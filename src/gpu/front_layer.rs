@@ -19,8 +19,8 @@ use crate::error::{Error, Result};
 use crate::eye::maps::{self, LightTriangles, ShadingPoints};
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
-use crate::pipeline::{Stopwatch, Timings};
 use crate::raster::setup_triangles;
+use crate::timing::{Stopwatch, Timings};
 use rayon::prelude::*;
 
 /// A method's kernel recorded after the front layer: it reads the layer at
@@ -65,7 +65,7 @@ impl FrontLayer {
                 ),
             ));
         }
-        let near = crate::pipeline::near_plane(&tris.verts);
+        let near = crate::raster::near_plane(&tris.verts);
         let occ_tris = setup_triangles(&grid, &tris.verts, tris.faces, near)
             .iter()
             .map(GpuTri::from_setup)

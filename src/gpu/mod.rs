@@ -31,7 +31,7 @@
 //!   `shadow_mapping.wgsl` and `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
 //! Entry points: `from_meshes` (the whole mesh pipeline), `from_depth`
-//! (the user's depth maps, shaded) and `render_gpu` (the eye view). Device, queue and pipelines are made once
+//! (the user's depth maps, shaded) and `GpuEye` (the eye view's stages, run by `crate::pipeline::eye_view`). Device, queue and pipelines are made once
 //! per process (`context.rs`).
 
 mod context;
@@ -47,6 +47,7 @@ mod gather;
 mod pcss;
 mod raster;
 mod readback;
+mod refusals;
 #[cfg(test)]
 mod shader_tests;
 mod shading;
@@ -55,9 +56,9 @@ mod smoothies;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};
-pub use eye::render_gpu;
+pub use eye::GpuEye;
 pub use from_depth::from_depth;
-pub use from_meshes::{from_meshes, MAX_SIDE};
+pub use from_meshes::from_meshes;
 
 use crate::error::Result;
 

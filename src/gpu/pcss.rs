@@ -25,7 +25,7 @@ use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
 use crate::methods::pcss::{half_per_w, MAX_TAPS};
 use crate::methods::LightPoint;
-use crate::pipeline::{Stopwatch, Timings};
+use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::OnceLock;

@@ -4,7 +4,7 @@
 use super::context::Gpu;
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::pipeline::Stopwatch;
+use crate::timing::Stopwatch;
 
 /// Runs `f` with the device's errors (out of memory, validation, internal)
 /// caught in error scopes and returned as `Error::Gpu`, rather than left to

@@ -30,23 +30,21 @@
 //! exact by rounding its bound down to f32); PCF sums its weights in f32
 //! where the CPU sums in f64 (|dV| below 1e-6).
 
-use super::context::{gpu, Gpu};
+use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::timing::StageTimer;
-use crate::backend::Backend;
 use crate::error::{Error, Result};
-use crate::eye::gbuffer::{self, GBuffer, SceneTriangles};
+use crate::eye::gbuffer::{GBuffer, SceneTriangles};
 use crate::eye::shadow_mapping::{self as sm, Prepared};
-use crate::eye::{self, EyeCall, EyeImage};
+use crate::eye::EyeCall;
 use crate::methods::shadow_mapping::blur::spacing;
 use crate::methods::shadow_mapping::config::{
     DepthBias, EyeSpaceBlur, ShadowMappingConfig, DEPTH_TOLERANCE,
 };
 use crate::methods::shadow_mapping::lookup::{query, Query};
 use crate::methods::shadow_mapping::raster::{DepthMap, Distribution, SetupTri};
-use crate::methods::MethodConfig;
-use crate::pipeline::{Stopwatch, Timings};
+use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use std::sync::OnceLock;
 
@@ -567,31 +565,6 @@ fn upload_rw(device: &wgpu::Device, label: &str, items: &[f32]) -> wgpu::Buffer 
         contents: bytemuck::cast_slice(data),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     })
-}
-
-/// `render(..., backend="gpu")` with ShadowMapping: the first hits on the
-/// device, the CPU's preparation, the map, lookups and blur on the device.
-pub fn render_eye(call: &EyeCall, cfg: &ShadowMappingConfig) -> Result<(EyeImage, MethodConfig)> {
-    let method = eye::resolve_at_camera(call, Backend::Gpu)?;
-    let g = gpu()?;
-    let mut sw = Stopwatch::new();
-    let scene = SceneTriangles::new(call.meshes)?;
-    let (hit, mut device_timings) = super::eye::first_hits(g, call.camera, &scene)?;
-    let gb = gbuffer::from_hits(call.camera, &scene, &hit);
-    sw.lap("first_hits");
-    let (vis, _) = render_prepared(
-        g,
-        call,
-        cfg,
-        &scene,
-        &gb,
-        false,
-        &mut sw,
-        &mut device_timings,
-    )?;
-    let mut timings = sw.timings;
-    timings.extend(device_timings);
-    Ok((sm::image(call, &scene, gb, vis, timings)?, method))
 }
 
 /// The visibility (and, if asked, the device's map) of G-buffer `gb`.

@@ -110,8 +110,8 @@ fn gpu_stage_name(name: &'static str) -> &'static str {
 /// `timings` with the stages named more than once (a call of several
 /// submissions: "encode", "device", "readback", "upload", or "gpu" without
 /// timestamps) summed into the first of each name.
-pub fn merged(timings: crate::pipeline::Timings) -> crate::pipeline::Timings {
-    let mut out: crate::pipeline::Timings = Vec::with_capacity(timings.len());
+pub fn merged(timings: crate::timing::Timings) -> crate::timing::Timings {
+    let mut out: crate::timing::Timings = Vec::with_capacity(timings.len());
     for (name, t) in timings {
         match out.iter_mut().find(|(n, _)| *n == name) {
             Some((_, sum)) => *sum += t,

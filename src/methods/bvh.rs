@@ -16,6 +16,7 @@
 //! below `SAH_DEPTH` levels the build falls back to median splits, which
 //! halve the count each level, so no tree is deeper than `SAH_DEPTH` + 32.
 
+use super::bvh_node::Node;
 use super::bvh_wide::{collapse, Wide};
 use glam::Vec3;
 
@@ -25,16 +26,6 @@ const LEAF: usize = 4;
 const SAH_DEPTH: usize = 28;
 /// Candidate planes per axis (bins - 1).
 const BINS: usize = 16;
-
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Node {
-    pub(crate) min: Vec3,
-    pub(crate) max: Vec3,
-    /// Leaf: first triangle; inner: index of the left child (right = left + 1).
-    pub(crate) start: u32,
-    /// Triangles in a leaf; 0 for an inner node.
-    pub(crate) count: u32,
-}
 
 /// A bounding volume hierarchy over triangles.
 pub struct Bvh {

@@ -14,7 +14,7 @@
 //! the binary tree, so every ray's answer is the binary tree's (and the
 //! GPU's, which traverses the binary tree).
 
-use super::bvh::Node;
+use super::bvh_node::Node;
 
 /// No child in this slot.
 const EMPTY: u32 = u32::MAX;

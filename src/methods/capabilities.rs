@@ -96,10 +96,11 @@ pub fn limits() -> Limits {
         max_passes: MAX_PASSES,
         max_samples: MAX_SAMPLES,
         max_threads: crate::threads::MAX_THREADS,
-        #[cfg(feature = "gpu")]
-        gpu_max_side: crate::gpu::MAX_SIDE,
-        #[cfg(not(feature = "gpu"))]
-        gpu_max_side: 0,
+        gpu_max_side: if cfg!(feature = "gpu") {
+            crate::backend::GPU_MAX_SIDE
+        } else {
+            0
+        },
     }
 }
 

@@ -71,7 +71,7 @@ pub struct ExactConfig {
 /// from the scene (`plan.rs`, light-view maps from meshes), elsewhere the rule.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MethodConfig {
-    Auto(SsmConfig, super::plan::Target),
+    Auto(SsmConfig, super::target::Target),
     Ssm(SsmConfig),
     Bitmask(BitmaskConfig),
     Exact(ExactConfig),

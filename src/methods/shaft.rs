@@ -19,7 +19,8 @@
 //! extremes over the s range are at its ends. The node can be entered only
 //! if its box meets that x range, and the y one.
 
-use super::bvh::{Bvh, Node};
+use super::bvh::Bvh;
+use super::bvh_node::Node;
 use glam::Vec3;
 
 /// The shaft test's margin, relative to the scene's size.

@@ -1,94 +1,15 @@
 //! Depth maps the user rendered -> visibility on the CPU, and the checks
 //! and unit change both backends apply to such maps.
 
-use crate::error::{Error, Result};
-use crate::geom::light::{check_light_size, MapGrid};
-use crate::geom::units::{depth_unit, farthest, light_size_in, scaled_map};
+use crate::error::Result;
+use crate::geom::light::MapGrid;
+use crate::geom::units::{depth_unit, farthest};
 use crate::memory::{check_fits, map_bytes};
-use crate::methods::{Input, Method, ShadowInputs};
-use rayon::prelude::*;
-use std::borrow::Cow;
+use crate::methods::{Method, ShadowInputs};
 
-use super::frame::{Stopwatch, Timings};
-use super::from_meshes::shade_map;
-
-/// Checks a user depth map: finite and > 0, or +inf for "nothing here".
-pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
-    if let Some(k) = depth.par_iter().position_any(|&z| !(z > 0.0)) {
-        return Err(Error::invalid(
-            arg,
-            format!(
-                "depths must be > 0 (planar distance from the light) or +inf where empty; \
-                 texel {k} holds {}",
-                depth[k]
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// Checks the inputs of `from_depth` (both backends): the light size, a
-/// method that reads maps, each map's size and depths. Returns the light size.
-pub(crate) fn check_depth_inputs(
-    grid: &MapGrid,
-    occluder_grid: &MapGrid,
-    light_size: [f64; 2],
-    front: &[f32],
-    back: Option<&[f32]>,
-    receiver: &[f32],
-    method: Method,
-) -> Result<[f64; 2]> {
-    let light_size = check_light_size("light_size", light_size)?;
-    if !method.reads_input(Input::OccluderLayers) {
-        return Err(Error::invalid(
-            "method",
-            "traces the occluder triangles, which depth maps do not have; use soft_shadow_map with meshes",
-        ));
-    }
-    for (arg, d, g) in [
-        ("occluder_depth", Some(front), occluder_grid),
-        ("occluder_depth_back", back, occluder_grid),
-        ("receiver_depth", Some(receiver), grid),
-    ] {
-        if let Some(d) = d {
-            if d.len() != g.len() {
-                return Err(Error::shape(
-                    arg,
-                    format!("has {} texels, expected {}x{}", d.len(), g.height, g.width),
-                ));
-            }
-            check_depth(arg, d)?;
-        }
-    }
-    Ok(light_size)
-}
-
-/// The user's depth maps and light size in the kernels' depth unit (see
-/// units.rs), shared by both backends; the maps are copied only when the unit
-/// is not 1.
-pub(crate) struct DepthInUnit<'a> {
-    pub light_size: [f64; 2],
-    pub front: Cow<'a, [f32]>,
-    pub back: Option<Cow<'a, [f32]>>,
-    pub receiver: Cow<'a, [f32]>,
-}
-
-impl<'a> DepthInUnit<'a> {
-    pub(crate) fn new(
-        unit: f64,
-        light_size: [f64; 2],
-        front: &'a [f32],
-        back: Option<&'a [f32]>,
-        receiver: &'a [f32],
-    ) -> Result<DepthInUnit<'a>> {
-        Ok(DepthInUnit {
-            light_size: light_size_in("light_size", light_size, unit)?,
-            front: scaled_map(front, unit),
-            back: back.map(|b| scaled_map(b, unit)),
-            receiver: scaled_map(receiver, unit),
-        })
-    }
-}
+use crate::frame::{check_depth_inputs, DepthInUnit};
+use crate::methods::shade_map;
+use crate::timing::{Stopwatch, Timings};
 
 /// Soft shadow map from depth maps the user rendered.
 pub fn from_depth(
@@ -141,6 +62,7 @@ pub fn from_depth(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
 
     /// A texel-aligned plate at depth 2 over receivers at depth 4, times `s`.
     fn plate_maps(n: usize, s: f32) -> (Vec<f32>, Vec<f32>) {

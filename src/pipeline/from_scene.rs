@@ -17,9 +17,8 @@ use crate::raster::Prepared;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-use super::frame::{frame_scene, FramedScene, Stopwatch};
-use super::from_meshes::light_space_triangles;
-use super::{MapSettings, ShadowResult};
+use crate::frame::{frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult};
+use crate::timing::Stopwatch;
 
 /// Soft shadow map of a scene shadowing itself.
 pub fn from_scene(

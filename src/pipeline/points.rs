@@ -2,25 +2,16 @@
 //! occluders, and the world points of its receiver texels.
 
 use crate::error::{Error, Result};
-use crate::geom::light::{is_point, MapGrid};
+use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
 use crate::geom::units::{check_lateral, check_unit, depth_unit, light_size_in, scaled_map};
-use crate::methods::{point_light, Input, LightPoint, Method, ShadowInputs};
+use crate::methods::{Input, LightPoint, Method, ShadowInputs};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::from_depth::check_depth;
-use super::from_meshes::light_space_triangles;
-
-/// Visibility at receiver points, as `shade_map`.
-pub(crate) fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
-    if is_point(inputs.light_size) && method.reads_input(Input::OccluderLayers) {
-        point_light::visibility_points(inputs, pts)
-    } else {
-        method.implementation().visibility_points(inputs, pts)
-    }
-}
+use crate::frame::{check_depth, light_space_triangles};
+use crate::methods::shade_points;
 
 /// What a method reads of the occluders when shading points.
 #[derive(Debug, Clone)]

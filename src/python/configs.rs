@@ -6,7 +6,7 @@
 
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string, string};
 use crate::methods::config::{auto_rule, check_resolution, LooseOptions};
-use crate::methods::plan::Target;
+use crate::methods::target::Target;
 use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;

@@ -5,7 +5,8 @@ use super::configs::{method_arg, Loose};
 use super::convert::{light_of, mesh, opt_int, same_shape, slice, space_of, triples, Light};
 use super::errors;
 use super::results::{DepthShadowResult, MeshShadowResult};
-use crate::backend::{self, BackendChoice, DepthCall, MeshCall, SceneCall};
+use crate::api::{self, DepthCall, MeshCall, SceneCall};
+use crate::backend::BackendChoice;
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::Light as CoreLight;
 use crate::methods::MethodConfig;
@@ -78,7 +79,7 @@ pub fn shadow_map_from_meshes<'py>(
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
         };
-        let run = py.detach(|| backend::shadow_map(&call))?;
+        let run = py.detach(|| api::shadow_map(&call))?;
         MeshShadowResult::new(py, run)
     })
 }
@@ -125,7 +126,7 @@ pub fn shadow_map_from_scene<'py>(
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
         };
-        let run = py.detach(|| backend::scene_shadow_map(&call))?;
+        let run = py.detach(|| api::scene_shadow_map(&call))?;
         MeshShadowResult::new(py, run)
     })
 }
@@ -193,7 +194,7 @@ pub fn shadow_map_from_depth<'py>(
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
         };
-        let run = py.detach(|| backend::shadow_map_from_depth(&call))?;
+        let run = py.detach(|| api::shadow_map_from_depth(&call))?;
         DepthShadowResult::new(py, &grid, run)
     })
 }
@@ -253,7 +254,7 @@ pub fn sample_points<'py>(
         let pts = triples("points", &points)?;
         let threads = opt_int("threads", threads.as_ref())?;
         let (v, inside) =
-            py.detach(|| backend::sample_points(&grid, &light, source, pts, &method, threads))?;
+            py.detach(|| api::sample_points(&grid, &light, source, pts, &method, threads))?;
         Ok((
             v.into_pyarray(py).into_any(),
             inside.into_pyarray(py).into_any(),
@@ -281,7 +282,7 @@ pub fn receiver_points<'py>(
         // The kernels' depths must be > 0 (or inf): a sun's orthographic
         // depths start at 0 and are checked once converted.
         let kernel: Vec<f32> = rec.iter().map(|&z| light.kernel_depth(z)).collect();
-        pipeline::check_depth("receiver_depth", &kernel)?;
+        crate::frame::check_depth("receiver_depth", &kernel)?;
         let (pts, idx) = py.detach(|| pipeline::receiver_points(&grid, &light, rec));
         let n = pts.len();
         let flat: Vec<f64> = pts.into_iter().flatten().collect();

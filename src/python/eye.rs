@@ -8,11 +8,12 @@ use super::configs::{self, method_arg, Loose};
 use super::convert::{light_of, mesh, opt_float, opt_int, opt_resolution, triples, Light};
 use super::errors;
 use super::results::{map, sun_depth};
-use crate::backend::{BackendChoice, Run};
+use crate::api::Run;
+use crate::backend::BackendChoice;
 use crate::eye::shading::{self, ColorValue};
-use crate::eye::{self, Bias, EyeCall, EyeImage, Lighting, Shaded};
+use crate::eye::{Bias, EyeCall, EyeImage, Lighting, Shaded};
 use crate::geom::mesh::MeshRef;
-use crate::pipeline::Timings;
+use crate::timing::Timings;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -145,7 +146,7 @@ pub fn render<'py>(
             opt_color("albedo", albedo.as_ref())?.as_ref(),
             refs.len(),
         )?;
-        let (run, shaded) = py.detach(|| eye::render_shaded(&call, &lighting))?;
+        let (run, shaded) = py.detach(|| crate::api::render_shaded(&call, &lighting))?;
         EyeResult::new(py, run, shaded)
     })
 }

@@ -2,11 +2,11 @@
 //! from the core's vectors without a copy.
 
 use super::configs;
-use crate::backend::DepthOutput;
-use crate::backend::Run;
+use crate::api::{DepthOutput, Run};
+use crate::frame::ShadowResult;
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
-use crate::pipeline::{ShadowResult, Timings};
+use crate::timing::Timings;
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
@@ -89,7 +89,7 @@ impl MeshShadowResult {
 
 /// A plan as Python reads it: (name, taken, why) per decision.
 pub(crate) fn plan_tuples(
-    plan: Option<crate::methods::plan::Plan>,
+    plan: Option<crate::auto::Plan>,
 ) -> Option<Vec<(&'static str, bool, String)>> {
     plan.map(|p| {
         p.decisions

@@ -13,24 +13,33 @@
 //! * Parallel without locks: the map is cut into bands of rows; triangles are
 //!   binned by band, and each band is rasterized by one task.
 //!
-//! The code is split by job: `clip.rs` holds the clip planes and
+//! The code is split by job: `geom/clip.rs` holds the clip planes and
 //! Sutherland-Hodgman clipping, `setup.rs` the projection, clipping and
 //! snapping of triangles into `SetupTri`, `scan.rs` the bands and the scan of
 //! one triangle, `layers.rs` the binning by band and the depth layers
 //! (nearest, farthest, peeling), and `depth_plane.rs` the f32 form of 1/Z.
 
-pub(crate) mod clip;
 pub(crate) mod depth_plane;
+mod edge;
 mod layers;
 mod scan;
 mod setup;
 
 pub use layers::{rasterize, DepthLayers, Prepared};
+
+use glam::DVec3;
 // For the GPU backend, which uploads the CPU's set-up triangles and peels
 // with the same gap, and the planner, which counts layers with it.
 pub(crate) use layers::PEEL_GAP;
 #[cfg(feature = "gpu")]
 pub(crate) use setup::{setup_triangles, SetupTri};
+
+/// Clip distance for rasterization: a tiny fraction of the scene's depth range,
+/// so that geometry touching the light's plane keeps finite 1/Z.
+pub fn near_plane<'a>(verts: impl IntoIterator<Item = &'a DVec3>) -> f64 {
+    let far = verts.into_iter().fold(0f64, |m, q| m.max(q.z.abs()));
+    (far * 1e-9).max(f64::MIN_POSITIVE)
+}
 
 #[cfg(test)]
 mod tests {

@@ -3,6 +3,7 @@
 //! edges watertight, and the height of the bands of rows that the map is cut
 //! into for parallel rasterization.
 
+use super::edge::owns_ties;
 use super::setup::{SetupTri, ONE};
 use crate::geom::light::MapGrid;
 
@@ -10,26 +11,6 @@ use crate::geom::light::MapGrid;
 pub(super) fn band_rows(height: usize) -> usize {
     let bands = (rayon::current_num_threads() * 8).max(1);
     height.div_ceil(bands).max(1)
-}
-
-/// Tie rule for a texel center exactly on an edge (dx, dy): of an edge and its
-/// reverse exactly one owns the center, so shared edges are neither cracked
-/// nor hit twice.
-#[inline]
-fn owns_ties(dx: i64, dy: i64) -> bool {
-    dy < 0 || (dy == 0 && dx > 0)
-}
-
-/// Whether the texel center (cx, cy) (subpixel units) is inside the
-/// triangle (x, y) by `raster_tri`'s rule: its edge functions, ties
-/// included, at one center.
-#[inline]
-pub(super) fn covers(x: &[i64; 3], y: &[i64; 3], cx: i64, cy: i64) -> bool {
-    (0..3).all(|k| {
-        let (s, e) = ((k + 1) % 3, (k + 2) % 3);
-        let (dx, dy) = (x[e] - x[s], y[e] - y[s]);
-        dx * (cy - y[s]) - dy * (cx - x[s]) + owns_ties(dx, dy) as i64 > 0
-    })
 }
 
 /// Visits the texel centers covered by triangle `t` within `rows`, calling
@@ -82,6 +63,7 @@ pub(super) fn raster_tri(
 
 #[cfg(test)]
 mod tests {
+    use super::super::edge::covers;
     use super::*;
     use crate::raster::depth_plane::DepthPlane;
 

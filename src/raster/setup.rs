@@ -3,7 +3,7 @@
 //! vertices to the fixed-point grid, giving the `SetupTri`s that both the CPU
 //! scan (`scan.rs`) and the GPU rasterizer consume.
 
-use super::clip::{clip_polygon, plane_dist, Plane};
+use crate::geom::clip::{clip_polygon, plane_dist, Plane};
 use crate::geom::light::MapGrid;
 use crate::raster::depth_plane::DepthPlane;
 use glam::DVec3;
@@ -188,7 +188,7 @@ impl Projector {
         // A triangle whose box holds one texel center and misses it writes
         // nothing: left out before its depth plane (most of a fine mesh's
         // triangles on a coarse map).
-        if i0 == i1 && j0 == j1 && !super::scan::covers(&x, &y, cx, cy) {
+        if i0 == i1 && j0 == j1 && !super::edge::covers(&x, &y, cx, cy) {
             return;
         }
         let mut w_ref = 0f64;

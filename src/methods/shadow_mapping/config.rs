@@ -247,8 +247,7 @@ pub struct ShadowMappingConfig {
 }
 
 pub const DEFAULT_SM_RESOLUTION: usize = 2048;
-/// The largest side of a shadow map (16384² f32 is 1 GiB per layer).
-pub const MAX_SM_SIDE: usize = 16384;
+pub use crate::methods::shadow_mapping::raster::MAX_SM_SIDE;
 
 impl Default for ShadowMappingConfig {
     fn default() -> Self {

@@ -378,8 +378,10 @@ fn setup(
     }
 }
 
-/// The largest map side the set-up handles (`config::MAX_SM_SIDE`).
-const MAX_SIDE: usize = super::config::MAX_SM_SIDE;
+/// The largest side of a shadow map (16384² f32 is 1 GiB per layer), the
+/// largest the set-up handles.
+pub const MAX_SM_SIDE: usize = 16384;
+const MAX_SIDE: usize = MAX_SM_SIDE;
 
 /// The set-up triangles of the faces `which` of `faces` (world `verts`)
 /// under `proj` on a (width, height) map, with `offset` baked in: the

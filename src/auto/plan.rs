@@ -27,43 +27,9 @@
 //! is kept when nothing better fits), and each more accurate setting's time
 //! is predicted from it by the largest ratio measured on the study's scenes.
 
-use super::config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
-use super::shadow_mapping::config::{check_real, Real};
-use crate::error::{Error, Result};
-
-/// What `ss.Auto` aims at: an error (the paper's §4.2.1 metric), a time
-/// budget in seconds, or neither (the fixed rule).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct Target {
-    pub error: Option<Real>,
-    pub time: Option<Real>,
-}
-
-/// Smallest error target accepted: below it only many samples of `exact`
-/// help, which the plan can still give but not promise.
-pub const MIN_ERROR: f64 = 1e-4;
-
-impl Target {
-    pub fn new(error: Option<f64>, time: Option<f64>) -> Result<Target> {
-        let error = error
-            .map(|e| check_real("error", e, MIN_ERROR, 1.0, "an error"))
-            .transpose()?;
-        let time = time
-            .map(|t| check_real("time", t, 1e-6, 1e6, "a time in seconds"))
-            .transpose()?;
-        if error.is_some() && time.is_some() {
-            return Err(Error::invalid(
-                "time",
-                "give an error target or a time budget, not both",
-            ));
-        }
-        Ok(Target { error, time })
-    }
-
-    pub fn is_none(&self) -> bool {
-        self.error.is_none() && self.time.is_none()
-    }
-}
+use crate::methods::config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
+use crate::methods::shadow_mapping::config::Real;
+use crate::methods::target::Target;
 
 /// What the planner reads of a framed scene (kernel units).
 #[derive(Debug, Clone, Copy)]
@@ -179,7 +145,7 @@ const CANDIDATES: [Candidate; 4] = [
         label: "ssm, 2 passes, quarter-resolution occluder maps (the sum)",
         worst_error: 0.046,
         time_ratio: 1.0,
-        config: |r| MethodConfig::Ssm(super::config::auto_rule(r)),
+        config: |r| MethodConfig::Ssm(crate::methods::config::auto_rule(r)),
     },
     Candidate {
         label: "bitmask, 256 samples, gaps closed, hierarchy",
@@ -209,7 +175,7 @@ const CANDIDATES: [Candidate; 4] = [
 /// (1024 samples: 0.0012-0.0019 against 4096 on the test scenes).
 fn exact_samples_for(error: f64) -> u32 {
     let n = (0.05 / error).powi(2).ceil();
-    n.clamp(16.0, super::config::MAX_SAMPLES as f64) as u32
+    n.clamp(16.0, crate::methods::config::MAX_SAMPLES as f64) as u32
 }
 
 /// The plan for `stats` and `target`; `probe_seconds` is the probe's time
@@ -510,7 +476,7 @@ impl Plan {
             ),
         });
         if open {
-            c.gaps = super::bitmask::Gaps::Open;
+            c.gaps = crate::methods::bitmask::Gaps::Open;
             self.config = MethodConfig::Bitmask(c);
         }
     }
@@ -535,7 +501,7 @@ impl Plan {
         let [covered, back] = surfaces;
         self.decisions.push(Decision {
             name: "layers",
-            taken: passes != super::config::DEFAULT_PASSES,
+            taken: passes != crate::methods::config::DEFAULT_PASSES,
             why: if passes == 1 {
                 format!(
                     "none of the {covered} texels of the coarse occluder map sees a second \
@@ -587,7 +553,8 @@ pub fn plan_eye(target: &Target, rule: MethodConfig) -> Plan {
             ),
         ),
         Some(Real(e)) => {
-            let n = ((EYE_EXACT / e).powi(2).ceil() as u32).clamp(1, super::config::MAX_SAMPLES);
+            let n = ((EYE_EXACT / e).powi(2).ceil() as u32)
+                .clamp(1, crate::methods::config::MAX_SAMPLES);
             (
                 MethodConfig::Exact(ExactConfig { samples: n }),
                 format!(

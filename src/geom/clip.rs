@@ -8,7 +8,7 @@ use glam::DVec3;
 /// A clip plane in light space: keep points where a.X + b.Y + c.Z + d >= 0.
 pub(crate) type Plane = [f64; 4];
 
-pub(super) fn plane_dist(p: &Plane, q: DVec3) -> f64 {
+pub(crate) fn plane_dist(p: &Plane, q: DVec3) -> f64 {
     p[0] * q.x + p[1] * q.y + p[2] * q.z + p[3]
 }
 

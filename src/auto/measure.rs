@@ -1,5 +1,5 @@
 //! What the planner measures of a scene's occluders before the planned run
-//! (`methods/plan.rs`): how many distinct surfaces the occluder texels see
+//! (`plan.rs`): how many distinct surfaces the occluder texels see
 //! along the light's central ray (front and back layers, then depth
 //! peeling), what each peeled layer changes in the shadow, and how much of
 //! the front layer lies in features at most `THIN_TEXELS` wide.
@@ -12,13 +12,14 @@
 //! 0.0003 of the full maps' (0.0005-0.0009). The thin features need the
 //! planned maps' own texels: only the front layer, at their resolution.
 
+use super::plan::{layer_change, SceneStats, LAYER_CHANGE, THIN_TEXELS};
 use crate::geom::light::MapGrid;
-use crate::methods::plan::{layer_change, LAYER_CHANGE, THIN_TEXELS};
 use crate::methods::{Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared, PEEL_GAP};
 
-use super::frame::FramedScene;
-use super::from_meshes::shade_map;
+use crate::frame::FramedScene;
+use crate::methods::shade_map;
+use glam::DVec3;
 
 /// The planned maps' front layer on `grid`: its covered and thin texels.
 pub(crate) fn thin_features(f: &FramedScene, faces: &[[u32; 3]], grid: &MapGrid) -> (usize, usize) {
@@ -164,6 +165,75 @@ pub(crate) fn thin_texels(front: &[f32], w: usize, h: usize) -> usize {
     thin.iter().filter(|&&t| t).count()
 }
 
+/// What a plan reads of a framed scene (`plan.rs`): its
+/// light-space depth ranges and bounds, the map's extent and the light's
+/// size, for an output of `resolution`. One pass over the vertices; the
+/// ratios the planner forms do not depend on the depth unit.
+pub(crate) fn scene_stats(f: &FramedScene, resolution: (usize, usize)) -> SceneStats {
+    let z_range = |v: &[DVec3]| {
+        v.iter().fold((f64::INFINITY, 0f64), |(lo, hi), q| {
+            (lo.min(q.z), hi.max(q.z))
+        })
+    };
+    let (oz0, oz1) = z_range(&f.occ_ls);
+    let (rz0, rz1) = z_range(&f.rec_ls);
+    let bounds = f.occ_ls.iter().fold(
+        [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ],
+        |b, q| {
+            let (x, y) = (q.x / q.z, q.y / q.z);
+            [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)]
+        },
+    );
+    let w = |z: f64| if z > 0.0 { 1.0 / z } else { f64::INFINITY };
+    SceneStats {
+        resolution,
+        extent: [f.grid.tx, f.grid.ty],
+        light_size: f.light_size,
+        occ_w_near: w(oz0),
+        occ_w_far: w(oz1),
+        rec_w_near: w(rz0.max(0.0)),
+        rec_w_far: w(rz1),
+        occ_bounds: bounds,
+        // One depth to 1e-9 of it: a plane parallel to the light.
+        occ_flat: oz1 - oz0 <= 1e-9 * oz1,
+        occ_planar: on_one_plane(&f.occ_ls),
+    }
+}
+
+/// Whether every point lies on one plane, to 1e-9 of the points' span:
+/// the plane through the first point, the farthest from it, and the one
+/// farthest from the line through both.
+fn on_one_plane(v: &[DVec3]) -> bool {
+    let Some(&a) = v.first() else {
+        return true;
+    };
+    let farthest = |key: &dyn Fn(DVec3) -> f64| {
+        v.iter()
+            .copied()
+            .max_by(|p, q| key(*p).total_cmp(&key(*q)))
+            .unwrap_or(a)
+    };
+    let b = farthest(&|p| (p - a).length_squared());
+    let span = (b - a).length();
+    if span == 0.0 {
+        return true;
+    }
+    let axis = (b - a) / span;
+    let c = farthest(&|p| (p - a).cross(axis).length_squared());
+    let n = (b - a).cross(c - a);
+    if n.length() <= 1e-12 * span * span {
+        // Collinear: a line lies on a plane.
+        return true;
+    }
+    let n = n.normalize();
+    v.iter().all(|p| n.dot(*p - a).abs() <= 1e-9 * span)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -183,5 +253,33 @@ mod tests {
         // thin); column t + 1 holds row 1's last texel alone between empty
         // texels (thin); column 0's texel touches the bottom border.
         assert_eq!(thin_texels(&m, w, 3), t + 1);
+    }
+}
+
+#[cfg(test)]
+mod plane_tests {
+    use super::on_one_plane;
+    use glam::DVec3;
+
+    #[test]
+    fn points_on_a_tilted_plane_are_planar_and_a_box_is_not() {
+        let n = DVec3::new(0.3, 1.0, -0.2).normalize();
+        let (u, v) = n.any_orthonormal_pair();
+        let plane: Vec<DVec3> = (0..20)
+            .map(|i| {
+                DVec3::new(1.0, 2.0, 3.0) + u * (i as f64).sin() * 5.0 + v * (i as f64 * 0.7).cos()
+            })
+            .collect();
+        assert!(on_one_plane(&plane));
+        let mut off = plane.clone();
+        off[7] += n * 1e-3;
+        assert!(!on_one_plane(&off));
+        let cube: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64))
+            .collect();
+        assert!(!on_one_plane(&cube));
+        // Fewer than three distinct points, or a line: planar.
+        assert!(on_one_plane(&[DVec3::ONE, DVec3::ONE]));
+        assert!(on_one_plane(&[DVec3::ZERO, DVec3::X, DVec3::X * 2.0]));
     }
 }

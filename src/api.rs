@@ -1,0 +1,440 @@
+//! The use cases, each on the backend it runs on: light-view maps of meshes
+//! (`shadow_map`, planned by `crate::auto` for a target), of a scene
+//! shadowing itself (`scene_shadow_map`), of the user's depth maps
+//! (`shadow_map_from_depth`), visibility at world points (`sample_points`)
+//! and the eye view (`render`, `render_shaded`). A Rust user calls these
+//! with a typed config and a [`BackendChoice`]; the bindings only convert.
+//!
+//! Every call resolves its method config here, against the backend that will
+//! run it (the GPU has no hierarchy and sums in f32 only), and runs on the
+//! worker threads `threads.rs` allows.
+
+use crate::backend::{Backend, BackendChoice};
+use crate::error::{Error, Result};
+use crate::eye::{EyeCall, EyeImage, Lighting, Shaded};
+use crate::frame::{orthographic_maps, MapSettings, ShadowResult};
+use crate::geom::light::{check_light_size, is_point, MapGrid};
+use crate::geom::light_space::{Light, LightSpace};
+use crate::geom::mesh::MeshRef;
+use crate::methods::config::{check_resolution, CallContext};
+use crate::methods::MethodConfig;
+use crate::pipeline;
+use crate::threads;
+use crate::timing::Timings;
+
+/// The backend that runs a call: "auto" takes a real GPU where the config
+/// resolves there (`gpu`: the call's context on the GPU) and the light is
+/// one the GPU kernels take (`light_ok`).
+fn pick(choice: BackendChoice, method: &MethodConfig, gpu: CallContext, light_ok: bool) -> Backend {
+    match choice {
+        BackendChoice::Cpu => Backend::Cpu,
+        BackendChoice::Gpu => Backend::Gpu,
+        BackendChoice::Auto => {
+            if real_gpu() && light_ok && method.resolve(&gpu).is_ok() {
+                Backend::Gpu
+            } else {
+                Backend::Cpu
+            }
+        }
+    }
+}
+
+/// Whether a real (non-software) GPU adapter opens: what "auto" needs.
+#[cfg(feature = "gpu")]
+pub(crate) fn real_gpu() -> bool {
+    crate::gpu::info().is_ok_and(|i| !i.software)
+}
+
+#[cfg(not(feature = "gpu"))]
+pub(crate) fn real_gpu() -> bool {
+    false
+}
+
+/// A call's output with what ran it.
+#[derive(Debug, Clone)]
+pub struct Run<T> {
+    pub output: T,
+    /// The config that ran ("auto" resolved, every default filled in).
+    pub method: MethodConfig,
+    pub backend: Backend,
+    /// Worker threads the CPU stages could use.
+    pub threads: usize,
+    /// What `Auto` with a target decided (light-view maps from meshes).
+    pub plan: Option<crate::auto::Plan>,
+}
+
+/// A shadow map of meshes: what to compute and where.
+#[derive(Debug, Clone, Copy)]
+pub struct MeshCall<'a> {
+    pub occluders: MeshRef<'a>,
+    pub receivers: MeshRef<'a>,
+    pub light: &'a Light,
+    /// Output (W, H).
+    pub resolution: (i64, i64),
+    /// Tangent half-extents, or `None` to fit them.
+    pub extent: Option<[f64; 2]>,
+    pub method: MethodConfig,
+    pub backend: BackendChoice,
+    /// Worker threads; `None`: SOFTSHADOW_THREADS, else all cores.
+    pub threads: Option<i64>,
+}
+
+/// Meshes -> light-view maps -> visibility, on the chosen backend.
+pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
+    let (w, h) = check_resolution("resolution", call.resolution)?;
+    let cap = threads::resolve(call.threads)?;
+    let ctx = CallContext {
+        backend: Backend::Cpu,
+        resolution: (w, h),
+        depth_layers: None,
+        eye: false,
+    };
+    let gpu = CallContext {
+        backend: Backend::Gpu,
+        ..ctx
+    };
+    let backend = pick(
+        call.backend,
+        &call.method,
+        gpu,
+        !is_point(call.light.kernel_size()),
+    );
+    let ctx = CallContext { backend, ..ctx };
+    let target = match call.method {
+        MethodConfig::Auto(_, t) if !t.is_none() => Some(t),
+        _ => None,
+    };
+    let method = call.method.resolve(&ctx)?;
+    let ((output, method, plan), threads) = threads::run_capped(cap, || {
+        let space = mesh_space(
+            call.light,
+            &[("occluders", call.occluders), ("receivers", call.receivers)],
+        )?;
+        // A sun's map extent is given in world units; the kernels' in tangents.
+        let extent = call.extent.map(|e| space.kernel_extent(e));
+        let run =
+            |method: &MethodConfig, hard: bool, size: (usize, usize), extent: Option<[f64; 2]>| {
+                let mut settings = MapSettings::new(size.0, size.1, extent, method);
+                settings.hard = hard;
+                match backend {
+                    Backend::Cpu => {
+                        pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
+                    }
+                    #[cfg(feature = "gpu")]
+                    Backend::Gpu => {
+                        crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
+                    }
+                    #[cfg(not(feature = "gpu"))]
+                    Backend::Gpu => Err(crate::backend::not_built()),
+                }
+            };
+        let Some(target) = target else {
+            return Ok((run(&method, false, (w, h), extent)?, method, None));
+        };
+        crate::auto::driver::planned(
+            (call.occluders, call.receivers),
+            &call.method,
+            &space,
+            extent,
+            &ctx,
+            &target,
+            run,
+        )
+    })?;
+    Ok(Run {
+        output,
+        method,
+        backend,
+        threads,
+        plan,
+    })
+}
+
+/// A shadow map of a scene where every mesh casts and receives shadows.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneCall<'a> {
+    /// Every mesh, as one.
+    pub scene: MeshRef<'a>,
+    pub light: &'a Light,
+    pub resolution: (i64, i64),
+    pub extent: Option<[f64; 2]>,
+    pub method: MethodConfig,
+    /// The map methods' self-shadowing biases (see `eye/maps.rs`).
+    pub bias: crate::eye::Bias,
+    pub backend: BackendChoice,
+    pub threads: Option<i64>,
+}
+
+/// A self-shadowing scene -> light-view maps -> visibility (the CPU: its
+/// receiver texels are shaded as points, which the GPU twin of the eye view
+/// does not cover yet).
+pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
+    let (w, h) = check_resolution("resolution", call.resolution)?;
+    let cap = threads::resolve(call.threads)?;
+    if call.backend == BackendChoice::Gpu {
+        return Err(Error::invalid(
+            "backend",
+            "the light-view maps of a scene shadowing itself run on the CPU only in this version; \
+             use backend=\"cpu\"",
+        ));
+    }
+    let ctx = CallContext {
+        backend: Backend::Cpu,
+        resolution: (w, h),
+        depth_layers: None,
+        eye: false,
+    };
+    let method = call.method.resolve(&ctx)?;
+    let (output, threads) = threads::run_capped(cap, || {
+        let space = mesh_space(call.light, &[("meshes", call.scene)])?;
+        let extent = call.extent.map(|e| space.kernel_extent(e));
+        let settings = MapSettings::new(w, h, extent, &method);
+        pipeline::from_scene(call.scene, &space, &settings, &call.bias)
+    })?;
+    Ok(Run {
+        output,
+        method,
+        backend: Backend::Cpu,
+        threads,
+        plan: None,
+    })
+}
+
+/// The light space of a scene made of `meshes` (each with the name errors
+/// give it): a sun's depth origin and range are fitted to their vertices
+/// (checked first: a non-finite vertex is named, not folded into the bounds).
+pub fn mesh_space(light: &Light, meshes: &[(&str, MeshRef)]) -> Result<LightSpace> {
+    if let Light::Sun(_) = light {
+        for (arg, m) in meshes {
+            m.validate(arg)?;
+        }
+    }
+    let verts = meshes
+        .iter()
+        .flat_map(|(_, m)| m.vertices.iter())
+        .map(|p| glam::DVec3::from_array(*p));
+    light.space_for(verts)
+}
+
+/// Depth maps the user rendered: what to shade and where.
+#[derive(Debug, Clone, Copy)]
+pub struct DepthCall<'a> {
+    /// The receiver map's grid, which the output shares.
+    pub grid: MapGrid,
+    /// The occluder maps' grid (same extent, their own resolution).
+    pub occluder_grid: MapGrid,
+    /// A rectangle's (width, height) in the depths' unit; ignored for
+    /// orthographic maps.
+    pub light_size: [f64; 2],
+    /// `Some(angular_size)`: orthographic maps of a directional light of
+    /// that angular size (degrees): depths from the depth origin, extents
+    /// in world units (see `geom/sun.rs`).
+    pub sun: Option<[f64; 2]>,
+    pub front: &'a [f32],
+    pub back: Option<&'a [f32]>,
+    pub receiver: &'a [f32],
+    pub method: MethodConfig,
+    pub backend: BackendChoice,
+    pub threads: Option<i64>,
+}
+
+/// What shading depth maps returns.
+#[derive(Debug, Clone)]
+pub struct DepthOutput {
+    pub visibility: Vec<f32>,
+    pub timings: Timings,
+    /// For orthographic maps: the depth range their kernel space used
+    /// (`ShadowMap.sample` rebuilds the space from it).
+    pub depth_range: Option<f64>,
+}
+
+/// Depth maps -> visibility, on the chosen backend.
+pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
+    let cap = threads::resolve(call.threads)?;
+    // Orthographic maps: the same shading on their kernel-space twins.
+    let ortho = call
+        .sun
+        .map(|a| {
+            orthographic_maps(
+                (&call.grid, &call.occluder_grid),
+                call.front,
+                call.back,
+                call.receiver,
+                a,
+            )
+        })
+        .transpose()?;
+    let (grid, occluder_grid, light_size) = match &ortho {
+        Some((_, g, og, size, _)) => (*g, *og, *size),
+        None => (
+            call.grid,
+            call.occluder_grid,
+            check_light_size("light_size", call.light_size)?,
+        ),
+    };
+    let (front, receiver, back) = match &ortho {
+        Some((.., m)) => (&m[0][..], &m[1][..], m.get(2).map(|b| &b[..])),
+        None => (call.front, call.receiver, call.back),
+    };
+    let layers = 1 + back.is_some() as u32;
+    let og = &occluder_grid;
+    let ctx = CallContext {
+        backend: Backend::Cpu,
+        resolution: (grid.width, grid.height),
+        depth_layers: Some((layers, (og.width, og.height))),
+        eye: false,
+    };
+    let gpu = CallContext {
+        backend: Backend::Gpu,
+        ..ctx
+    };
+    let backend = pick(call.backend, &call.method, gpu, !is_point(light_size));
+    let method = call.method.resolve(&CallContext { backend, ..ctx })?;
+    let kernel = method.kernel();
+    let (g, f, b, r) = (&grid, front, back, receiver);
+    let ((visibility, timings), threads) = threads::run_capped(cap, || match backend {
+        Backend::Cpu => pipeline::from_depth(g, og, light_size, f, b, r, kernel),
+        #[cfg(feature = "gpu")]
+        Backend::Gpu => crate::gpu::from_depth(g, og, light_size, f, b, r, kernel),
+        #[cfg(not(feature = "gpu"))]
+        Backend::Gpu => Err(crate::backend::not_built()),
+    })?;
+    let output = DepthOutput {
+        visibility,
+        timings,
+        depth_range: ortho.map(|(space, ..)| space.depth_range),
+    };
+    Ok(Run {
+        output,
+        method,
+        backend,
+        threads,
+        plan: None,
+    })
+}
+
+/// Visibility at world points from a shadow map's occluders (the CPU: points
+/// are few and scattered). `method` is the config the map ran with.
+pub fn sample_points(
+    grid: &MapGrid,
+    light: &LightSpace,
+    occluders: pipeline::OccluderSource,
+    points: &[[f64; 3]],
+    method: &MethodConfig,
+    threads: Option<i64>,
+) -> Result<(Vec<f32>, Vec<bool>)> {
+    let cap = threads::resolve(threads)?;
+    let kernel = method.kernel();
+    threads::run_capped(cap, || {
+        pipeline::sample_points(grid, light, occluders, points, kernel)
+    })
+    .map(|(v, _)| v)
+}
+
+/// Renders the visibility image of `call` on the backend it asks for:
+/// "auto" takes the GPU where the light view would (a real, non-software
+/// adapter, a config that resolves there) and the light is not hard (the
+/// GPU has no hard shadow map kernel for the map methods; ShadowMapping
+/// takes any light).
+pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
+    let cap = threads::resolve(call.threads)?;
+    if let Some(r) = call.map_resolution {
+        check_resolution("map_resolution", r)?;
+    }
+    let gpu = CallContext {
+        backend: Backend::Gpu,
+        resolution: (call.camera.width, call.camera.height),
+        depth_layers: None,
+        eye: true,
+    };
+    // ShadowMapping is a hard shadow: it takes hard lights on the GPU.
+    let hard_ok = matches!(call.method, MethodConfig::ShadowMapping(_));
+    let backend = pick(
+        call.backend,
+        &call.method,
+        gpu,
+        hard_ok || !call.light.is_hard(),
+    );
+    // A target plans the setting (`auto/plan.rs`, `plan_eye`); the
+    // planned config then runs as if the user had given it.
+    let t0 = std::time::Instant::now();
+    let mut plan = match call.method {
+        MethodConfig::Auto(given, target) if !target.is_none() => Some(crate::auto::plan_eye(
+            &target,
+            MethodConfig::Auto(given, Default::default()),
+        )),
+        _ => None,
+    };
+    let planned = EyeCall {
+        method: plan.as_ref().map_or(call.method, |p| p.config),
+        ..*call
+    };
+    let planning = t0.elapsed().as_secs_f64();
+    let ((mut image, method), threads) =
+        threads::run_capped(cap, || pipeline::eye_view::render(&planned, backend))?;
+    if let Some(p) = plan.as_mut() {
+        p.decisions.push(focus_decision(&image));
+        p.config = method;
+        image.timings.insert(0, ("plan", planning));
+    }
+    Ok(Run {
+        output: image,
+        method,
+        backend,
+        threads,
+        plan,
+    })
+}
+
+/// `render`, then the direct lighting of every pixel under `lighting`
+/// (shading.rs) on the CPU whatever the backend, timed as `shading`.
+/// `lighting` is checked against the call's light and meshes
+/// (`Lighting::new`).
+pub fn render_shaded(call: &EyeCall, lighting: &Lighting) -> Result<(Run<EyeImage>, Shaded)> {
+    if lighting.albedo.len() != call.meshes.len() {
+        return Err(Error::shape(
+            "albedo",
+            format!(
+                "{} albedos for {} meshes",
+                lighting.albedo.len(),
+                call.meshes.len()
+            ),
+        ));
+    }
+    let cap = threads::resolve(call.threads)?;
+    let mut run = render(call)?;
+    let t0 = std::time::Instant::now();
+    let img = &run.output;
+    let (shaded, _) = threads::run_capped(cap, || {
+        Ok(crate::eye::shading::shade(
+            call.light,
+            lighting,
+            &img.gbuffer,
+            &img.visibility,
+        ))
+    })?;
+    run.output
+        .timings
+        .push(("shading", t0.elapsed().as_secs_f64()));
+    Ok((run, shaded))
+}
+
+/// What the eye view shades, reported in a plan: light-view texels only
+/// where pixels need them (the maps fitted to the visible points, focus.rs),
+/// or shadow rays from the visible pixels only.
+fn focus_decision(image: &EyeImage) -> crate::auto::Decision {
+    let pixels = image.gbuffer.hits().len();
+    let why = match &image.maps {
+        Some(m) => format!(
+            "light-view maps {}x{} over the light-space bounds of the {pixels} visible points \
+             only, at about one texel a pixel's footprint",
+            m.grid.width, m.grid.height
+        ),
+        None => format!("shadow rays from the {pixels} pixels that see a surface only"),
+    };
+    crate::auto::Decision {
+        name: "focus",
+        taken: true,
+        why,
+    }
+}

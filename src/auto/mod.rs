@@ -1,0 +1,12 @@
+//! `ss.Auto(error=..., time=...)`: the planner. `plan.rs` holds the pure
+//! decisions (scene facts and a target in, a config and the reasons out),
+//! `measure.rs` what they read of a framed scene (depth ranges, thin
+//! features, the layers tried on coarse maps), `driver.rs` the order in
+//! which a planned light-view call frames, measures, plans and runs.
+//! Above the orchestrators (it runs them), below the API.
+
+pub mod driver;
+pub mod measure;
+pub mod plan;
+
+pub use plan::{plan, plan_eye, Decision, Plan, SceneStats};

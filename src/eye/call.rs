@@ -1,0 +1,40 @@
+//! What the eye view's stages read and return: the call (meshes, light,
+//! camera, method, biases, backend) and the image (the G-buffer, the
+//! visibility, the map methods' maps, timings). Shared by the CPU stages,
+//! their GPU twins and the orchestrator (`crate::pipeline::eye_view`).
+
+use super::gbuffer::GBuffer;
+use super::maps::{Bias, EyeMaps};
+use crate::backend::BackendChoice;
+use crate::geom::camera::Camera;
+use crate::geom::light_space::{Light, LightSpace};
+use crate::geom::mesh::MeshRef;
+use crate::methods::MethodConfig;
+use crate::timing::Timings;
+
+/// An image to render.
+#[derive(Debug, Clone, Copy)]
+pub struct EyeCall<'a> {
+    pub meshes: &'a [MeshRef<'a>],
+    pub light: &'a Light,
+    pub camera: &'a Camera,
+    pub method: MethodConfig,
+    /// The light-view maps' (W, H); `None`: from the pixels' footprint.
+    pub map_resolution: Option<(i64, i64)>,
+    pub bias: Bias,
+    pub backend: BackendChoice,
+    pub threads: Option<i64>,
+}
+
+/// A rendered image.
+#[derive(Debug, Clone)]
+pub struct EyeImage {
+    pub gbuffer: GBuffer,
+    /// (H, W) visibility; 1 where no surface.
+    pub visibility: Vec<f32>,
+    /// The map methods' light-view maps (None for `exact`).
+    pub maps: Option<EyeMaps>,
+    /// The light space they are in.
+    pub light_space: LightSpace,
+    pub timings: Timings,
+}

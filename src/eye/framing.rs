@@ -1,0 +1,230 @@
+//! The eye view's framing, shared by the CPU stages and their GPU twins:
+//! the visible points in the light's space (fitted to them for the sun),
+//! the kernels' depth unit, the triangles in kernel light space, the
+//! casters (`casters.rs`) and the occluder grid focused on what they can
+//! shadow (`focus.rs`), and the config resolved at the camera or the grid.
+
+use super::call::EyeCall;
+use super::gbuffer::{GBuffer, SceneTriangles};
+use super::{casters, focus, maps};
+use crate::backend::Backend;
+use crate::error::Result;
+use crate::geom::light::MapGrid;
+use crate::geom::light_space::{Light, LightSpace};
+use crate::geom::sun::SunSpace;
+use crate::geom::units::{check_unit, depth_unit, light_size_in};
+use crate::methods::config::CallContext;
+use crate::methods::MethodConfig;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use std::borrow::Cow;
+
+/// What both backends derive from the G-buffer before shading: the visible
+/// points, the light space fitted to them, the depth unit and every
+/// triangle's corners in kernel light space.
+pub struct Framed {
+    /// Flat indices of the pixels that see a surface, and their world points
+    /// and camera-facing normals.
+    pub hits: Vec<usize>,
+    pub points: Vec<[f64; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub space: LightSpace,
+    /// The visible points in light space (not unit-scaled).
+    pub pts_ls: Vec<DVec3>,
+    /// The kernels' depth unit, and the light's size in it.
+    pub unit: f64,
+    pub light_size: [f64; 2],
+    /// Every vertex in kernel light space, unit-scaled (the faces into them
+    /// are `SceneTriangles::faces`).
+    pub verts: Vec<DVec3>,
+}
+
+/// The light space, depth unit and light-space triangles of an image whose
+/// G-buffer is `g`.
+pub fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Framed> {
+    let hits = g.hits();
+    let points: Vec<[f64; 3]> = hits.par_iter().map(|&k| g.position[k]).collect();
+    let normals: Vec<[f32; 3]> = hits.par_iter().map(|&k| g.normal[k]).collect();
+    let space = match call.light {
+        Light::Rect(l) => LightSpace::Rect(*l),
+        Light::Sun(s) => {
+            let focus: Vec<DVec3> = points.iter().map(|p| DVec3::from_array(*p)).collect();
+            let focus = if focus.is_empty() {
+                scene.points().collect()
+            } else {
+                focus
+            };
+            LightSpace::Sun(SunSpace::fit_focused(
+                *s,
+                scene.points(),
+                focus.into_iter(),
+            )?)
+        }
+    };
+    // Kernel light space, in the depth unit of the visible points.
+    let pts_ls: Vec<DVec3> = points
+        .par_iter()
+        .map(|p| space.to_light(DVec3::from_array(*p)))
+        .collect();
+    let unit = depth_unit(pts_ls.par_iter().map(|q| q.z).reduce(|| 0.0, f64::max));
+    check_unit("meshes", unit)?;
+    let light_size = light_size_in("size", space.size(), unit)?;
+    let verts: Vec<DVec3> = scene
+        .vertices
+        .par_iter()
+        .map(|&c| space.to_light(c) / unit)
+        .collect();
+    Ok(Framed {
+        hits,
+        points,
+        normals,
+        space,
+        pts_ls,
+        unit,
+        light_size,
+        verts,
+    })
+}
+
+/// The most points the median pixel footprint is taken over (focus.rs).
+const FOOTPRINT_SAMPLES: usize = 1 << 14;
+
+/// The config of a call that reads no maps (`exact`, or no visible point),
+/// resolved for `backend` at the camera's resolution.
+pub fn resolve_at_camera(call: &EyeCall, backend: Backend) -> Result<MethodConfig> {
+    call.method.resolve(&CallContext {
+        backend,
+        resolution: (call.camera.width, call.camera.height),
+        depth_layers: None,
+        eye: true,
+    })
+}
+
+/// Light samples per pixel of `exact`: a hard light needs one ray (every
+/// sample would be the same).
+pub fn exact_samples(call: &EyeCall, method: &MethodConfig) -> u32 {
+    match method.kernel() {
+        crate::methods::Method::Exact { samples } if !call.light.is_hard() => samples,
+        _ => 1,
+    }
+}
+
+/// The triangles `exact` traces: the corners in f32.
+pub fn traced_triangles(f: &Framed, scene: &SceneTriangles) -> Vec<[Vec3; 3]> {
+    scene
+        .faces
+        .par_iter()
+        .map(|t| t.map(|i| f.verts[i as usize].as_vec3()))
+        .collect()
+}
+
+/// The faces of the meshes that can shadow a visible point (`casters.rs`):
+/// the map methods' occluders. Smoothies keep every mesh: their falloff
+/// reads the depth of the receiver behind each silhouette from the map
+/// (without the floor there, its error on contact_boxes went from under
+/// 0.1 to 0.26).
+pub fn casting_faces<'s>(
+    call: &EyeCall,
+    scene: &'s SceneTriangles,
+    f: &Framed,
+    g: &GBuffer,
+) -> Cow<'s, [[u32; 3]]> {
+    if matches!(
+        call.method.kernel(),
+        crate::methods::Method::Smoothies { .. }
+    ) {
+        return Cow::Borrowed(&scene.faces);
+    }
+    let point_mesh: Vec<i32> = f.hits.iter().map(|&k| g.mesh_id[k]).collect();
+    let casts = casters::casters(scene, call.light, &f.points, &point_mesh);
+    scene
+        .faces
+        .iter()
+        .zip(&scene.mesh_of)
+        .filter(|(_, &m)| casts[m as usize])
+        .map(|(t, _)| *t)
+        .collect::<Vec<_>>()
+        .into()
+}
+
+/// The map methods' occluder grid (focused on what the occluders `faces`
+/// can shadow of the visible points, sized from their footprint unless the
+/// call sets it) and the config resolved for `backend` at that resolution.
+/// `f` has visible points.
+pub fn map_grid(
+    call: &EyeCall,
+    g: &GBuffer,
+    f: &Framed,
+    faces: &[[u32; 3]],
+    backend: Backend,
+) -> Result<(MapGrid, MethodConfig)> {
+    let visible = focus::VisibleBounds::of(&f.pts_ls, f.unit);
+    let mut used = vec![false; f.verts.len()];
+    for t in faces {
+        for &i in t {
+            used[i as usize] = true;
+        }
+    }
+    // Every vertex in use (Smoothies, or every mesh can cast): no copy.
+    let occluders: Cow<[DVec3]> = if used.iter().all(|&u| u) {
+        Cow::Borrowed(&f.verts)
+    } else {
+        f.verts
+            .iter()
+            .zip(&used)
+            .filter(|(_, &u)| u)
+            .map(|(q, _)| *q)
+            .collect()
+    };
+    let extent = match &visible {
+        None => [1.0, 1.0],
+        Some(v) => focus::focused_extent(&occluders, v, f.light_size)?,
+    };
+    // The median over a regular subsample of at most FOOTPRINT_SAMPLES
+    // points: the resolution is a rule of thumb, not worth a full select.
+    let stride = f.hits.len().div_ceil(FOOTPRINT_SAMPLES).max(1);
+    let footprint = focus::median(
+        f.hits
+            .iter()
+            .zip(&f.pts_ls)
+            .step_by(stride)
+            .filter(|(_, q)| q.z > 0.0)
+            .map(|(&k, q)| {
+                let world = g.depth[k] as f64 / call.camera.focal;
+                match f.space {
+                    LightSpace::Rect(_) => world / q.z,
+                    LightSpace::Sun(s) => world / s.lateral_scale(),
+                }
+            })
+            .collect(),
+    )
+    .unwrap_or(1.0);
+    let fitted = focus::footprint_resolution(
+        extent,
+        focus::capped_footprint(extent, footprint, f.hits.len()),
+    );
+    let resolution = match call.map_resolution {
+        Some((w, h)) => (w as usize, h as usize),
+        None => fitted,
+    };
+    let method = call.method.resolve(&CallContext {
+        backend,
+        resolution,
+        depth_layers: None,
+        eye: true,
+    })?;
+    // The eye view has occluder maps only: the resolved config's
+    // occluder resolution (the fitted one unless the config sets it;
+    // "auto"'s rule takes a quarter of it).
+    let (w, h) = method.occluder_resolution().unwrap_or(resolution);
+    Ok((MapGrid::new(w, h, extent)?, method))
+}
+
+/// The occluders `faces` as one indexed mesh in kernel light space (the map
+/// methods' occluders), its vertices taken out of `f`.
+pub fn light_triangles<'s>(f: &mut Framed, faces: &'s [[u32; 3]]) -> maps::LightTriangles<'s> {
+    maps::LightTriangles {
+        verts: std::mem::take(&mut f.verts),
+        faces,
+    }
+}

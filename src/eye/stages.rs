@@ -1,0 +1,144 @@
+//! The eye view's stages as one interface, implemented by the CPU
+//! (`CpuEye`, here) and by the GPU (`crate::gpu::GpuEye`): the orchestrator
+//! (`crate::pipeline::eye_view`) runs one sequence of stages on either, so
+//! a stage is added once and both backends give the same answers from the
+//! same framing (framing.rs).
+
+use super::call::EyeCall;
+use super::framing::Framed;
+use super::gbuffer::{self, GBuffer, SceneTriangles};
+use super::maps::{self, EyeMaps, LightTriangles};
+use super::{rays, shadow_mapping};
+use crate::backend::Backend;
+use crate::error::Result;
+use crate::geom::camera::Camera;
+use crate::geom::light::MapGrid;
+use crate::methods::shadow_mapping::config::ShadowMappingConfig;
+use crate::methods::MethodConfig;
+use crate::timing::{Stopwatch, Timings};
+use glam::Vec3;
+
+/// The stages of the eye view on one backend. Each returns what the next
+/// reads; stage times go to `sw` (the device's own, where it has them, are
+/// kept by the implementation and handed over by `timings`).
+pub trait EyeStages {
+    /// The backend the configs resolve for.
+    const BACKEND: Backend;
+
+    /// Refuses, before any work, a call this backend cannot run (the map
+    /// methods: a hard light or a config the GPU has no kernel for).
+    fn check(&self, call: &EyeCall) -> Result<()>;
+
+    /// What each pixel sees: the G-buffer.
+    fn first_hits(&mut self, camera: &Camera, scene: &SceneTriangles) -> Result<GBuffer>;
+
+    /// ShadowMapping's visibility of every pixel of `g` (1 where no surface).
+    fn shadow_mapping(
+        &mut self,
+        call: &EyeCall,
+        cfg: &ShadowMappingConfig,
+        scene: &SceneTriangles,
+        g: &GBuffer,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<f32>>;
+
+    /// `exact`: the visibility of each visible point of `f` from `samples`
+    /// stratified shadow rays through the triangles `tris`.
+    fn trace(
+        &mut self,
+        f: &Framed,
+        tris: Vec<[Vec3; 3]>,
+        camera: &Camera,
+        samples: u32,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<f32>>;
+
+    /// The map methods: the occluder layers of `tris` on `grid`, and the
+    /// visibility of each visible point of `f` read from them.
+    fn shade_maps(
+        &mut self,
+        call: &EyeCall,
+        f: &Framed,
+        tris: &LightTriangles,
+        grid: MapGrid,
+        method: &MethodConfig,
+        sw: &mut Stopwatch,
+    ) -> Result<(Vec<f32>, EyeMaps)>;
+
+    /// The call's stage times: the host's laps `host` with the device's.
+    fn timings(&mut self, host: Timings, method: &MethodConfig) -> Timings;
+}
+
+/// The eye view's stages on all CPU cores.
+pub struct CpuEye;
+
+impl EyeStages for CpuEye {
+    const BACKEND: Backend = Backend::Cpu;
+
+    fn check(&self, _call: &EyeCall) -> Result<()> {
+        Ok(())
+    }
+
+    fn first_hits(&mut self, camera: &Camera, scene: &SceneTriangles) -> Result<GBuffer> {
+        Ok(gbuffer::first_hits(camera, scene))
+    }
+
+    fn shadow_mapping(
+        &mut self,
+        call: &EyeCall,
+        cfg: &ShadowMappingConfig,
+        scene: &SceneTriangles,
+        g: &GBuffer,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<f32>> {
+        shadow_mapping::render(call, cfg, scene, g, sw).map(|(v, _map)| v)
+    }
+
+    fn trace(
+        &mut self,
+        f: &Framed,
+        tris: Vec<[Vec3; 3]>,
+        camera: &Camera,
+        samples: u32,
+        _sw: &mut Stopwatch,
+    ) -> Result<Vec<f32>> {
+        let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
+        let order = rays::tiled(&f.hits, camera.width, camera.height);
+        Ok(rays::visibility(
+            f.light_size,
+            tris,
+            &starts,
+            &order,
+            samples,
+        ))
+    }
+
+    fn shade_maps(
+        &mut self,
+        call: &EyeCall,
+        f: &Framed,
+        tris: &LightTriangles,
+        grid: MapGrid,
+        method: &MethodConfig,
+        sw: &mut Stopwatch,
+    ) -> Result<(Vec<f32>, EyeMaps)> {
+        maps::shade(
+            &f.space,
+            f.unit,
+            f.light_size,
+            tris,
+            grid,
+            method.passes(),
+            method.kernel(),
+            &f.points,
+            &f.pts_ls,
+            &f.normals,
+            &call.bias,
+            sw,
+        )
+    }
+
+    fn timings(&mut self, host: Timings, _method: &MethodConfig) -> Timings {
+        host
+    }
+}

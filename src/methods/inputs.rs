@@ -1,0 +1,68 @@
+//! What every method reads and writes, apart from the registry that picks
+//! one (`registry.rs`): the methods' modules read these types, the registry
+//! reads the methods.
+
+use crate::geom::light::MapGrid;
+use glam::Vec3;
+
+/// What every method reads: the light-view maps and the light's size.
+#[derive(Debug, Clone)]
+pub struct ShadowInputs<'a> {
+    /// The output grid, which the receiver map shares.
+    pub grid: MapGrid,
+    /// The occluder maps' grid: the same extent, its own resolution (coarser
+    /// occluder maps cost less; the paper notes large lights need fewer texels).
+    pub occluder_grid: MapGrid,
+    /// Full light width along u and height along v (world units).
+    pub light_size: [f64; 2],
+    /// Receiver planar depth per texel, `inf` where there is no receiver.
+    pub receiver: &'a [f32],
+    /// Occluder depth layers: the front (nearest) map, then the back (farthest) one.
+    pub occluder_layers: Vec<&'a [f32]>,
+    /// Occluder triangles in light space, for the methods that trace them.
+    pub occluder_triangles: Option<&'a [[Vec3; 3]]>,
+}
+
+/// A receiver point in light space: tangent coordinates and planar depth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightPoint {
+    pub x: f32,
+    pub y: f32,
+    pub z: f32,
+}
+
+/// The interface of a shadow method.
+pub trait ShadowMethod: Sync {
+    /// Visibility of the light (fraction of its area) for every receiver texel;
+    /// 1 where there is no receiver. Row-major (H, W).
+    fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32>;
+    /// Visibility at receiver points given in light space.
+    fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32>;
+}
+
+/// What a method reads besides the receivers: the pipeline builds only that.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Input {
+    /// Light-view depth layers of the occluders (front, peeled, back).
+    OccluderLayers,
+    /// The occluder triangles in light space.
+    OccluderTriangles,
+    /// A camera: the eye view's visible points (what ShadowMapping focuses,
+    /// warps and blurs for).
+    Camera,
+    /// Every mesh's triangles in world space, rasterized into the method's
+    /// own shadow map.
+    SceneTriangles,
+}
+
+impl Input {
+    /// The name the capabilities table gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::OccluderLayers => "occluder_layers",
+            Input::OccluderTriangles => "occluder_triangles",
+            Input::Camera => "camera",
+            Input::SceneTriangles => "scene_triangles",
+        }
+    }
+}
