@@ -173,7 +173,7 @@ def main(argv: list[str] | None = None) -> int:
                 "two such references with different seeds. *open*: the flat per-texel micro-patches; *closed* (the "
                 "default): connected micro-quads ([bitmask](../methods/bitmask.md#gaps)). *auto rule*: "
                 "`ss.Auto()`, the probe `ss.Auto(time=...)` times first; the planner's error bounds "
-                "(`src/methods/plan.rs`) are this table's worst errors; its time ratios for `time=` were read "
+                "(`src/auto/plan.rs`) are this table's worst errors; its time ratios for `time=` were read "
                 "from an earlier run's largest (they move between runs; constants above today's ratios only "
                 "make budget plans more cautious). Scenes: "
                 "`softshadow.scenes.SCENES` and `softshadow.scenes.HARD_SURFACES`."

@@ -7,7 +7,7 @@ planned config run with gaps closed and open, `layer_change` of the two:
 mean |difference| over texels shadowed in either) and what opening them
 costs in error there (each against the 1024-sample Mitsuba reference, the
 paper's §4.2.1 metric, cached in `.cache/references/` like the tests').
-`GAP_SCALE` in `src/methods/plan.rs` is the largest ratio of the full maps'
+`GAP_SCALE` in `src/auto/plan.rs` is the largest ratio of the full maps'
 change to the coarse one, rounded up. Beside them, plates tilted against
 the light next to a second, smaller plate tilted the other way (so that
 the occluders are not one plane and the union runs): the surfaces where open

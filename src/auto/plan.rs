@@ -439,7 +439,7 @@ impl Plan {
     /// Opens a union plan's gaps (flat per-texel micro-patches, cheaper
     /// than connected quads) where closing them changes the shadow by less
     /// than the plan's slack: `change` is what closing them changed in the
-    /// coarse shadow of the layer tries (`pipeline/measure.rs`, None: not
+    /// coarse shadow of the layer tries (`auto/measure.rs`, None: not
     /// measured). The metric is a mean of |differences| over one set of
     /// texels, so error(open) <= error(closed) + |open - closed|: with the
     /// coarse change scaled to the full maps' (GAP_SCALE, measured), the
@@ -482,7 +482,7 @@ impl Plan {
     }
 
     /// The occluder layers of a union plan, as the caller measured them
-    /// on coarse maps (`pipeline/measure.rs`): `passes` taken (1: no texel
+    /// on coarse maps (`auto/measure.rs`): `passes` taken (1: no texel
     /// sees a back surface); `surfaces` the texels that see a surface and a
     /// back behind it; `peeled[k]` the texels where the (k+3)-th layer holds
     /// a surface before the back, `changes[k]` what adding it changed.

@@ -125,7 +125,7 @@ pub struct MapSettings {
     pub method: Method,
     /// Shade the map methods' layers as for a point light (hard shadows),
     /// whatever the light's size: what a plan decides where every penumbra
-    /// is under half a texel (`methods/plan.rs`).
+    /// is under half a texel (`auto/plan.rs`).
     pub hard: bool,
 }
 

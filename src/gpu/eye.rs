@@ -1,5 +1,5 @@
-//! The eye view on the GPU (`render(..., backend="gpu")`): the twin of
-//! `eye::render_cpu` (src/eye/mod.rs), stage for stage, with the same
+//! The eye view on the GPU (`render(..., backend="gpu")`): `GpuEye`, the
+//! twin of `eye::CpuEye` (src/eye/stages.rs) that `pipeline::eye_view` runs, stage for stage, with the same
 //! answers.
 //!
 //! * First hits (`eye_hits.wgsl`): each pixel-centre ray o = 0 (eye-relative),
@@ -12,7 +12,7 @@
 //!   every pixel on lavapipe); the CPU's own G-buffer rasterizes the same
 //!   pixel centres (`gbuffer::rasterized_hits`), so the two backends'
 //!   G-buffers may differ where a pixel centre grazes an edge.
-//! * Framing (CPU, shared with the CPU path: `eye::frame`, `eye::map_grid`):
+//! * Framing (CPU, shared with the CPU path: `eye::framing`):
 //!   the light space, the depth unit, the triangles in kernel light space,
 //!   the focused grid and its resolution.
 //! * `exact` (`eye_rays.wgsl`): per visible point, stratified shadow rays
