@@ -186,6 +186,7 @@ def _done_lines(out: Path) -> int:
         return 0
 
 
+@pytest.mark.slow
 def test_sigkill_halfway_then_resume_gives_the_same_files(tmp_path):
     count = 120
     spec_path = write_spec(tmp_path, SMALL.replace("count = 5", f"count = {count}"))

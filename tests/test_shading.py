@@ -139,6 +139,7 @@ def test_default_albedo_is_grey_and_channels_hold_the_shaded_images():
     assert np.all(rgb.shaded[..., 2] == 0.0)
 
 
+@pytest.mark.gpu
 @pytest.mark.skipif(not ss.gpu_available(), reason="no GPU adapter")
 def test_gpu_shades_its_visibility_as_the_cpu_does():
     scene, cam = _two_mesh_scene()

@@ -22,10 +22,12 @@ from softshadow.scenes import quad, sphere
 RES = (160, 120)
 
 
-def _backends():
-    """The CPU, and the GPU where an adapter opens (lavapipe in CI)."""
+def _backends(slow_on_gpu: bool = False):
+    """The CPU, and the GPU where an adapter opens (lavapipe in CI);
+    ``slow_on_gpu`` marks the GPU's run slow (lavapipe takes 3-12 s there)."""
     gpu = ss.gpu_available() or os.environ.get("SOFTSHADOW_REQUIRE_GPU") == "1"
-    return ["cpu"] + (["gpu"] if gpu else [])
+    on_gpu = pytest.param("gpu", marks=pytest.mark.slow) if slow_on_gpu else "gpu"
+    return ["cpu"] + ([on_gpu] if gpu else [])
 
 
 def _hard(light):
@@ -49,7 +51,7 @@ def hard_refs():
     return out
 
 
-@pytest.mark.parametrize("backend", _backends())
+@pytest.mark.parametrize("backend", _backends(slow_on_gpu=True))
 @pytest.mark.parametrize("name", list(EYE_SCENES))
 def test_every_bias_method_removes_acne_that_no_bias_leaves(hard_refs, name, backend):
     scene, hard, cam, ref = hard_refs[name]
@@ -91,7 +93,7 @@ def test_bias_removes_acne_on_a_sphere_and_a_tilted_plane_facing_the_light(backe
             assert acne < 0.016 and acne < acne_none / 3, (bias, acne, acne_none)
 
 
-@pytest.mark.parametrize("backend", _backends())
+@pytest.mark.parametrize("backend", _backends(slow_on_gpu=True))
 def test_focus_and_lispsm_reduce_aliasing_in_a_large_city(backend):
     """The bar at Scherzer's resolution (2048²): focused LiSPSM misclassifies
     at most 0.7x the pixels of the focused uniform map, which misclassifies
@@ -225,11 +227,11 @@ def test_wrong_part_types_are_refused_by_name():
         ss.ShadowMapping(warp=ss.EyeSpaceBlur())
 
 
-def test_what_a_method_cannot_do_is_refused():
+@pytest.mark.parametrize("backend", _backends())
+def test_what_a_method_cannot_do_is_refused(backend):
     scene, light, cam = EYE_SCENES["bunny_on_floor"](RES)
-    for backend in _backends():
-        with pytest.raises(ValueError, match="^warp: LiSPSM warps directional lights"):
-            ss.render(scene, light, cam, method=ss.ShadowMapping(warp=ss.LiSPSM()), backend=backend)
+    with pytest.raises(ValueError, match="^warp: LiSPSM warps directional lights"):
+        ss.render(scene, light, cam, method=ss.ShadowMapping(warp=ss.LiSPSM()), backend=backend)
     with pytest.raises(ValueError, match="^method: ShadowMapping renders the eye view"):
         ss.soft_shadow_map(scene, light, resolution=32, method=ss.ShadowMapping())
 

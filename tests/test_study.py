@@ -6,6 +6,7 @@ pytest.importorskip("matplotlib")
 pytest.importorskip("mitsuba")
 
 
+@pytest.mark.slow
 def test_study_plane_on_a_small_map(tmp_path):
     from softshadow.experiments.study import main
 
@@ -59,6 +60,7 @@ def test_mitsuba_time_at_equal_error_follows_the_sample_law():
         assert out is outside
 
 
+@pytest.mark.slow
 def test_study_eye_view_and_scherzer_parts_write_tables_plots_and_the_readme_block(tmp_path):
     from softshadow.study import main
 

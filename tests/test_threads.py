@@ -15,6 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
+import pytest
 
 import softshadow as ss
 from softshadow import eye_scenes, scenes
@@ -105,6 +106,7 @@ def test_concurrent_calls_on_the_cpu_match_serial_ones():
     assert {r.backend for r in first.values()} == {"cpu"}
 
 
+@pytest.mark.slow
 def test_concurrent_calls_on_the_gpu_match_serial_ones(gpu):
     first = run_concurrently(light_view_calls("gpu") + eye_view_calls("gpu"))
     # They ran on the device (no silent fallback to the CPU).

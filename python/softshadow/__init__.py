@@ -35,9 +35,10 @@ from .methods import (
     capabilities,
     limits,
 )
+from .plan import Decision, Plan
 from .render import Image, render
 from .scene import Scene
-from .shadow_map import Decision, Plan, ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
+from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
 __all__ = [
     "SlopeScaleBias",

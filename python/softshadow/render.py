@@ -22,8 +22,8 @@ from . import _core
 from .camera import Camera
 from .light import DirectionalLight, RectLight, _color
 from .methods import MethodConfig
+from .plan import Plan, plan_from_core
 from .scene import Scene
-from .shadow_map import Decision, Plan
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -256,7 +256,7 @@ def render(
         threads=r.threads,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
-        plan=None if r.plan is None else Plan(tuple(Decision(*d) for d in r.plan), r.method),
+        plan=plan_from_core(r.plan, r.method),
     )
 
 

@@ -19,30 +19,9 @@ from . import _core
 from . import _validate as check
 from .light import DirectionalLight, RectLight
 from .methods import MethodConfig
+from .plan import Decision as Decision  # re-exported: softshadow.shadow_map.Decision as before
+from .plan import Plan, plan_from_core
 from .scene import Scene
-
-
-@dataclass(frozen=True)
-class Decision:
-    """One decision of a plan: its name, whether it was taken, and why (the
-    number that decided)."""
-
-    name: str
-    taken: bool
-    why: str
-
-
-@dataclass(frozen=True)
-class Plan:
-    """What ``Auto(error=...)`` or ``Auto(time=...)`` decided for a scene, and
-    the config that ran. ``print(sm.plan)`` lists the decisions."""
-
-    decisions: tuple[Decision, ...]
-    method: MethodConfig
-
-    def __str__(self) -> str:
-        lines = [f"[{'x' if d.taken else ' '}] {d.name}: {d.why}" for d in self.decisions]
-        return "\n".join([*lines, f"ran: {self.method!r}"])
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -366,7 +345,7 @@ def soft_shadow_map(
         self_shadowing=not scene.split,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
-        plan=None if r.plan is None else Plan(tuple(Decision(*d) for d in r.plan), r.method),
+        plan=plan_from_core(r.plan, r.method),
     )
 
 

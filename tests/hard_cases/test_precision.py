@@ -71,6 +71,7 @@ def test_figure_14_on_the_bunny():
         assert diff[n, "f32"][1] < 1e-5, diff
 
 
+@pytest.mark.slow
 def test_f32_holds_to_1e_4_of_f64_at_4096():
     # Occluder maps at 4096², shaded at 64x64 of the 4096² output's texel
     # centers (every 64th: the whole map would take minutes): each sum has up

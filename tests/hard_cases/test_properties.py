@@ -24,6 +24,7 @@ sees the same examples every run).
 """
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -62,6 +63,7 @@ def _kw(method, backend, passes=None):
     return kw | ({"passes": passes} if passes is not None and has_option(method, "passes") else {})
 
 
+@pytest.mark.gpu  # its examples draw backend="gpu" too
 @SETTINGS
 @given(scene_and_light(), st.sampled_from(METHODS), st.sampled_from(BACKENDS), st.integers(1, 3))
 def test_visibility_is_finite_and_in_unit_interval(sl, method, backend, passes):
@@ -97,6 +99,7 @@ def depth_maps(draw):
 MONOTONE_MAP_METHODS = tuple(m for m in MAP_METHODS if m != "pcss")
 
 
+@pytest.mark.gpu  # its examples draw backend="gpu" too
 @SETTINGS
 @given(depth_maps(), st.sampled_from(MONOTONE_MAP_METHODS), st.sampled_from(BACKENDS))
 def test_occluders_in_empty_texels_never_raise_visibility(maps, method, backend):
@@ -111,6 +114,7 @@ def test_occluders_in_empty_texels_never_raise_visibility(maps, method, backend)
     assert np.all(after <= before), float((after - before).max())
 
 
+@pytest.mark.gpu  # its examples draw backend="gpu" too
 @SETTINGS
 @given(scene_and_light(), plate(), st.sampled_from(BACKENDS))
 def test_any_occluder_never_raises_exact_visibility(sl, extra, backend):
@@ -139,6 +143,7 @@ def test_occluder_hiding_another_can_lighten_the_map_methods():
     assert np.all(two <= one)
 
 
+@pytest.mark.gpu  # its examples draw backend="gpu" too
 @SETTINGS
 @given(
     scene_and_light(),
@@ -162,6 +167,7 @@ def test_moving_scene_and_light_together_changes_nothing(sl, method, backend, of
     assert d.mean() <= 1e-3, (d.mean(), d.max())
 
 
+@pytest.mark.gpu  # its examples draw backend="gpu" too
 @SETTINGS
 @given(depth_maps(), st.sampled_from(MAP_METHODS), st.sampled_from(BACKENDS), st.integers(-80, 80))
 def test_power_of_two_scale_changes_nothing(maps, method, backend, k):
@@ -197,6 +203,7 @@ def two_aligned_plates(draw):
     return a, za, b, zb, size
 
 
+@pytest.mark.gpu  # its examples draw backend="gpu" too
 @SETTINGS
 @given(two_aligned_plates(), st.sampled_from(BACKENDS))
 def test_ssm_is_darker_than_the_truth_by_the_back_projections_overlap(case, backend):

@@ -8,8 +8,8 @@ modules, one job each: :mod:`.spec` (the spec, validated on load, with
 parameters), :mod:`.build` (its scene, light and camera), :mod:`.item`
 (render and write one item), :mod:`.files` (all-or-nothing writes inside
 ``--out``), :mod:`.manifest` (the output folder's bookkeeping),
-:mod:`.runner` and :mod:`.dask_runner` (handing items out), :mod:`.check`,
-:mod:`.cli`. The format is in docs/dataset.md.
+:mod:`.runner` and :mod:`.dask_runner` (handing items out, with the
+accounting they share in :mod:`.book`), :mod:`.check`, :mod:`.cli`. The format is in docs/dataset.md.
 """
 
 from __future__ import annotations

@@ -15,18 +15,15 @@ from __future__ import annotations
 
 import uuid
 from collections import deque
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from .book import Book, default_threads
 from .item import make_item
-from .runner import default_threads
 from .spec import Spec
-
-if TYPE_CHECKING:
-    from .runner import _Book
 
 
 def run_dask(
-    book: _Book, spec: Spec, out: str, todo: list[int], dask: Any, workers: int, threads: int | None, window: int | None
+    book: Book, spec: Spec, out: str, todo: list[int], dask: Any, workers: int, threads: int | None, window: int | None
 ) -> str:
     from distributed import Client, LocalCluster, as_completed
 

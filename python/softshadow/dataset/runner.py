@@ -7,7 +7,8 @@ bounded window of tasks in flight: to itself (one worker), to local
 processes (``ProcessPoolExecutor``, forkserver), or to Dask. Workers render
 and write their item's files (:func:`.item.make_item`); the client appends
 each result to the manifest, retries a failed item up to ``retries`` times
-on any worker, then records it as failed and goes on. A worker process that
+on any worker, then records it as failed and goes on (the accounting,
+:class:`.book.Book`, is shared with :mod:`.dask_runner`). A worker process that
 dies costs only the items it held: they are handed out again (the local
 pool is rebuilt; Dask's scheduler reschedules by itself). Errors of the
 output's storage (full disk, read-only or forbidden folder) stop the run:
@@ -16,7 +17,6 @@ every further item would fail the same way.
 
 from __future__ import annotations
 
-import errno
 import multiprocessing
 import os
 import sys
@@ -25,88 +25,18 @@ from collections import deque
 from collections.abc import Iterable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass, field
 from typing import Any
 
 from . import limits as L
+from .book import STORAGE_ERRNOS as STORAGE_ERRNOS  # re-exported, as before the move
+from .book import Book, Summary, default_threads
+from .book import storage_problem as storage_problem
 from .check import check_item
+from .dask_runner import run_dask
 from .files import sweep_temporaries
 from .item import item_files, make_item
-from .manifest import Output, StorageError, read_dataset, read_manifest
+from .manifest import Output, read_dataset, read_manifest
 from .spec import Spec
-
-STORAGE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOTDIR, errno.EFBIG}
-
-
-@dataclass
-class Summary:
-    done: int = 0
-    """Items made by this run."""
-    skipped: int = 0
-    """Items already complete."""
-    failed: dict[int, str] = field(default_factory=dict)
-    """Items that failed every attempt, with their last error."""
-    retried: int = 0
-    seconds: float = 0.0
-    workers: str = ""
-
-    @property
-    def items_per_second(self) -> float:
-        return self.done / self.seconds if self.seconds > 0 else 0.0
-
-    def __str__(self) -> str:
-        s = (
-            f"{self.done} items made, {self.skipped} skipped (already complete), {len(self.failed)} failed, "
-            f"{self.retried} retries; {self.seconds:.1f} s, {self.items_per_second:.2f} items/s ({self.workers})"
-        )
-        for k, err in list(self.failed.items())[:20]:
-            s += f"\n  item {k} failed: {err}"
-        return s
-
-
-def _error_text(e: BaseException) -> str:
-    return f"{type(e).__name__}: {e}"
-
-
-def storage_problem(e: BaseException) -> bool:
-    return isinstance(e, OSError) and e.errno in STORAGE_ERRNOS
-
-
-class _Book:
-    """The client's accounting: manifest lines, attempts, progress."""
-
-    def __init__(self, output: Output, retries: int, bar: Any, summary: Summary) -> None:
-        self.output, self.retries, self.bar, self.summary = output, retries, bar, summary
-        self.attempts: dict[int, int] = {}
-        self.finished: set[int] = set()
-
-    def done(self, k: int, result: dict[str, Any]) -> None:
-        if k in self.finished:  # a duplicate result (a task run twice): already counted
-            return
-        self.finished.add(k)
-        self.output.append({**result, "status": "done", "attempts": self.attempts.get(k, 0) + 1})
-        self.summary.done += 1
-        self.bar.update(1)
-
-    def failed_attempt(self, k: int, e: BaseException) -> bool:
-        """Records a failed attempt; True if item k should be tried again."""
-        if storage_problem(e):
-            assert isinstance(e, OSError)
-            where = f" writing {e.filename!r}" if e.filename else ""
-            raise StorageError(
-                f"out: cannot write{where}: {e.strerror or e} ({errno.errorcode.get(e.errno or 0, '?')}); "
-                f"{self.summary.done} items made by this run are complete; fix the folder and rerun to resume"
-            ) from e
-        n = self.attempts[k] = self.attempts.get(k, 0) + 1
-        if n <= self.retries:
-            self.summary.retried += 1
-            return True
-        self.finished.add(k)
-        self.summary.failed[k] = _error_text(e)
-        self.output.append({"k": k, "status": "failed", "error": _error_text(e), "attempts": n})
-        self.bar.update(1)
-        self.bar.set_postfix(failed=len(self.summary.failed))
-        return False
 
 
 def parse_items(text: str, count: int) -> list[int]:
@@ -196,11 +126,9 @@ def run(
         summary = Summary(skipped=len(wanted) - len(todo))
         t0 = time.perf_counter()
         with tqdm(total=len(todo), unit="item", desc="items", disable=not progress, file=sys.stderr) as bar:
-            book = _Book(output, retries, bar, summary)
+            book = Book(output, retries, bar, summary)
             try:
                 if dask is not None:
-                    from .dask_runner import run_dask
-
                     summary.workers = run_dask(book, spec, output.root, todo, dask, workers, threads, window)
                 elif workers == 1:
                     summary.workers = _run_serial(book, spec, output.root, todo, threads)
@@ -212,7 +140,7 @@ def run(
     return summary
 
 
-def _run_serial(book: _Book, spec: Spec, out: str, todo: list[int], threads: int | None) -> str:
+def _run_serial(book: Book, spec: Spec, out: str, todo: list[int], threads: int | None) -> str:
     for k in todo:
         while True:
             try:
@@ -224,17 +152,12 @@ def _run_serial(book: _Book, spec: Spec, out: str, todo: list[int], threads: int
     return "1 local worker"
 
 
-def default_threads(workers: int) -> int:
-    """The cores shared among the workers (at least 1 each)."""
-    return max(1, (os.cpu_count() or 1) // workers)
-
-
 def _init_worker(threads: int) -> None:
     os.environ["SOFTSHADOW_THREADS"] = str(threads)
 
 
 def _run_pool(
-    book: _Book, spec: Spec, out: str, todo: list[int], workers: int, threads: int | None, window: int | None
+    book: Book, spec: Spec, out: str, todo: list[int], workers: int, threads: int | None, window: int | None
 ) -> str:
     threads = threads or default_threads(workers)
     window = window or 2 * workers

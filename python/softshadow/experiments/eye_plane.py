@@ -40,7 +40,7 @@ from .. import (
 )
 from ..eye_scenes import EYE_SCENES
 from ..metrics import compare_images
-from .study import Point, mitsuba_seconds_at
+from .points import Point, mitsuba_seconds_at
 
 #: 1 and 4 besides 16, 64 and 256: Mitsuba's error at low counts is small on
 #: this metric (most pixels are fully lit or in umbra, which one sample gets

@@ -29,44 +29,24 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from .. import PCSS, Auto, Smoothies, metrics, scenes
+from ..eye_scenes import EYE_SCENES
 from ..light import RectLight
 from ..scene import Scene
 from ..shadow_map import ShadowMap, soft_shadow_map
+from .eye_plane import eye_plane, markdown_eye_plane, markdown_eye_summary
+from .points import Point, median_seconds, mitsuba_seconds_at  # importable from here too, as before
 
 PLANE_SCENES = ("bunny_floating", "bunny_on_floor", "two_spheres", "torus")
 #: Builds an experiment's scene and light from the value of its parameter.
 MakeScene = Callable[[float], tuple[Scene, RectLight]]
 #: The same, with the map resolution to time it at.
 MakeTimedScene = Callable[[float], tuple[Scene, RectLight, int]]
-
-
-@dataclass
-class Point:
-    """One measured setting: a method, its settings, time and error."""
-
-    scene: str
-    method: str
-    setting: str
-    seconds: float
-    error: float
-
-
-def median_seconds(fn: Callable[[], object], repeats: int) -> float:
-    fn()  # warm-up
-    ts = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t)
-    return float(np.median(ts))
 
 
 class Study:
@@ -279,19 +259,6 @@ def plot_curves(
     plt.close(fig)
 
 
-def mitsuba_seconds_at(error: float, points: list[Point]) -> tuple[float, bool]:
-    """Mitsuba's ray_test time at ``error`` on the scene of ``points``,
-    interpolated log-log between its measured sample counts (error ~
-    1/sqrt(samples), time ~ samples), and whether that extrapolates."""
-    mi = sorted((p.error, p.seconds) for p in points if p.method == "mitsuba")
-    le, lt = np.log([m[0] for m in mi]), np.log([m[1] for m in mi])
-    outside = not (le[0] <= np.log(error) <= le[-1])
-    # Beyond the measured range, extend the last segment's slope.
-    i = 0 if np.log(error) < le[0] else max(0, min(len(le) - 2, int(np.searchsorted(le, np.log(error))) - 1))
-    slope = (lt[i + 1] - lt[i]) / (le[i + 1] - le[i])
-    return float(np.exp(lt[i] + slope * (np.log(error) - le[i]))), outside
-
-
 def markdown_plane(points: list[Point]) -> str:
     lines = [
         "| scene | method | setting | time (ms) | error | Mitsuba at equal error (ms) | Mitsuba time / time |",
@@ -370,9 +337,6 @@ def write_readme_block(path: str, lines: list[str]) -> None:
 def eye_part(a: argparse.Namespace, md: list[str]) -> list[str]:
     """4. The accuracy-time plane in eye view (every family, Mitsuba's whole
     job); returns the summary table."""
-    from ..eye_scenes import EYE_SCENES
-    from .eye_plane import eye_plane, markdown_eye_plane, markdown_eye_summary
-
     res = (int(a.eye_resolution[0]), int(a.eye_resolution[1]))
     names = a.eye_scenes or list(EYE_SCENES)
     md += [
