@@ -116,17 +116,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
             |method: &MethodConfig, hard: bool, size: (usize, usize), extent: Option<[f64; 2]>| {
                 let mut settings = MapSettings::new(size.0, size.1, extent, method);
                 settings.hard = hard;
-                match backend {
-                    Backend::Cpu => {
-                        pipeline::from_meshes(call.occluders, call.receivers, &space, &settings)
-                    }
-                    #[cfg(feature = "gpu")]
-                    Backend::Gpu => {
-                        crate::gpu::from_meshes(call.occluders, call.receivers, &space, &settings)
-                    }
-                    #[cfg(not(feature = "gpu"))]
-                    Backend::Gpu => Err(crate::backend::not_built()),
-                }
+                pipeline::from_meshes(call.occluders, call.receivers, &space, &settings, backend)
             };
         let Some(target) = target else {
             return Ok((run(&method, false, (w, h), extent)?, method, None));
@@ -291,14 +281,16 @@ pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
     let backend = pick(call.backend, &call.method, gpu, !is_point(light_size));
     let method = call.method.resolve(&CallContext { backend, ..ctx })?;
     let kernel = method.kernel();
-    let (g, f, b, r) = (&grid, front, back, receiver);
-    let ((visibility, timings), threads) = threads::run_capped(cap, || match backend {
-        Backend::Cpu => pipeline::from_depth(g, og, light_size, f, b, r, kernel),
-        #[cfg(feature = "gpu")]
-        Backend::Gpu => crate::gpu::from_depth(g, og, light_size, f, b, r, kernel),
-        #[cfg(not(feature = "gpu"))]
-        Backend::Gpu => Err(crate::backend::not_built()),
-    })?;
+    let maps = pipeline::DepthMaps {
+        grid: &grid,
+        occluder_grid: og,
+        light_size,
+        front,
+        back,
+        receiver,
+    };
+    let ((visibility, timings), threads) =
+        threads::run_capped(cap, || pipeline::from_depth(&maps, kernel, backend))?;
     let output = DepthOutput {
         visibility,
         timings,

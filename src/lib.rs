@@ -50,6 +50,7 @@ pub mod frame;
 pub mod geom;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod light_view;
 pub mod memory;
 pub mod methods;
 pub mod pipeline;

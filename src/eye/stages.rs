@@ -66,7 +66,7 @@ pub trait EyeStages {
     ) -> Result<(Vec<f32>, EyeMaps)>;
 
     /// The call's stage times: the host's laps `host` with the device's.
-    fn timings(&mut self, host: Timings, method: &MethodConfig) -> Timings;
+    fn timings(&mut self, host: Timings) -> Timings;
 }
 
 /// The eye view's stages on all CPU cores.
@@ -138,7 +138,7 @@ impl EyeStages for CpuEye {
         )
     }
 
-    fn timings(&mut self, host: Timings, _method: &MethodConfig) -> Timings {
+    fn timings(&mut self, host: Timings) -> Timings {
         host
     }
 }

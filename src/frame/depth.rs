@@ -65,7 +65,7 @@ pub(crate) fn check_depth_inputs(
 /// The user's depth maps and light size in the kernels' depth unit (see
 /// units.rs), shared by both backends; the maps are copied only when the unit
 /// is not 1.
-pub(crate) struct DepthInUnit<'a> {
+pub struct DepthInUnit<'a> {
     pub light_size: [f64; 2],
     pub front: Cow<'a, [f32]>,
     pub back: Option<Cow<'a, [f32]>>,
@@ -73,7 +73,7 @@ pub(crate) struct DepthInUnit<'a> {
 }
 
 impl<'a> DepthInUnit<'a> {
-    pub(crate) fn new(
+    pub fn new(
         unit: f64,
         light_size: [f64; 2],
         front: &'a [f32],

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 /// A scene moved to light space with its map grids fitted: what both
 /// backends start from.
-pub(crate) struct FramedScene {
+pub struct FramedScene {
     /// Light-space vertices in the kernels' depth unit (see units.rs).
     pub occ_ls: Vec<DVec3>,
     pub rec_ls: Vec<DVec3>,

@@ -13,7 +13,9 @@
 pub mod depth;
 pub mod light_view;
 
+pub(crate) use depth::check_depth_inputs;
+pub use depth::DepthInUnit;
 pub use depth::{check_depth, orthographic_maps};
-pub(crate) use depth::{check_depth_inputs, DepthInUnit};
-pub(crate) use light_view::{frame_scene, FramedScene};
+pub(crate) use light_view::frame_scene;
+pub use light_view::FramedScene;
 pub use light_view::{light_space_triangles, MapSettings, ShadowResult};

@@ -2,11 +2,35 @@
 //! an adapter these tests say so and pass, unless SOFTSHADOW_REQUIRE_GPU=1
 //! (set by scripts/test.sh, which installs lavapipe) makes that a failure.
 
+use crate::backend::Backend;
 use crate::frame::{MapSettings, ShadowResult};
-use crate::geom::light::RectLight;
+use crate::geom::light::{MapGrid, RectLight};
 use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
 use crate::pipeline;
+
+/// `pipeline::from_depth` on `backend`, the maps given one by one.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn depth_on(
+    backend: Backend,
+    grid: &MapGrid,
+    occluder_grid: &MapGrid,
+    light_size: [f64; 2],
+    front: &[f32],
+    back: Option<&[f32]>,
+    receiver: &[f32],
+    method: Method,
+) -> crate::error::Result<(Vec<f32>, crate::timing::Timings)> {
+    let maps = pipeline::DepthMaps {
+        grid,
+        occluder_grid,
+        light_size,
+        front,
+        back,
+        receiver,
+    };
+    pipeline::from_depth(&maps, method, backend)
+}
 
 fn device_or_skip() -> bool {
     match super::info() {
@@ -89,9 +113,9 @@ fn run_at(gpu: bool, passes: u32, method: Method, (width, height): (usize, usize
         faces: &rf,
     };
     if gpu {
-        super::from_meshes(occ, rec, &light.into(), &s).unwrap()
+        pipeline::from_meshes(occ, rec, &light.into(), &s, Backend::Gpu).unwrap()
     } else {
-        pipeline::from_meshes(occ, rec, &light.into(), &s).unwrap()
+        pipeline::from_meshes(occ, rec, &light.into(), &s, Backend::Cpu).unwrap()
     }
 }
 
@@ -230,9 +254,9 @@ fn gpu_bitmask_is_the_cpus_bit_for_bit_both_gaps_every_mask() {
                     },
                 );
                 if gpu {
-                    super::from_meshes(o, r, &light.into(), &s).unwrap()
+                    pipeline::from_meshes(o, r, &light.into(), &s, Backend::Gpu).unwrap()
                 } else {
-                    pipeline::from_meshes(o, r, &light.into(), &s).unwrap()
+                    pipeline::from_meshes(o, r, &light.into(), &s, Backend::Cpu).unwrap()
                 }
             };
             let (c, g) = (go(false), go(true));
@@ -328,11 +352,28 @@ fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
         for method in bitmask_kernels() {
             for back in [None, Some(&back[..])] {
                 let light = [0.8, 0.6];
-                let (c, _) =
-                    pipeline::from_depth(&grid, &og, light, &front, back, &receiver, method)
-                        .unwrap();
-                let (g, t) =
-                    super::from_depth(&grid, &og, light, &front, back, &receiver, method).unwrap();
+                let (c, _) = crate::gpu::device_tests::depth_on(
+                    Backend::Cpu,
+                    &grid,
+                    &og,
+                    light,
+                    &front,
+                    back,
+                    &receiver,
+                    method,
+                )
+                .unwrap();
+                let (g, t) = crate::gpu::device_tests::depth_on(
+                    Backend::Gpu,
+                    &grid,
+                    &og,
+                    light,
+                    &front,
+                    back,
+                    &receiver,
+                    method,
+                )
+                .unwrap();
                 assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 50);
                 let n = same_bits(&c, &g);
                 assert_eq!(n, 0, "{method:?}, back {}, {og:?}", back.is_some());
@@ -371,11 +412,28 @@ fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
         // lie within [2^-16, 2^16]).
         let w_max = front.iter().fold(0f64, |m, &z| m.max(1.0 / z as f64));
         assert!(super::gather::chunking(&og, light, w_max, method).1 > 2);
-        let (c, _) =
-            pipeline::from_depth(&grid, &og, light, &front, Some(&back), &receiver, method)
-                .unwrap();
-        let (g, _) =
-            super::from_depth(&grid, &og, light, &front, Some(&back), &receiver, method).unwrap();
+        let (c, _) = crate::gpu::device_tests::depth_on(
+            Backend::Cpu,
+            &grid,
+            &og,
+            light,
+            &front,
+            Some(&back),
+            &receiver,
+            method,
+        )
+        .unwrap();
+        let (g, _) = crate::gpu::device_tests::depth_on(
+            Backend::Gpu,
+            &grid,
+            &og,
+            light,
+            &front,
+            Some(&back),
+            &receiver,
+            method,
+        )
+        .unwrap();
         assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 100);
         assert_eq!(same_bits(&c, &g), 0, "{method:?}");
     }
@@ -400,7 +458,8 @@ fn depth_maps_cannot_be_traced() {
     // the CPU, before any GPU work.
     let z = vec![2f32; 64];
     let g = crate::geom::light::MapGrid::new(8, 8, [0.5, 0.5]).unwrap();
-    let e = super::from_depth(
+    let e = crate::gpu::device_tests::depth_on(
+        Backend::Gpu,
         &g,
         &g,
         [1.0, 1.0],
@@ -1438,6 +1497,7 @@ mod smoothies {
 
 mod pcss {
     use super::{device_or_skip, run_at, same_bits};
+    use crate::backend::Backend;
     use crate::geom::light::MapGrid;
     use crate::gpu::context::gpu;
     use crate::gpu::dispatch::upload;
@@ -1446,7 +1506,6 @@ mod pcss {
     use crate::gpu::timing::StageTimer;
     use crate::methods::pcss::{Pcss, MAX_TAPS};
     use crate::methods::{LightPoint, Method, ShadowInputs, ShadowMethod};
-    use crate::pipeline;
     use crate::timing::Stopwatch;
 
     fn lcg(seed: &mut u64) -> f64 {
@@ -1545,11 +1604,28 @@ mod pcss {
             (7, [1e30, 0.5]),
         ] {
             let method = Method::Pcss { max_taps: taps };
-            let (c, _) =
-                pipeline::from_depth(&grid, &og, light, &front, None, &receiver, method).unwrap();
-            let (g, _) =
-                super::super::from_depth(&grid, &og, light, &front, None, &receiver, method)
-                    .unwrap();
+            let (c, _) = crate::gpu::device_tests::depth_on(
+                Backend::Cpu,
+                &grid,
+                &og,
+                light,
+                &front,
+                None,
+                &receiver,
+                method,
+            )
+            .unwrap();
+            let (g, _) = crate::gpu::device_tests::depth_on(
+                Backend::Gpu,
+                &grid,
+                &og,
+                light,
+                &front,
+                None,
+                &receiver,
+                method,
+            )
+            .unwrap();
             let (max, mean, flips) = compare(&c, &g);
             eprintln!("wide {taps} {light:?}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
             assert!(

@@ -1,6 +1,6 @@
 //! The eye view on the GPU (`render(..., backend="gpu")`): `GpuEye`, the
-//! twin of `eye::CpuEye` (src/eye/stages.rs) that `pipeline::eye_view` runs, stage for stage, with the same
-//! answers.
+//! twin of `eye::CpuEye` (src/eye/stages.rs) that `pipeline::eye_view`
+//! runs, stage for stage, with the same answers.
 //!
 //! * First hits (`eye_hits.wgsl`): each pixel-centre ray o = 0 (eye-relative),
 //!   d = `gbuffer::pixel_ray` (f32, uploaded) is cast through the camera BVH
@@ -264,15 +264,11 @@ impl EyeStages for GpuEye {
         Ok((v, m))
     }
 
-    fn timings(&mut self, host: Timings, method: &MethodConfig) -> Timings {
+    // Several submissions time some stages more than once: summed.
+    fn timings(&mut self, host: Timings) -> Timings {
         let mut timings = host;
         timings.extend(std::mem::take(&mut self.device_timings));
-        if matches!(method, MethodConfig::ShadowMapping(_)) {
-            timings
-        } else {
-            // Several submissions time some stages more than once: summed.
-            merged(timings)
-        }
+        merged(timings)
     }
 }
 

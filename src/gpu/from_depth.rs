@@ -12,43 +12,41 @@ use super::refusals::{check_side, point_light_on_gpu};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::Result;
-use crate::frame::{check_depth_inputs, DepthInUnit};
+use crate::frame::DepthInUnit;
 use crate::geom::light::{is_point, MapGrid};
-use crate::geom::units::{depth_unit, farthest};
 use crate::methods::Method;
 use crate::timing::{Stopwatch, Timings};
 
-/// `pipeline::from_depth` on the GPU: the same checks, result and stage
-/// names (plus the device's).
-pub fn from_depth(
-    grid: &MapGrid,
-    occluder_grid: &MapGrid,
-    light_size: [f64; 2],
-    front: &[f32],
-    back: Option<&[f32]>,
-    receiver: &[f32],
-    method: Method,
-) -> Result<(Vec<f32>, Timings)> {
-    let light_size = check_depth_inputs(
-        grid,
-        occluder_grid,
-        light_size,
-        front,
-        back,
-        receiver,
-        method,
-    )?;
+/// What the GPU refuses of depth maps before any work: a method it has no
+/// kernel for, a map side beyond its fixed-point coordinates.
+pub(crate) fn check(method: Method, grid: &MapGrid, occluder_grid: &MapGrid) -> Result<()> {
     if !matches!(method, Method::Pcss { .. }) {
         gather::check_method(method)?;
     }
-    // The kernels' depth unit, as on the CPU (see units.rs).
-    let d = DepthInUnit::new(
-        depth_unit(farthest(receiver)),
-        light_size,
-        front,
-        back,
-        receiver,
-    )?;
+    check_side("receiver_depth", (grid.width, grid.height))?;
+    check_side(
+        "occluder_depth",
+        (occluder_grid.width, occluder_grid.height),
+    )
+}
+
+/// Refuses maps the device cannot bind.
+pub(crate) fn reserve(
+    method: Method,
+    (grid, occluder_grid): (&MapGrid, &MapGrid),
+    layers: usize,
+) -> Result<()> {
+    check_size(gpu()?, method, grid, occluder_grid, layers as u32)
+}
+
+/// The visibility of depth maps in the kernels' unit on the device
+/// (`light_view::LightViewStages::depth`), and the device's stage times.
+pub(crate) fn shade(
+    (grid, occluder_grid): (&MapGrid, &MapGrid),
+    d: &DepthInUnit,
+    method: Method,
+    sw: &mut Stopwatch,
+) -> Result<(Vec<f32>, Timings)> {
     if is_point(d.light_size) {
         return Err(point_light_on_gpu("light_size"));
     }
@@ -58,15 +56,8 @@ pub fn from_depth(
         d.back.as_deref(),
         &d.receiver[..],
     );
-    check_side("receiver_depth", (grid.width, grid.height))?;
-    check_side(
-        "occluder_depth",
-        (occluder_grid.width, occluder_grid.height),
-    )?;
     let g = gpu()?;
     let n_layers = 1 + back.is_some() as u32;
-    check_size(g, method, grid, occluder_grid, n_layers)?;
-    let mut sw = Stopwatch::new();
     // Bitmask's connected micro-quads: their corners, on the CPU.
     let corners = gather::needs_corners(method).then(|| {
         let layers: Vec<&[f32]> = std::iter::once(front).chain(back).collect();
@@ -99,7 +90,7 @@ pub fn from_depth(
                     label: Some("softshadow from depth pcss"),
                 });
             sh.record(g, &mut enc, &timer, &maps);
-            return submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], &mut sw);
+            return submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], sw);
         }
         let shading = Shading::new(
             g,
@@ -119,16 +110,8 @@ pub fn from_depth(
                 label: Some("softshadow from depth"),
             });
         shading.record(g, &mut enc, &timer, &maps)?;
-        submit_and_read(
-            g,
-            enc,
-            &timer,
-            &[(&shading.vis, shading.vis_bytes)],
-            &mut sw,
-        )
+        submit_and_read(g, enc, &timer, &[(&shading.vis, shading.vis_bytes)], sw)
     })?;
     let v = visibility(&out.buffers[0])?;
-    let mut timings = sw.timings;
-    timings.extend(out.device_timings);
-    Ok((v, timings))
+    Ok((v, out.device_timings))
 }

@@ -1,4 +1,5 @@
-//! Meshes -> light-view maps -> visibility, every per-texel stage on the
+//! The light view's maps and visibility on the GPU (`GpuLightView::meshes`),
+//! every per-texel stage on the
 //! device: the set-up triangles go up once, the receiver map, the occluder
 //! layers (front, peeled, back), their row statistics and the method's
 //! shading run in one command buffer, and the maps and the visibility come
@@ -17,18 +18,16 @@ use super::gather;
 use super::pcss::PcssShading;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
-use super::refusals::{check_side, point_light_on_gpu};
+use super::refusals::check_side;
 use super::shading::{check_size, Shading};
 use super::smoothies::{self, Receivers, SmoothieShading};
-use super::timing::{merged, StageTimer};
+use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::frame::{frame_scene, light_space_triangles, FramedScene, MapSettings, ShadowResult};
-use crate::geom::light::is_point;
-use crate::geom::light_space::LightSpace;
-use crate::geom::mesh::MeshRef;
+use crate::frame::{light_space_triangles, FramedScene, MapSettings};
+use crate::light_view::LightMaps;
 use crate::methods::Method;
 use crate::raster::setup_triangles;
-use crate::timing::Stopwatch;
+use crate::timing::{Stopwatch, Timings};
 
 /// The shading stage of a method: over occluder maps, or over triangles.
 enum Stage {
@@ -41,14 +40,9 @@ enum Stage {
     Pcss(PcssShading),
 }
 
-/// Soft shadow map from meshes on the GPU; the same result type, maps and
-/// stage names (plus the device's) as `pipeline::from_meshes`.
-pub fn from_meshes(
-    occluders: MeshRef,
-    receivers: MeshRef,
-    light: &LightSpace,
-    s: &MapSettings,
-) -> Result<ShadowResult> {
+/// What the GPU refuses of a mesh call before any work: a method it has
+/// no kernel for, a map side beyond its fixed-point coordinates.
+pub(crate) fn check(s: &MapSettings) -> Result<()> {
     // Map methods shade occluder maps; `exact` traces the triangles.
     let traced = s.method.traces();
     let pcss = matches!(s.method, Method::Pcss { .. });
@@ -59,32 +53,41 @@ pub fn from_meshes(
     if let Some(o) = s.occluder_resolution {
         check_side("occluder_resolution", o)?;
     }
-    let g = gpu()?;
-    let mut sw = Stopwatch::new();
+    Ok(())
+}
+
+/// The maps and the visibility of a framed scene on the device
+/// (`light_view::LightViewStages::meshes`), and the device's stage times.
+pub(crate) fn maps(
+    f: &FramedScene,
+    (occluder_faces, receiver_faces): (&[[u32; 3]], &[[u32; 3]]),
+    s: &MapSettings,
+    sw: &mut Stopwatch,
+) -> Result<(LightMaps, Timings)> {
+    let traced = s.method.traces();
     let FramedScene {
         occ_ls,
         rec_ls,
         grid,
         occluder_grid,
         near,
-        unit,
         light_size,
-    } = frame_scene(&occluders, &receivers, light, s, &mut sw)?;
-    if is_point(light_size) {
-        return Err(point_light_on_gpu("size"));
-    }
+        ..
+    } = f;
+    let (grid, occluder_grid, near, light_size) = (*grid, *occluder_grid, *near, *light_size);
+    let g = gpu()?;
     // Occluder depth layers in `maps` after the receiver's (none when traced).
     let layers = if traced { 0 } else { s.passes };
     let passes = layers as usize;
     check_size(g, s.method, &grid, &occluder_grid, layers)?;
-    let rec_tris: Vec<GpuTri> = setup_triangles(&grid, &rec_ls, receivers.faces, near)
+    let rec_tris: Vec<GpuTri> = setup_triangles(&grid, rec_ls, receiver_faces, near)
         .iter()
         .map(GpuTri::from_setup)
         .collect();
     let occ_tris: Vec<GpuTri> = if traced {
         vec![]
     } else {
-        setup_triangles(&occluder_grid, &occ_ls, occluders.faces, near)
+        setup_triangles(&occluder_grid, occ_ls, occluder_faces, near)
             .iter()
             .map(GpuTri::from_setup)
             .collect()
@@ -92,14 +95,7 @@ pub fn from_meshes(
     // Smoothies: steps 2-3 on the CPU (smoothies.rs).
     let smoothies = smoothies::options(s.method)
         .map(|m| {
-            smoothies::prepare_light_view(
-                g,
-                &m,
-                &occluder_grid,
-                light_size,
-                &occ_ls,
-                occluders.faces,
-            )
+            smoothies::prepare_light_view(g, &m, &occluder_grid, light_size, occ_ls, occluder_faces)
         })
         .transpose()?;
     sw.lap("setup");
@@ -118,7 +114,7 @@ pub fn from_meshes(
                 },
             )),
             (Method::Exact { samples }, _) => {
-                let t = light_space_triangles(&occ_ls, occluders.faces);
+                let t = light_space_triangles(occ_ls, occluder_faces);
                 Stage::Rays(ExactShading::new(g, &grid, t, samples, light_size))
             }
             (Method::Pcss { max_taps }, _) => Stage::Pcss(PcssShading::maps(
@@ -177,7 +173,7 @@ pub fn from_meshes(
                 sources.push((&sh.vis, sh.vis_bytes));
             }
         }
-        let mut out = submit_and_read(g, enc, &timer, &sources, &mut sw)?;
+        let mut out = submit_and_read(g, enc, &timer, &sources, sw)?;
         if let Stage::Quads = shading {
             // The corners from the maps read back, then the shading.
             let m = words(&out.buffers[0]);
@@ -203,7 +199,7 @@ pub fn from_meshes(
                     label: Some("softshadow quads"),
                 });
             sh.record(g, &mut enc, &timer, &maps)?;
-            let shaded = submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], &mut sw)?;
+            let shaded = submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], sw)?;
             out.buffers.extend(shaded.buffers);
             out.device_timings.extend(shaded.device_timings);
         }
@@ -217,10 +213,6 @@ pub fn from_meshes(
     }
     let maps = words(&out.buffers[0]);
     let visibility = visibility(&out.buffers[1])?;
-    let mut timings = sw.timings;
-    timings.extend(out.device_timings);
-    // Two submissions (closed gaps) time their stages twice: summed.
-    let timings = merged(timings);
     let rec_len = grid.len();
     let occ_len = occluder_grid.len();
     let map_of = |k: usize, empty_zero: bool| -> Vec<f32> {
@@ -243,16 +235,14 @@ pub fn from_meshes(
         .collect();
     // The farthest layer starts at 0 (before the atomicMax): 0 means empty.
     let back = (passes >= 2).then(|| map_of(passes - 1, true));
-    Ok(ShadowResult {
-        grid,
-        occluder_grid,
-        visibility,
-        receiver,
-        occluder_front: front,
-        occluder_middle: middle,
-        occluder_back: back,
-        timings,
-        light_space: *light,
-    }
-    .in_user_units(unit))
+    Ok((
+        LightMaps {
+            visibility,
+            receiver,
+            front,
+            middle,
+            back,
+        },
+        out.device_timings,
+    ))
 }

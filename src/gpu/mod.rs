@@ -30,9 +30,12 @@
 //! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl`,
 //!   `shadow_mapping.wgsl` and `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
-//! Entry points: `from_meshes` (the whole mesh pipeline), `from_depth`
-//! (the user's depth maps, shaded) and `GpuEye` (the eye view's stages, run by `crate::pipeline::eye_view`). Device, queue and pipelines are made once
-//! per process (`context.rs`).
+//! What the orchestrators (`crate::pipeline`) run: `GpuLightView` (the
+//! light view's stages: the mesh maps and their shading in one submission,
+//! `from_meshes.rs`; the user's depth maps shaded, `from_depth.rs`) and
+//! `GpuEye` (the eye view's stages, `eye.rs`); this module never runs a
+//! sequence of its own. Device, queue and pipelines are made once per
+//! process (`context.rs`).
 
 mod context;
 #[cfg(test)]
@@ -44,6 +47,7 @@ mod from_depth;
 mod from_meshes;
 mod front_layer;
 mod gather;
+mod light_view;
 mod pcss;
 mod raster;
 mod readback;
@@ -57,8 +61,7 @@ mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};
 pub use eye::GpuEye;
-pub use from_depth::from_depth;
-pub use from_meshes::from_meshes;
+pub use light_view::GpuLightView;
 
 use crate::error::Result;
 

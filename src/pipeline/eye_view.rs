@@ -44,7 +44,7 @@ pub fn render_with<S: EyeStages>(
         let g = stages.first_hits(call.camera, &scene)?;
         sw.lap("first_hits");
         let visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
-        let timings = stages.timings(sw.timings, &method);
+        let timings = stages.timings(sw.timings);
         let image = shadow_mapping::image(call, &scene, g, visibility, timings)?;
         return Ok((image, method));
     }
@@ -84,7 +84,7 @@ pub fn render_with<S: EyeStages>(
     } else {
         method = resolve_at_camera(call, S::BACKEND)?;
     }
-    let timings = stages.timings(sw.timings, &method);
+    let timings = stages.timings(sw.timings);
     Ok((
         EyeImage {
             gbuffer: g,

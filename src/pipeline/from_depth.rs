@@ -1,68 +1,94 @@
-//! Depth maps the user rendered -> visibility on the CPU, and the checks
-//! and unit change both backends apply to such maps.
+//! Depth maps the user rendered -> visibility, on either backend: the
+//! checks and unit change of `crate::frame::depth`, then the backend's
+//! shading stage (`crate::light_view`).
 
+use crate::backend::Backend;
 use crate::error::Result;
+use crate::frame::{check_depth_inputs, DepthInUnit};
 use crate::geom::light::MapGrid;
 use crate::geom::units::{depth_unit, farthest};
-use crate::memory::{check_fits, map_bytes};
-use crate::methods::{Method, ShadowInputs};
-
-use crate::frame::{check_depth_inputs, DepthInUnit};
-use crate::methods::shade_map;
+use crate::light_view::{CpuLightView, LightViewStages};
+use crate::methods::Method;
 use crate::timing::{Stopwatch, Timings};
 
-/// Soft shadow map from depth maps the user rendered.
+/// The user's depth maps: the receiver map's grid (the output's), the
+/// occluder maps' grid, the light's size in the depths' unit, the maps.
+#[derive(Debug, Clone, Copy)]
+pub struct DepthMaps<'a> {
+    pub grid: &'a MapGrid,
+    pub occluder_grid: &'a MapGrid,
+    pub light_size: [f64; 2],
+    pub front: &'a [f32],
+    pub back: Option<&'a [f32]>,
+    pub receiver: &'a [f32],
+}
+
+/// Soft shadow map from depth maps the user rendered, on `backend`.
 pub fn from_depth(
-    grid: &MapGrid,
-    occluder_grid: &MapGrid,
-    light_size: [f64; 2],
-    front: &[f32],
-    back: Option<&[f32]>,
-    receiver: &[f32],
+    maps: &DepthMaps,
+    method: Method,
+    backend: Backend,
+) -> Result<(Vec<f32>, Timings)> {
+    match backend {
+        Backend::Cpu => from_depth_with(&mut CpuLightView, maps, method),
+        #[cfg(feature = "gpu")]
+        Backend::Gpu => from_depth_with(&mut crate::gpu::GpuLightView::default(), maps, method),
+        #[cfg(not(feature = "gpu"))]
+        Backend::Gpu => Err(crate::backend::not_built()),
+    }
+}
+
+/// Soft shadow map from depth maps on `stages`' backend.
+pub fn from_depth_with<S: LightViewStages>(
+    stages: &mut S,
+    m: &DepthMaps,
     method: Method,
 ) -> Result<(Vec<f32>, Timings)> {
     let light_size = check_depth_inputs(
-        grid,
-        occluder_grid,
-        light_size,
-        front,
-        back,
-        receiver,
+        m.grid,
+        m.occluder_grid,
+        m.light_size,
+        m.front,
+        m.back,
+        m.receiver,
         method,
     )?;
+    stages.check_depth(method, m.grid, m.occluder_grid)?;
     let mut sw = Stopwatch::new();
     // The kernels' depth unit (see units.rs): copies only far from 1.
-    let unit = depth_unit(farthest(receiver));
-    // Visibility, the kernels' 1/depth layers, and the copies in that unit.
-    let copies = if unit == 1.0 { 0 } else { 1 };
-    let layers = 1 + back.is_some() as usize;
-    check_fits(
-        "receiver_depth",
-        &format!("{}x{} maps", grid.width, grid.height),
-        map_bytes(grid.len(), 1 + copies) + map_bytes(occluder_grid.len(), layers * (1 + copies)),
-    )?;
-    let d = DepthInUnit::new(unit, light_size, front, back, receiver)?;
-    let mut layers: Vec<&[f32]> = vec![&d.front];
-    if let Some(b) = &d.back {
-        layers.push(b);
-    }
-    let inputs = ShadowInputs {
-        grid: *grid,
-        occluder_grid: *occluder_grid,
-        light_size: d.light_size,
-        receiver: &d.receiver,
-        occluder_layers: layers,
-        occluder_triangles: None,
-    };
-    let v = shade_map(method, &inputs);
-    sw.lap("shadow");
-    Ok((v, sw.timings))
+    let unit = depth_unit(farthest(m.receiver));
+    let layers = 1 + m.back.is_some() as usize;
+    stages.reserve_depth(method, (m.grid, m.occluder_grid), layers, unit)?;
+    let d = DepthInUnit::new(unit, light_size, m.front, m.back, m.receiver)?;
+    let v = stages.depth((m.grid, m.occluder_grid), &d, method, &mut sw)?;
+    Ok((v, stages.timings(sw.timings)))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::error::Error;
+
+    /// `from_depth` on the CPU, the maps given one by one.
+    fn cpu(
+        grid: &MapGrid,
+        og: &MapGrid,
+        light_size: [f64; 2],
+        front: &[f32],
+        back: Option<&[f32]>,
+        receiver: &[f32],
+        method: Method,
+    ) -> Result<(Vec<f32>, Timings)> {
+        let maps = DepthMaps {
+            grid,
+            occluder_grid: og,
+            light_size,
+            front,
+            back,
+            receiver,
+        };
+        from_depth(&maps, method, Backend::Cpu)
+    }
 
     /// A texel-aligned plate at depth 2 over receivers at depth 4, times `s`.
     fn plate_maps(n: usize, s: f32) -> (Vec<f32>, Vec<f32>) {
@@ -97,13 +123,13 @@ mod tests {
         };
         for method in [ssm, bitmask] {
             let (f, r) = plate_maps(n, 1.0);
-            let (base, _) = from_depth(&grid, &grid, [1.0, 0.6], &f, None, &r, method).unwrap();
+            let (base, _) = cpu(&grid, &grid, [1.0, 0.6], &f, None, &r, method).unwrap();
             assert!(base.iter().any(|&v| v < 1e-6));
             for k in [-90, -70, 50, 60, 90] {
                 let s = 2f32.powi(k);
                 let (f, r) = plate_maps(n, s);
                 let size = [s as f64, 0.6 * s as f64];
-                let (v, _) = from_depth(&grid, &grid, size, &f, None, &r, method).unwrap();
+                let (v, _) = cpu(&grid, &grid, size, &f, None, &r, method).unwrap();
                 assert_eq!(v, base, "{method:?} at 2^{k}");
             }
         }
@@ -114,7 +140,7 @@ mod tests {
         let n = 8;
         let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
         let (f, r) = plate_maps(n, 1.0);
-        let err = from_depth(
+        let err = cpu(
             &grid,
             &grid,
             [1e-35, 1.0],

@@ -12,7 +12,7 @@ mod from_meshes;
 mod from_scene;
 mod points;
 
-pub use from_depth::from_depth;
-pub use from_meshes::from_meshes;
+pub use from_depth::{from_depth, from_depth_with, DepthMaps};
+pub use from_meshes::{from_meshes, from_meshes_with};
 pub use from_scene::from_scene;
 pub use points::{receiver_points, sample_points, OccluderSource};

@@ -5,26 +5,8 @@
 //! the sorted points into runs (`shade_row_generic`, `shade_points_generic`:
 //! the source that `simd.rs` compiles for each instruction set).
 
-use super::{Accumulator, Kernel, Lanes, LANES, ROWS_PER_GROUP, TILE_W};
+use super::kernel::{Accumulator, Group, Kernel, LANES, ROWS_PER_GROUP, TILE_W};
 use crate::methods::LightPoint;
-
-/// Up to LANES receivers shaded together. Inactive lanes (no receiver) have
-/// wr = +inf, which makes every contribution 0.
-pub(in crate::methods) struct Group {
-    pub xr: Lanes,
-    pub yr: Lanes,
-    pub wr: Lanes,
-    /// Bounds over the active lanes.
-    pub wr_min: f32,
-    pub(super) wr_max: f32,
-    /// A whole tile (lane l = row TILE_W + column, every lane active) whose
-    /// receivers share one depth (see `Accumulator::add_texel_tile`).
-    pub(super) uniform_tile: bool,
-    pub(super) x_lo: f32,
-    pub(super) x_hi: f32,
-    pub(super) y_lo: f32,
-    pub(super) y_hi: f32,
-}
 
 impl Group {
     /// `None` when no lane has a receiver in front of the light. `tile`:

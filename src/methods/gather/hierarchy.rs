@@ -4,46 +4,9 @@
 //! BLOCK-wide block) and the level choice, which reads coarser texels where
 //! the penumbra is wide. Built once per call in `Kernel::new`.
 
-use super::{Group, Kernel, BLOCK};
+use super::kernel::{Group, Kernel, Layer, Level, RowSpan, BLOCK};
 use crate::methods::ShadowInputs;
 use rayon::prelude::*;
-
-/// One occluder depth layer at one level of the hierarchy, in the form the
-/// kernel reads.
-pub(super) struct Layer {
-    /// 1/depth per texel, 0 where empty (so it is never in front of a receiver).
-    /// At coarser levels: the mean of the occupied children where at least
-    /// half the children are occupied, else 0.
-    pub(super) w: Vec<f32>,
-    /// Smallest and largest 1/depth of the occupied level-0 texels under each
-    /// texel (inf and 0 where none): what the level choice bounds with.
-    w_far: Vec<f32>,
-    w_near: Vec<f32>,
-    /// Largest 1/depth of each BLOCK-wide block of each row (`blocks_per_row` a row).
-    pub(super) block_w_max: Vec<f32>,
-    pub(super) rows: Vec<RowSpan>,
-    pub(super) w_max: f32,
-    /// Batch of each row: runs of rows holding about sqrt(M) of the M
-    /// occupied texels each (Appendix A's workaround for FP16 blending; the
-    /// batches end at row boundaries here).
-    pub(super) row_batch: Vec<u32>,
-    /// Corner 1/depths of the connected micro-quads (`corners.rs`), when the
-    /// method reads them; empty otherwise.
-    pub(super) corners: Vec<[f32; 4]>,
-    /// `corner_invs` of each quad seen from the kernel's `plane_wr` (empty
-    /// without one): whole tiles on that plane read them instead of
-    /// dividing per (quad, tile).
-    pub(super) plane_invs: Vec<[f32; 4]>,
-}
-
-#[derive(Clone, Copy)]
-pub(super) struct RowSpan {
-    /// Largest 1/depth in the row (its nearest occluder texel).
-    pub(super) w_max: f32,
-    /// Occupied columns [first, last).
-    pub(super) first: u32,
-    pub(super) last: u32,
-}
 
 impl Layer {
     /// Level 0: the occluder map as given.
@@ -177,28 +140,6 @@ impl Layer {
         }
         self.w_max = self.rows.iter().fold(0f32, |m, r| m.max(r.w_max));
     }
-}
-
-/// One level of the occluder hierarchy: its texel geometry and its layers.
-/// Level 0 is the occluder grid; each next level halves both sizes
-/// (rounding up), so texel i of level l covers level-0 columns
-/// [i 2^l, (i + 1) 2^l).
-pub(super) struct Level {
-    pub(super) width: usize,
-    pub(super) height: usize,
-    pub(super) blocks_per_row: usize,
-    /// Level-0 texels per texel of this level, per axis (2^l).
-    scale: f32,
-    /// Left edge (tangent x) of every column, and the left edge in
-    /// half-light units (2 x0 / Lx).
-    pub(super) col_x0: Vec<f32>,
-    pub(super) col_x0_scaled: Vec<f32>,
-    /// Center (tangent y) of every row.
-    pub(super) row_y: Vec<f32>,
-    /// Tangent half-size of a texel.
-    pub(super) hw: f32,
-    pub(super) hh: f32,
-    pub(super) layers: Vec<Layer>,
 }
 
 /// The level whose texels the level choice reads (8x8 level-0 texels each):

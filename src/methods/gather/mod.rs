@@ -22,172 +22,19 @@
 pub mod corners;
 mod group;
 mod hierarchy;
+mod kernel;
 mod simd;
 mod traverse;
 
-pub(super) use group::Group;
 pub use hierarchy::Hierarchy;
-use hierarchy::Level;
+use kernel::Kernel;
+pub(in crate::methods) use kernel::{
+    max, min, Accumulator, Group, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
+};
 
 use super::{LightPoint, ShadowInputs};
 use crate::geom::light::MapGrid;
 use rayon::prelude::*;
-
-/// What a gather method does with one (occluder texel, receiver lanes) pair,
-/// and how its per-lane state becomes an occlusion.
-pub(super) trait Accumulator: Sync {
-    /// Per-lane state (a sum, a bit mask).
-    type State;
-    /// Whether the occluder layers add into one state (bit masks: merged by
-    /// OR) rather than each into its own (sums: merged by max).
-    const LAYERS_SHARE_STATE: bool;
-    fn empty(&self) -> Self::State;
-    /// Adds the micro-patch [x0, x1] x (row) at 1/depth w to every lane.
-    /// x0, x1 and the row's lanes are in half-light units (see RowLanes).
-    fn add_texel(&self, acc: &mut Self::State, w: f32, x0: f32, x1: f32, row: &RowLanes, g: &Group);
-    /// Whether every lane with a receiver is fully occluded (no more work).
-    fn full(&self, acc: &Self::State, g: &Group) -> bool;
-    /// Occlusion per lane in [0, 1].
-    fn occlusion(&self, acc: &Self::State) -> Lanes;
-    /// Whether occluder rows are visited top to bottom, the order in which
-    /// the paper's GPU blended micro-patches (what FP16 emulation needs),
-    /// rather than outward from the tile (what reaches umbra soonest).
-    const ROW_MAJOR: bool = false;
-    /// Called (with ROW_MAJOR) where the rows pass from one batch of about
-    /// sqrt(M) micro-patches to the next (see `Layer::row_batch`).
-    fn end_batch(&self, _acc: &mut Self::State) {}
-    /// Called after each occluder row a group shades (before `full`).
-    fn end_row(&self, _acc: &mut Self::State) {}
-    /// `add_texel` for a group that is a whole tile (lane l = row TILE_W +
-    /// column) whose receivers share one depth, as on a floor facing the
-    /// light: lanes in a column then share x, lanes in a row share y, and a
-    /// method may work per column and per row instead of per lane. Must give
-    /// the same bits as `add_texel`.
-    #[inline(always)]
-    fn add_texel_tile(
-        &self,
-        acc: &mut Self::State,
-        w: f32,
-        x0: f32,
-        x1: f32,
-        row: &RowLanes,
-        g: &Group,
-    ) {
-        self.add_texel(acc, w, x0, x1, row, g)
-    }
-    /// Whether the micro-patches are connected quads (`corners.rs`): the
-    /// traversal then calls `add_quad` with each texel's corner 1/depths
-    /// instead of `add_texel`.
-    const CORNERS: bool = false;
-    /// Adds the quad [x0, x1] x (row) at centre 1/depth w with corner
-    /// 1/depths `c` ([top-left, top-right, bottom-left, bottom-right]).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn add_quad(
-        &self,
-        acc: &mut Self::State,
-        w: f32,
-        _c: &[f32; 4],
-        x0: f32,
-        x1: f32,
-        row: &RowLanes,
-        g: &Group,
-    ) {
-        self.add_texel(acc, w, x0, x1, row, g)
-    }
-    /// `add_quad` for a whole tile on one depth (as `add_texel_tile`), with
-    /// the corners' `corners::corner_invs` for the tile's receiver depth.
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn add_quad_tile(
-        &self,
-        acc: &mut Self::State,
-        w: f32,
-        c: &[f32; 4],
-        _inv: &[f32; 4],
-        x0: f32,
-        x1: f32,
-        row: &RowLanes,
-        g: &Group,
-    ) {
-        self.add_quad(acc, w, c, x0, x1, row, g)
-    }
-}
-
-/// Per-lane receiver coordinates for one occluder row, in half-light units
-/// (2x / Lx, 2y / Ly): the receiver's x, and the row's y-interval relative to
-/// the receiver as [-nay0, ay1].
-pub(super) struct RowLanes {
-    pub xr: Lanes,
-    pub nay0: Lanes,
-    pub ay1: Lanes,
-}
-
-/// Receivers per group (vector lanes: 4 AVX-512 registers). Fixed in the
-/// source, so the summation order (and the result) does not depend on the
-/// SIMD width the CPU offers. A power of two.
-pub(super) const LANES: usize = 64;
-const _: () = assert!(LANES.is_power_of_two());
-/// Map texels are shaded in square tiles of TILE_W x ROWS_PER_GROUP
-/// receivers: one visit of an occluder row serves the whole tile, and a
-/// square keeps the union of the receivers' extents small. (Measured on the
-/// bunny at 256²: 8x8 beats 16x1 by 1.4x and 16x4 or 32x2 by 5-15%.)
-pub(super) const TILE_W: usize = 8;
-pub(super) const ROWS_PER_GROUP: usize = LANES / TILE_W;
-/// Occluder texels per block for the block-level depth bound (8 measured
-/// best: 16 costs 5% more, 32 15%).
-const BLOCK: usize = 8;
-
-pub(super) type Lanes = [f32; LANES];
-
-/// min and max as x86's minps/maxps read them (the second operand wins on NaN,
-/// and no NaN reaches them here): one instruction each, where f32::min's NaN
-/// rules cost three.
-#[inline(always)]
-pub(super) fn min(a: f32, b: f32) -> f32 {
-    if a < b {
-        a
-    } else {
-        b
-    }
-}
-
-#[inline(always)]
-pub(super) fn max(a: f32, b: f32) -> f32 {
-    if a > b {
-        a
-    } else {
-        b
-    }
-}
-
-/// Everything the per-group loop reads, prepared once per call.
-struct Kernel {
-    /// The output (receiver) grid: width, column and row centers.
-    rec_width: usize,
-    rec_col_x: Vec<f32>,
-    rec_row_y: Vec<f32>,
-    /// The occluder grid (level 0) from here on: half-extents and size.
-    tx: f32,
-    ty: f32,
-    width: f32,
-    height: f32,
-    inv_half_lx: f32,
-    inv_half_ly: f32,
-    half_lx: f32,
-    half_ly: f32,
-    /// Level 0, then coarser ones when a hierarchy is used.
-    levels: Vec<Level>,
-    /// Largest level-0 texel size on the light, in half-light units, per
-    /// unit of d = wO - wR; 0 without a hierarchy.
-    texel_per_d: f32,
-    /// 2 x the hierarchy's `max_texel_on_light` (half-light units).
-    max_on_light: f32,
-    /// The receiver 1/depth most whole tiles share (a floor facing the
-    /// light), for which every layer holds its quads' corner reciprocals
-    /// (`Layer::plane_invs`); None: none computed.
-    plane_wr: Option<f32>,
-}
 
 /// Shades every receiver texel of the output map with accumulator `a`.
 pub(super) fn visibility_map<A: Accumulator>(

@@ -5,7 +5,7 @@
 //! `shade_points_generic`), which inlines the traversal; each entry here picks
 //! the best compiled copy the CPU can run.
 
-use super::{Accumulator, Kernel};
+use super::kernel::{Accumulator, Kernel};
 use crate::methods::LightPoint;
 
 impl Kernel {

@@ -4,8 +4,7 @@
 //! reach a lane, then one long loop over those texels (the accumulator's
 //! `add_texel`); the layers' results merged as the accumulator says.
 
-use super::hierarchy::Layer;
-use super::{Accumulator, Group, Kernel, Lanes, Level, RowLanes, BLOCK, LANES};
+use super::kernel::{Accumulator, Group, Kernel, Lanes, Layer, Level, RowLanes, BLOCK, LANES};
 
 impl Kernel {
     /// Adds one layer's micro-patches to `acc` for each lane, visiting rows
