@@ -4,6 +4,7 @@
 //! The values are checked by the core's constructors (`methods/config.rs`);
 //! `None` means "resolved when the config runs".
 
+use super::config_class::{config_class, newargs};
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string, string};
 use crate::methods::config::{auto_rule, check_resolution, LooseOptions};
 use crate::methods::target::Target;
@@ -12,31 +13,9 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-fn py_bool(b: bool) -> &'static str {
-    if b {
-        "True"
-    } else {
-        "False"
-    }
-}
-
-/// Python's repr of an option value.
-fn opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {
-    v.map(f).unwrap_or_else(|| "None".into())
-}
-
-fn res(r: (usize, usize)) -> String {
-    format!("({}, {})", r.0, r.1)
-}
-
-/// Soft shadow maps as published (Atty et al. 2005). See `capabilities()["ssm"]`.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Ssm")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PySsm(pub SsmConfig);
-
-#[pymethods]
-impl PySsm {
-    #[new]
+config_class! {
+    /// Soft shadow maps as published (Atty et al. 2005). See `capabilities()["ssm"]`.
+    class PySsm(SsmConfig) as "Ssm", name "ssm";
     #[pyo3(signature = (*, passes=None, occluder_resolution=None, hierarchy=None, precision=None))]
     fn new(
         passes: Option<&Bound<'_, PyAny>>,
@@ -52,63 +31,18 @@ impl PySsm {
             precision.as_deref(),
         )?))
     }
-    /// "ssm", the name given as ``method=``.
-    #[getter]
-    fn name(&self) -> &'static str {
-        "ssm"
-    }
-    #[getter]
-    fn passes(&self) -> Option<u32> {
-        self.0.passes
-    }
-    #[getter]
-    fn occluder_resolution(&self) -> Option<(usize, usize)> {
-        self.0.occluder_resolution
-    }
-    #[getter]
-    fn hierarchy(&self) -> Option<bool> {
-        self.0.hierarchy
-    }
-    #[getter]
-    fn precision(&self) -> &'static str {
-        self.0.precision.name()
-    }
-    /// The options as keyword arguments: ``Ssm(**c.to_dict()) == c``.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("passes", self.0.passes)?;
-        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
-        d.set_item("hierarchy", self.0.hierarchy)?;
-        d.set_item("precision", self.0.precision.name())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok((PyTuple::empty(py), self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        let c = self.0;
-        format!(
-            "Ssm(passes={}, occluder_resolution={}, hierarchy={}, precision='{}')",
-            opt(c.passes, |p| p.to_string()),
-            opt(c.occluder_resolution, res),
-            opt(c.hierarchy, |h| py_bool(h).into()),
-            c.precision.name()
-        )
+    options {
+        passes: Option<u32> = |c, py| c.0.passes;
+        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
+        hierarchy: Option<bool> = |c, py| c.0.hierarchy;
+        precision: &'static str = |c, py| c.0.precision.name();
     }
 }
 
-/// Micro-patches marking light samples in a bit mask per receiver. See
-/// `capabilities()["bitmask"]`.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Bitmask")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyBitmask(pub BitmaskConfig);
-
-#[pymethods]
-impl PyBitmask {
-    #[new]
+config_class! {
+    /// Micro-patches marking light samples in a bit mask per receiver. See
+    /// `capabilities()["bitmask"]`.
+    class PyBitmask(BitmaskConfig) as "Bitmask", name "bitmask";
     #[pyo3(signature = (*, samples=None, passes=None, occluder_resolution=None, hierarchy=None, gaps=None))]
     fn new(
         samples: Option<&Bound<'_, PyAny>>,
@@ -126,95 +60,24 @@ impl PyBitmask {
             gaps.as_deref(),
         )?))
     }
-    /// "bitmask", the name given as ``method=``.
-    #[getter]
-    fn name(&self) -> &'static str {
-        "bitmask"
-    }
-    #[getter]
-    fn samples(&self) -> u32 {
-        self.0.samples
-    }
-    #[getter]
-    fn passes(&self) -> Option<u32> {
-        self.0.passes
-    }
-    #[getter]
-    fn occluder_resolution(&self) -> Option<(usize, usize)> {
-        self.0.occluder_resolution
-    }
-    #[getter]
-    fn hierarchy(&self) -> Option<bool> {
-        self.0.hierarchy
-    }
-    #[getter]
-    fn gaps(&self) -> &'static str {
-        self.0.gaps.name()
-    }
-    /// The options as keyword arguments: ``Bitmask(**c.to_dict()) == c``.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("samples", self.0.samples)?;
-        d.set_item("passes", self.0.passes)?;
-        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
-        d.set_item("hierarchy", self.0.hierarchy)?;
-        d.set_item("gaps", self.0.gaps.name())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok((PyTuple::empty(py), self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        let c = self.0;
-        format!(
-            "Bitmask(samples={}, passes={}, occluder_resolution={}, hierarchy={}, gaps='{}')",
-            c.samples,
-            opt(c.passes, |p| p.to_string()),
-            opt(c.occluder_resolution, res),
-            opt(c.hierarchy, |h| py_bool(h).into()),
-            c.gaps.name(),
-        )
+    options {
+        samples: u32 = |c, py| c.0.samples;
+        passes: Option<u32> = |c, py| c.0.passes;
+        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
+        hierarchy: Option<bool> = |c, py| c.0.hierarchy;
+        gaps: &'static str = |c, py| c.0.gaps.name();
     }
 }
 
-/// Ray casting against the occluder triangles. See `capabilities()["exact"]`.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Exact")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyExact(pub ExactConfig);
-
-#[pymethods]
-impl PyExact {
-    #[new]
+config_class! {
+    /// Ray casting against the occluder triangles. See `capabilities()["exact"]`.
+    class PyExact(ExactConfig) as "Exact", name "exact";
     #[pyo3(signature = (*, samples=None))]
     fn new(samples: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         Ok(PyExact(ExactConfig::new(opt_int("samples", samples)?)?))
     }
-    /// "exact", the name given as ``method=``.
-    #[getter]
-    fn name(&self) -> &'static str {
-        "exact"
-    }
-    #[getter]
-    fn samples(&self) -> u32 {
-        self.0.samples
-    }
-    /// The options as keyword arguments: ``Exact(**c.to_dict()) == c``.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("samples", self.0.samples)?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok((PyTuple::empty(py), self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        format!("Exact(samples={})", self.0.samples)
+    options {
+        samples: u32 = |c, py| c.0.samples;
     }
 }
 
@@ -269,8 +132,9 @@ impl PyAuto {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok((PyTuple::empty(py), self.to_dict(py)?))
+        Ok(newargs(py, self.to_dict(py)?))
     }
+    // Only the target given (an `Auto` holds one at most).
     fn __repr__(&self) -> String {
         match (self.error(), self.time()) {
             (Some(e), _) => format!("Auto(error={e})"),

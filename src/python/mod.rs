@@ -4,7 +4,10 @@
 //! the backend dispatch live in the core; Python reads them from here.
 //!
 //! * `convert.rs`: Python values to core values (TypeError naming the argument).
-//! * `configs.rs`: the method configs `Ssm`, `Bitmask`, `Exact`, `Auto`.
+//! * `config_class.rs`: the macro that makes a config class from one
+//!   description of its options; `configs.rs` (`Ssm`, `Bitmask`, `Exact`,
+//!   `Auto`, the string form) and `shadow_configs.rs` (ShadowMapping and
+//!   its parts, PCSS, Smoothies) describe them.
 //! * `camera.rs`: the eye view's `Camera`.
 //! * `entry.rs`: the entry points.
 //! * `eye.rs`: the eye view's `render` and its result.
@@ -15,6 +18,7 @@
 
 mod camera;
 mod capabilities;
+mod config_class;
 mod configs;
 mod convert;
 mod entry;

@@ -1,7 +1,9 @@
-//! The ShadowMapping config and its parts as Python classes (frozen,
-//! keyword-only, compared by value, picklable); the values are checked by
-//! the core (`methods/shadow_mapping/config.rs`).
+//! The ShadowMapping config and its parts, PCSS and Smoothies as Python
+//! classes (frozen, keyword-only, compared by value, picklable: see
+//! `config_class.rs`); the values are checked by the core
+//! (`methods/shadow_mapping/config.rs`, `methods/config.rs`).
 
+use super::config_class::config_class;
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string};
 use crate::methods::config::{PcssConfig, SmoothiesConfig};
 use crate::methods::shadow_mapping::config::{
@@ -9,50 +11,22 @@ use crate::methods::shadow_mapping::config::{
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
 
-fn newargs<'py>(
-    py: Python<'py>,
-    d: Bound<'py, PyDict>,
-) -> (Bound<'py, PyTuple>, Bound<'py, PyDict>) {
-    (PyTuple::empty(py), d)
-}
-
-/// A constant depth offset, in depth steps of a 24-bit buffer (2⁻²⁴ of the
-/// map's depth range).
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "ConstantBias")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyConstantBias(pub DepthBias);
-
-#[pymethods]
-impl PyConstantBias {
-    #[new]
+config_class! {
+    /// A constant depth offset, in depth steps of a 24-bit buffer (2⁻²⁴ of the
+    /// map's depth range).
+    class PyConstantBias(DepthBias) as "ConstantBias";
     #[pyo3(signature = (*, constant))]
     fn new(constant: &Bound<'_, PyAny>) -> PyResult<Self> {
         let c = opt_float("constant", Some(constant))?
             .ok_or_else(|| PyTypeError::new_err("constant: must be a number, got None"))?;
         Ok(PyConstantBias(DepthBias::constant(c)?))
     }
-    #[getter]
-    fn constant(&self) -> f64 {
-        match self.0 {
+    options {
+        constant: f64 = |c, py| match c.0 {
             DepthBias::Constant { constant } => constant.0,
             _ => unreachable!(),
-        }
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("constant", self.constant())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        format!("ConstantBias(constant={:?})", self.constant())
+        };
     }
 }
 
@@ -65,15 +39,10 @@ fn pair(b: &DepthBias) -> (f64, f64) {
     }
 }
 
-/// glPolygonOffset on the z-buffer's own depth: ``slope`` times the depth's
-/// slope per texel plus ``constant`` depth steps (2⁻²⁴).
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "SlopeScaleBias")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PySlopeScaleBias(pub DepthBias);
-
-#[pymethods]
-impl PySlopeScaleBias {
-    #[new]
+config_class! {
+    /// glPolygonOffset on the z-buffer's own depth: ``slope`` times the depth's
+    /// slope per texel plus ``constant`` depth steps (2⁻²⁴).
+    class PySlopeScaleBias(DepthBias) as "SlopeScaleBias";
     #[pyo3(signature = (*, constant=None, slope=None))]
     fn new(
         constant: Option<&Bound<'_, PyAny>>,
@@ -84,178 +53,72 @@ impl PySlopeScaleBias {
             opt_float("slope", slope)?,
         )?))
     }
-    #[getter]
-    fn constant(&self) -> f64 {
-        pair(&self.0).0
-    }
-    #[getter]
-    fn slope(&self) -> f64 {
-        pair(&self.0).1
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("constant", self.constant())?;
-        d.set_item("slope", self.slope())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "SlopeScaleBias(constant={:?}, slope={:?})",
-            self.constant(),
-            self.slope()
-        )
+    options {
+        constant: f64 = |c, py| pair(&c.0).0;
+        slope: f64 = |c, py| pair(&c.0).1;
     }
 }
 
-/// The same offset on a linear depth distribution (the distance along the
-/// light's axis), which Scherzer 2005 found best.
-#[pyclass(
-    frozen,
-    eq,
-    hash,
-    module = "softshadow._core",
-    name = "LinearDepthBias"
-)]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyLinearDepthBias(pub DepthBias);
-
-#[pymethods]
-impl PyLinearDepthBias {
-    #[new]
+config_class! {
+    /// The same offset on a linear depth distribution (the distance along the
+    /// light's axis), which Scherzer 2005 found best.
+    class PyLinearDepthBias(DepthBias) as "LinearDepthBias";
     #[pyo3(signature = (*, constant=None, slope=None))]
     fn new(
-        constant: Option<&Bound<'_, PyAny>>,
-        slope: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        Ok(PyLinearDepthBias(DepthBias::linear_depth(
-            opt_float("constant", constant)?,
-            opt_float("slope", slope)?,
-        )?))
-    }
-    #[getter]
-    fn constant(&self) -> f64 {
-        pair(&self.0).0
-    }
-    #[getter]
-    fn slope(&self) -> f64 {
-        pair(&self.0).1
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("constant", self.constant())?;
-        d.set_item("slope", self.slope())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "LinearDepthBias(constant={:?}, slope={:?})",
-            self.constant(),
-            self.slope()
-        )
+    constant: Option<&Bound<'_, PyAny>>,
+    slope: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Self> {
+    Ok(PyLinearDepthBias(DepthBias::linear_depth(
+        opt_float("constant", constant)?,
+        opt_float("slope", slope)?,
+    )?))
+}
+    options {
+        constant: f64 = |c, py| pair(&c.0).0;
+        slope: f64 = |c, py| pair(&c.0).1;
     }
 }
 
-/// Only faces turned away from the light are written: the map holds the far
-/// side of solid casters (closed, consistently wound meshes).
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "BackFaces")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyBackFaces;
-
-#[pymethods]
-impl PyBackFaces {
-    #[new]
-    fn new() -> Self {
-        PyBackFaces
+config_class! {
+    /// Only faces turned away from the light are written: the map holds the far
+    /// side of solid casters (closed, consistently wound meshes).
+    class PyBackFaces as "BackFaces";
+    #[pyo3(signature = ())]
+    fn new() -> PyResult<Self> {
+        Ok(PyBackFaces)
     }
-    fn to_dict<'py>(&self, py: Python<'py>) -> Bound<'py, PyDict> {
-        PyDict::new(py)
-    }
-    fn __getnewargs_ex__<'py>(&self, py: Python<'py>) -> (Bound<'py, PyTuple>, Bound<'py, PyDict>) {
-        newargs(py, PyDict::new(py))
-    }
-    fn __repr__(&self) -> &'static str {
-        "BackFaces()"
-    }
+    options {}
 }
 
-/// Woo's midpoint: the test depth halfway between the nearest and the
-/// second nearest surface.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "MidpointBias")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyMidpointBias;
-
-#[pymethods]
-impl PyMidpointBias {
-    #[new]
-    fn new() -> Self {
-        PyMidpointBias
+config_class! {
+    /// Woo's midpoint: the test depth halfway between the nearest and the
+    /// second nearest surface.
+    class PyMidpointBias as "MidpointBias";
+    #[pyo3(signature = ())]
+    fn new() -> PyResult<Self> {
+        Ok(PyMidpointBias)
     }
-    fn to_dict<'py>(&self, py: Python<'py>) -> Bound<'py, PyDict> {
-        PyDict::new(py)
-    }
-    fn __getnewargs_ex__<'py>(&self, py: Python<'py>) -> (Bound<'py, PyTuple>, Bound<'py, PyDict>) {
-        newargs(py, PyDict::new(py))
-    }
-    fn __repr__(&self) -> &'static str {
-        "MidpointBias()"
-    }
+    options {}
 }
 
-/// Percentage-closer filtering: ``size``×``size`` bilinear taps one texel
-/// apart (a step edge becomes a ramp ``size`` texels wide).
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "PCF")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyPcf(pub Pcf);
-
-#[pymethods]
-impl PyPcf {
-    #[new]
+config_class! {
+    /// Percentage-closer filtering: ``size``×``size`` bilinear taps one texel
+    /// apart (a step edge becomes a ramp ``size`` texels wide).
+    class PyPcf(Pcf) as "PCF";
     #[pyo3(signature = (*, size=None))]
     fn new(size: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         Ok(PyPcf(check_pcf(opt_int("size", size)?)?))
     }
-    #[getter]
-    fn size(&self) -> u32 {
-        self.0.size
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("size", self.0.size)?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        format!("PCF(size={})", self.0.size)
+    options {
+        size: u32 = |c, py| c.0.size;
     }
 }
 
-/// Light-space perspective shadow maps (directional lights): ``n`` the
-/// warp's parameter in world units (None: n_opt), ``vector`` "middle"
-/// (Scherzer's middle vector of the intersection body) or "camera".
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "LiSPSM")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyLiSPSM(pub LiSPSM);
-
-#[pymethods]
-impl PyLiSPSM {
-    #[new]
+config_class! {
+    /// Light-space perspective shadow maps (directional lights): ``n`` the
+    /// warp's parameter in world units (None: n_opt), ``vector`` "middle"
+    /// (Scherzer's middle vector of the intersection body) or "camera".
+    class PyLiSPSM(LiSPSM) as "LiSPSM";
     #[pyo3(signature = (*, n=None, vector=None))]
     fn new(n: Option<&Bound<'_, PyAny>>, vector: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         let vector = opt_string("vector", vector)?;
@@ -264,43 +127,15 @@ impl PyLiSPSM {
             vector.as_deref(),
         )?))
     }
-    #[getter]
-    fn n(&self) -> Option<f64> {
-        self.0.n.map(|n| n.0)
-    }
-    #[getter]
-    fn vector(&self) -> &'static str {
-        self.0.vector.name()
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("n", self.n())?;
-        d.set_item("vector", self.vector())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        let n = self
-            .n()
-            .map(|n| format!("{n:?}"))
-            .unwrap_or_else(|| "None".into());
-        format!("LiSPSM(n={n}, vector='{}')", self.vector())
+    options {
+        n: Option<f64> = |c, py| c.0.n.map(|n| n.0);
+        vector: &'static str = |c, py| c.0.vector.name();
     }
 }
 
-/// The depth-dependent eye-space blur of the shadow image.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "EyeSpaceBlur")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyEyeSpaceBlur(pub EyeSpaceBlur);
-
-#[pymethods]
-impl PyEyeSpaceBlur {
-    #[new]
+config_class! {
+    /// The depth-dependent eye-space blur of the shadow image.
+    class PyEyeSpaceBlur(EyeSpaceBlur) as "EyeSpaceBlur";
     #[pyo3(signature = (*, iterations=None, radius=None))]
     fn new(
         iterations: Option<&Bound<'_, PyAny>>,
@@ -311,32 +146,9 @@ impl PyEyeSpaceBlur {
             opt_float("radius", radius)?,
         )?))
     }
-    #[getter]
-    fn iterations(&self) -> u32 {
-        self.0.iterations
-    }
-    #[getter]
-    fn radius(&self) -> f64 {
-        self.0.radius.0
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("iterations", self.0.iterations)?;
-        d.set_item("radius", self.radius())?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "EyeSpaceBlur(iterations={}, radius={:?})",
-            self.0.iterations,
-            self.radius()
-        )
+    options {
+        iterations: u32 = |c, py| c.0.iterations;
+        radius: f64 = |c, py| c.0.radius.0;
     }
 }
 
@@ -394,14 +206,9 @@ where
     }
 }
 
-/// Scherzer 2005's practical shadow mapping. See ``capabilities()["shadow_mapping"]``.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "ShadowMapping")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyShadowMapping(pub ShadowMappingConfig);
-
-#[pymethods]
-impl PyShadowMapping {
-    #[new]
+config_class! {
+    /// Scherzer 2005's practical shadow mapping. See ``capabilities()["shadow_mapping"]``.
+    class PyShadowMapping(ShadowMappingConfig) as "ShadowMapping", name "shadow_mapping";
     #[pyo3(signature = (*, resolution=None, bias=None, filter=None, warp=None, focus=None, blur=None))]
     fn new(
         resolution: Option<&Bound<'_, PyAny>>,
@@ -421,83 +228,20 @@ impl PyShadowMapping {
             part::<PyEyeSpaceBlur, _>("blur", "EyeSpaceBlur", blur, |c| c.0)?,
         )?))
     }
-    /// "shadow_mapping", the name given as ``method=``.
-    #[getter]
-    fn name(&self) -> &'static str {
-        "shadow_mapping"
-    }
-    #[getter]
-    fn resolution(&self) -> (usize, usize) {
-        self.0.resolution
-    }
-    #[getter]
-    fn bias(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        bias_to_py(py, self.0.bias)
-    }
-    #[getter]
-    fn filter(&self, py: Python<'_>) -> PyResult<Option<Py<PyPcf>>> {
-        self.0.filter.map(|f| Py::new(py, PyPcf(f))).transpose()
-    }
-    #[getter]
-    fn warp(&self, py: Python<'_>) -> PyResult<Option<Py<PyLiSPSM>>> {
-        self.0.warp.map(|w| Py::new(py, PyLiSPSM(w))).transpose()
-    }
-    #[getter]
-    fn focus(&self) -> bool {
-        self.0.focus
-    }
-    #[getter]
-    fn blur(&self, py: Python<'_>) -> PyResult<Option<Py<PyEyeSpaceBlur>>> {
-        self.0
-            .blur
-            .map(|b| Py::new(py, PyEyeSpaceBlur(b)))
-            .transpose()
-    }
-    /// The options as keyword arguments: ``ShadowMapping(**c.to_dict()) == c``.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("resolution", self.resolution())?;
-        d.set_item("bias", self.bias(py)?)?;
-        d.set_item("filter", self.filter(py)?)?;
-        d.set_item("warp", self.warp(py)?)?;
-        d.set_item("focus", self.0.focus)?;
-        d.set_item("blur", self.blur(py)?)?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        let r = |o: Option<Py<PyAny>>| -> PyResult<String> {
-            match o {
-                None => Ok("None".into()),
-                Some(o) => Ok(o.bind(py).repr()?.to_string()),
-            }
-        };
-        Ok(format!(
-            "ShadowMapping(resolution=({}, {}), bias={}, filter={}, warp={}, focus={}, blur={})",
-            self.0.resolution.0,
-            self.0.resolution.1,
-            r(Some(self.bias(py)?))?,
-            r(self.filter(py)?.map(|p| p.into_any()))?,
-            r(self.warp(py)?.map(|p| p.into_any()))?,
-            if self.0.focus { "True" } else { "False" },
-            r(self.blur(py)?.map(|p| p.into_any()))?,
-        ))
+    options {
+        resolution: (usize, usize) = |c, py| c.0.resolution;
+        bias: Py<PyAny> = |c, py| bias_to_py(py, c.0.bias)?;
+        filter: Option<Py<PyPcf>> = |c, py| c.0.filter.map(|f| Py::new(py, PyPcf(f))).transpose()?;
+        warp: Option<Py<PyLiSPSM>> = |c, py| c.0.warp.map(|w| Py::new(py, PyLiSPSM(w))).transpose()?;
+        focus: bool = |c, py| c.0.focus;
+        blur: Option<Py<PyEyeSpaceBlur>> =
+            |c, py| c.0.blur.map(|b| Py::new(py, PyEyeSpaceBlur(b))).transpose()?;
     }
 }
 
-/// Smoothies (Chan & Durand 2003). See ``capabilities()["smoothies"]``.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Smoothies")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PySmoothies(pub SmoothiesConfig);
-
-#[pymethods]
-impl PySmoothies {
-    #[new]
+config_class! {
+    /// Smoothies (Chan & Durand 2003). See ``capabilities()["smoothies"]``.
+    class PySmoothies(SmoothiesConfig) as "Smoothies", name "smoothies";
     #[pyo3(signature = (*, width=None, falloff=None, filter=None, occluder_resolution=None))]
     fn new(
         width: Option<&Bound<'_, PyAny>>,
@@ -514,63 +258,17 @@ impl PySmoothies {
             opt_resolution("occluder_resolution", occluder_resolution)?,
         )?))
     }
-    /// "smoothies", the name given as ``method=``.
-    #[getter]
-    fn name(&self) -> &'static str {
-        "smoothies"
-    }
-    #[getter]
-    fn width(&self) -> f64 {
-        self.0.width.0
-    }
-    #[getter]
-    fn falloff(&self) -> &'static str {
-        self.0.falloff.name()
-    }
-    #[getter]
-    fn filter(&self) -> &'static str {
-        "bilinear"
-    }
-    #[getter]
-    fn occluder_resolution(&self) -> Option<(usize, usize)> {
-        self.0.occluder_resolution
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("width", self.width())?;
-        d.set_item("falloff", self.falloff())?;
-        d.set_item("filter", self.filter())?;
-        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        let r = self
-            .0
-            .occluder_resolution
-            .map(|(w, h)| format!("({w}, {h})"))
-            .unwrap_or_else(|| "None".into());
-        format!(
-            "Smoothies(width={:?}, falloff='{}', filter='bilinear', occluder_resolution={r})",
-            self.width(),
-            self.falloff()
-        )
+    options {
+        width: f64 = |c, py| c.0.width.0;
+        falloff: &'static str = |c, py| c.0.falloff.name();
+        filter: &'static str = |c, py| "bilinear";
+        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
     }
 }
 
-/// PCSS (Fernando 2005). See ``capabilities()["pcss"]``.
-#[pyclass(frozen, eq, hash, module = "softshadow._core", name = "PCSS")]
-#[derive(Clone, PartialEq, Eq, Hash)]
-pub struct PyPcss(pub PcssConfig);
-
-#[pymethods]
-impl PyPcss {
-    #[new]
+config_class! {
+    /// PCSS (Fernando 2005). See ``capabilities()["pcss"]``.
+    class PyPcss(PcssConfig) as "PCSS", name "pcss";
     #[pyo3(signature = (*, max_taps=None, occluder_resolution=None))]
     fn new(
         max_taps: Option<&Bound<'_, PyAny>>,
@@ -581,41 +279,9 @@ impl PyPcss {
             opt_resolution("occluder_resolution", occluder_resolution)?,
         )?))
     }
-    /// "pcss", the name given as ``method=``.
-    #[getter]
-    fn name(&self) -> &'static str {
-        "pcss"
-    }
-    #[getter]
-    fn max_taps(&self) -> u32 {
-        self.0.max_taps
-    }
-    #[getter]
-    fn occluder_resolution(&self) -> Option<(usize, usize)> {
-        self.0.occluder_resolution
-    }
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        d.set_item("max_taps", self.0.max_taps)?;
-        d.set_item("occluder_resolution", self.0.occluder_resolution)?;
-        Ok(d)
-    }
-    fn __getnewargs_ex__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        Ok(newargs(py, self.to_dict(py)?))
-    }
-    fn __repr__(&self) -> String {
-        let r = self
-            .0
-            .occluder_resolution
-            .map(|(w, h)| format!("({w}, {h})"))
-            .unwrap_or_else(|| "None".into());
-        format!(
-            "PCSS(max_taps={}, occluder_resolution={r})",
-            self.0.max_taps
-        )
+    options {
+        max_taps: u32 = |c, py| c.0.max_taps;
+        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
     }
 }
 
