@@ -50,6 +50,7 @@ __all__ = [
     "gpu_available",
     "gpu_info",
     "GpuUnavailableError",
+    "TooLargeError",
     "_panic_for_tests",
     "__version__",
     "ENV_THREADS",
@@ -620,6 +621,10 @@ def receiver_points(
 
 class GpuUnavailableError(RuntimeError):
     """backend="gpu" was asked for and no GPU adapter can be opened."""
+
+class TooLargeError(ValueError, MemoryError):
+    """A request refused before allocating because it would need too much
+    memory. Both a ValueError (a bad argument) and a MemoryError."""
 
 def gpu_available() -> bool:
     """Whether a GPU adapter opens (software ones such as lavapipe count)."""

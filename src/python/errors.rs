@@ -3,7 +3,8 @@
 use crate::error::Error;
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyType;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple, PyType};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 pyo3::create_exception!(
@@ -12,6 +13,37 @@ pyo3::create_exception!(
     PyRuntimeError,
     "backend=\"gpu\" was asked for and no GPU adapter can be opened (none present, no Vulkan driver, or SOFTSHADOW_GPU=off)."
 );
+
+/// `TooLargeError`: a request refused before allocating because it would
+/// need too much memory; both a ValueError (a bad argument) and a
+/// MemoryError. Two bases, which `create_exception!` cannot give, so the
+/// class is made with `type()` when the module is first imported.
+static TOO_LARGE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+const TOO_LARGE_DOC: &str = "A request refused before allocating because it would need too much \
+memory. Both a ValueError (a bad argument) and a MemoryError.";
+
+/// The `TooLargeError` class, made once.
+pub fn too_large_error(py: Python<'_>) -> PyResult<&Bound<'_, PyType>> {
+    TOO_LARGE
+        .get_or_try_init(py, || {
+            let bases = PyTuple::new(
+                py,
+                [
+                    py.get_type::<PyValueError>(),
+                    py.get_type::<PyMemoryError>(),
+                ],
+            )?;
+            let attrs = PyDict::new(py);
+            attrs.set_item("__module__", "softshadow._core")?;
+            attrs.set_item("__doc__", TOO_LARGE_DOC)?;
+            let cls = py
+                .get_type::<PyType>()
+                .call1(("TooLargeError", bases, attrs))?;
+            Ok::<_, PyErr>(cls.cast_into::<PyType>()?.unbind())
+        })
+        .map(|c| c.bind(py))
+}
 
 impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
@@ -23,17 +55,11 @@ impl From<Error> for PyErr {
             Error::InvalidArgument { .. } | Error::ShapeMismatch { .. } => {
                 PyValueError::new_err(msg)
             }
-            // Refused before allocating: softshadow.TooLargeError, both a
-            // ValueError (a bad argument) and a MemoryError.
-            Error::TooLarge { .. } => Python::attach(|py| {
-                match py
-                    .import("softshadow.errors")
-                    .and_then(|m| m.getattr("TooLargeError"))
-                    .and_then(|c| Ok(c.cast_into::<PyType>()?))
-                {
-                    Ok(cls) => PyErr::from_type(cls, msg),
-                    Err(_) => PyMemoryError::new_err(msg),
-                }
+            // Refused before allocating: TooLargeError, both a ValueError
+            // (a bad argument) and a MemoryError.
+            Error::TooLarge { .. } => Python::attach(|py| match too_large_error(py) {
+                Ok(cls) => PyErr::from_type(cls.clone(), msg),
+                Err(_) => PyMemoryError::new_err(msg),
             }),
         }
     }

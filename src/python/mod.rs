@@ -64,6 +64,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "GpuUnavailableError",
         m.py().get_type::<errors::GpuUnavailableError>(),
     )?;
+    m.add("TooLargeError", errors::too_large_error(m.py())?)?;
     m.add_function(wrap_pyfunction!(entry::_panic_for_tests, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("ENV_THREADS", crate::threads::ENV_THREADS)?;

@@ -319,3 +319,11 @@ def test_io_errors_name_the_path_or_channel(tmp_path):
     with pytest.raises(ValueError, match=r"compression: must be one of \['none', 'zip', 'zstd'\], got 'lzw'"):
         io.write_exr(tmp_path / "a.exr", np.zeros((2, 2)), compression="lzw")
     assert not (tmp_path / "a.exr").exists()
+
+
+def test_too_large_error_is_the_core_s_and_both_a_value_and_a_memory_error():
+    # Defined by the core (with two bases, made when _core is imported), so
+    # the core raises the class the package exports, without importing it.
+    assert ss.TooLargeError is _core.TooLargeError
+    assert issubclass(ss.TooLargeError, ValueError) and issubclass(ss.TooLargeError, MemoryError)
+    assert ss.TooLargeError.__module__ == "softshadow._core"
