@@ -12,7 +12,7 @@ from ._core import __version__
 from .backend import gpu_available, gpu_info
 from .camera import Camera
 from .errors import GpuUnavailableError, TooLargeError
-from .light import DirectionalLight, RectLight
+from .lights import DirectionalLight, RectLight
 from .methods import (
     PCF,
     PCSS,

@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .camera import Camera
-from .light import DirectionalLight, RectLight
+from .lights import DirectionalLight, RectLight
 from .scene import Mesh, Scene
 from .scenes import bunny_mesh, quad, sphere, torus
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import _core
 from .camera import Camera
-from .light import DirectionalLight, RectLight, _color
+from .lights import DirectionalLight, RectLight, _color
 from .methods import MethodConfig
 from .plan import Plan, plan_from_core
 from .scene import Scene

@@ -14,7 +14,7 @@ from importlib import resources
 
 import numpy as np
 
-from .light import RectLight
+from .lights import RectLight
 from .scene import Mesh, Scene
 
 LIGHT_HEIGHT = 4.0

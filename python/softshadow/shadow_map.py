@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
-from .light import DirectionalLight, RectLight
+from .lights import DirectionalLight, RectLight
 from .methods import MethodConfig
 from .plan import Decision as Decision  # re-exported: softshadow.shadow_map.Decision as before
 from .plan import Plan, plan_from_core

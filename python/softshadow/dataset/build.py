@@ -19,7 +19,7 @@ import numpy as np
 
 from ..camera import Camera
 from ..eye_scenes import box
-from ..light import DirectionalLight, RectLight
+from ..lights import DirectionalLight, RectLight
 from ..scene import Mesh, Scene
 from ..scenes import bunny_mesh, quad, sphere, torus
 

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .. import eye_scenes
-from ..light import RectLight
+from ..lights import RectLight
 from ..render import Image, render
 
 #: The signed difference's colour scale: |V - V_Mitsuba| beyond this saturates.

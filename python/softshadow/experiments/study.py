@@ -36,7 +36,7 @@ import numpy as np
 
 from .. import PCSS, Auto, Smoothies, metrics, scenes
 from ..eye_scenes import EYE_SCENES
-from ..light import RectLight
+from ..lights import RectLight
 from ..scene import Scene
 from ..shadow_map import ShadowMap, soft_shadow_map
 from .eye_plane import eye_plane, markdown_eye_plane, markdown_eye_summary

@@ -1,4 +1,5 @@
-"""The lights: a rectangular area light and the sun, with their emission.
+"""The lights: a rectangular area light and the sun (:class:`RectLight`,
+:class:`DirectionalLight`), with their emission.
 
 A light's emission is RGB (a number is grey): a rectangle's ``radiance``
 (emitted uniformly, Lambertian, on its ``n`` side only) and the sun's
