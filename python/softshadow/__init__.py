@@ -9,7 +9,7 @@ docs/ for the conventions.
 """
 
 from ._core import __version__
-from .backend import gpu_available, gpu_info
+from .api import gpu_available, gpu_info, render, soft_shadow_map, soft_shadow_map_from_depth
 from .camera import Camera
 from .errors import GpuUnavailableError, TooLargeError
 from .lights import DirectionalLight, RectLight
@@ -35,10 +35,8 @@ from .methods import (
     capabilities,
     limits,
 )
-from .plan import Decision, Plan
-from .render import Image, render
+from .results import Decision, Image, Plan, ShadowMap
 from .scene import Scene
-from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
 
 __all__ = [
     "SlopeScaleBias",

@@ -35,8 +35,9 @@ from typing import Any
 import numpy as np
 
 from .. import eye_scenes
+from ..api import render
 from ..lights import RectLight
-from ..render import Image, render
+from ..results import Image
 
 #: The signed difference's colour scale: |V - V_Mitsuba| beyond this saturates.
 DIFF_RANGE = 0.25

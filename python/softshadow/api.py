@@ -1,192 +1,43 @@
-"""The result type and the two entry points.
+"""The calls: the light view's :func:`soft_shadow_map` (from meshes) and
+:func:`soft_shadow_map_from_depth` (from light-view depth maps), both
+returning a :class:`~softshadow.results.ShadowMap`; the eye view's
+:func:`render`, returning an :class:`~softshadow.results.Image`; and the GPU
+queries :func:`gpu_available` and :func:`gpu_info`.
 
-Each entry point converts its arguments' types and hands them to ``_core``,
-which builds the method config (a typed config, or a name with loose
-options), resolves it for the call, checks every value, and runs it on the
-chosen backend.
+Each call converts its arguments' types and hands them to ``_core``, which
+builds the method config (a typed config, or a name with loose options),
+resolves it for the call, checks every value, and runs it on the chosen
+backend (``backend=`` is passed through): ``"cpu"`` (all cores), ``"gpu"``
+(wgpu; never falls back: no adapter raises
+:class:`~softshadow.errors.GpuUnavailableError`) or ``"auto"`` (the GPU when
+a real, non-software adapter is present and runs the call, else the CPU).
+``SOFTSHADOW_GPU=off`` in the environment hides every adapter.
+
+The eye view (:func:`render`): a scene seen through a
+:class:`softshadow.Camera`, every mesh casting and receiving shadows (its own
+included), lit by a :class:`RectLight` or a :class:`DirectionalLight`. The
+core casts the pixel-centre rays (the G-buffer), then shades each pixel's
+surface point with the method: ``exact`` traces shadow rays, the map methods
+read light-view occluder maps focused on what the camera sees. See
+docs/eye_view.md. Every image also holds the direct lighting of Lambertian
+surfaces, unshadowed and times the visibility (``Image.unshadowed``,
+``Image.shaded``; docs/shading.md).
 """
 
 from __future__ import annotations
 
 import numbers
-import os
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from . import _core
 from . import _validate as check
-from .lights import DirectionalLight, RectLight
+from .camera import Camera
+from .lights import DirectionalLight, RectLight, _color
 from .methods import MethodConfig
-from .plan import Decision as Decision  # re-exported: softshadow.shadow_map.Decision as before
-from .plan import Plan, plan_from_core
+from .results import Image, ShadowMap, plan_from_core
 from .scene import Scene
-
-
-@dataclass(frozen=True, eq=False, repr=False)
-class ShadowMap:
-    """A soft shadow map and the light-view maps it was computed from.
-
-    All maps have shape (H, W), seen from the light's center along its normal:
-    texel ``[j, i]`` has center direction ``n + x u + y v`` with
-    ``x = (-1 + 2(i + 1/2)/W) tx`` and ``y = (1 - 2(j + 1/2)/H) ty``. Depths are
-    planar (distance from the light's plane along n), float32, ``inf`` where
-    nothing is hit.
-    """
-
-    visibility: np.ndarray
-    """(H, W) float32 in [0, 1]: fraction of the light's area seen from the
-    receiver point of each texel; 1 where there is no receiver."""
-    receiver_depth: np.ndarray
-    occluder_depth: np.ndarray | None
-    """Front (nearest) occluder depth; None for methods that read no
-    occluder layers (``Exact`` traces the occluder triangles)."""
-    occluder_depth_back: np.ndarray | None
-    """Back (farthest) occluder depth; None with one pass or no layers."""
-    light: RectLight | DirectionalLight
-    extent: tuple[float, float]
-    """Tangent half-extents (tx, ty); for a DirectionalLight, world
-    half-extents of the orthographic maps."""
-    method: MethodConfig
-    """The config that ran: ``"auto"`` resolved, every default filled in."""
-    extent_fitted: bool
-    """True when ``extent`` was fitted to the shadows (``extent=None``)."""
-    timings: dict[str, float] = field(default_factory=dict)
-    """Seconds per stage, in the order the stages ran."""
-    occluder_depth_middle: tuple[np.ndarray, ...] = ()
-    """With ``passes`` >= 3, the peeled layers between front and back, nearest
-    first: layer k is the nearest surface beyond layer k - 1."""
-    backend: str = "cpu"
-    """The backend that ran it: "cpu" or "gpu"."""
-    threads: int = 0
-    """Worker threads the CPU stages could use."""
-    _occluder_mesh: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
-    depth_origin: tuple[float, float, float] | None = None
-    """For a DirectionalLight: a world point on the maps' depth-0 plane (the
-    plane across the light's direction touching the scene on its side)."""
-    depth_range: float | None = None
-    """For a DirectionalLight: the scene's depth range along the light."""
-    self_shadowing: bool = False
-    """True for the map of a ``Scene(meshes=...)``: every mesh casts and receives."""
-    plan: Plan | None = None
-    """What ``Auto(error=...)`` or ``Auto(time=...)`` decided (light-view maps
-    of a split scene); None for every other method."""
-
-    def _light_args(self) -> tuple[Any, ...]:
-        if isinstance(self.light, DirectionalLight):
-            assert self.depth_origin is not None and self.depth_range is not None
-            return (*self.light._core_args(), self.depth_origin, self.depth_range)
-        return self.light._core_args()
-
-    @property
-    def resolution(self) -> tuple[int, int]:
-        """(W, H)."""
-        h, w = self.visibility.shape
-        return w, h
-
-    @property
-    def passes(self) -> int | None:
-        """Occluder depth layers read (None for methods that read none)."""
-        return getattr(self.method, "passes", None)
-
-    def __repr__(self) -> str:
-        w, h = self.resolution
-        total = sum(self.timings.values()) * 1e3
-        return (
-            f"ShadowMap({w}x{h}, method={self.method!r}, backend={self.backend!r}, "
-            f"extent=({self.extent[0]:.4g}, {self.extent[1]:.4g}), "
-            f"visibility in [{float(self.visibility.min()):.3f}, {float(self.visibility.max()):.3f}], "
-            f"{total:.1f} ms)"
-        )
-
-    def write_exr(self, path: str | os.PathLike[str]) -> None:
-        """Writes the visibility (channel ``V``) and the depth maps (``receiver``,
-        ``occluder``, ``occluder_back`` with two passes) as one float32 EXR file.
-        Needs ``OpenEXR`` (``pip install softshadow[io]``)."""
-        from .io import write_exr
-
-        channels = {"V": self.visibility, "receiver": self.receiver_depth}
-        if self.occluder_depth is not None:
-            channels["occluder"] = self.occluder_depth
-        if self.occluder_depth_back is not None:
-            channels["occluder_back"] = self.occluder_depth_back
-        write_exr(path, channels)
-
-    def sample(self, points: Any, *, outside: float | None = None, threads: int | None = None) -> np.ndarray:
-        """Visibility (N,) float32 at world points lying on receivers.
-
-        Each point is shaded with the same method config as the map, at its
-        own exact position and depth (no interpolation between texels): the
-        occluder maps are the occluders. Points outside the map's extent (or
-        at/behind the light's plane) get ``outside``; by default that is 1.0
-        when the extent was fitted (no shadow can fall there) and a
-        ValueError otherwise. ``threads`` as for :func:`soft_shadow_map`.
-        """
-        if self.self_shadowing:
-            raise ValueError(
-                "points: a scene shadowing itself needs each point's normal to shade it without acne; "
-                "use softshadow.render, or the map's own texels (sm.visibility)"
-            )
-        pts = np.asarray(points)
-        if pts.dtype.kind not in "fiu":
-            raise TypeError(f"points: must be real numbers, got dtype {pts.dtype}")
-        pts = pts.astype(np.float64, copy=False)
-        if outside is not None:
-            # Any number, NaN included (a marker for points off the map).
-            if isinstance(outside, bool) or not isinstance(outside, numbers.Real):
-                raise TypeError(f"outside: must be a number or None, got {type(outside).__name__}")
-        if pts.ndim != 2 or pts.shape[1] != 3:
-            raise ValueError(f"points: must have shape (N, 3), got {pts.shape}")
-        if self._occluder_mesh is not None:
-            ov, of = self._occluder_mesh
-            occ: dict[str, Any] = {"occ_vertices": ov, "occ_faces": of}
-        else:
-            occ = {
-                "occluder_depth": self.occluder_depth,
-                "occluder_depth_back": self.occluder_depth_back,
-                "occluder_depth_middle": list(self.occluder_depth_middle),
-            }
-        vis, inside = _core.sample_points(
-            self._light_args(),
-            self.extent,
-            self.resolution,
-            np.ascontiguousarray(pts),
-            self.method,
-            threads=threads,
-            **occ,
-        )
-        if not inside.all():
-            if outside is None and not self.extent_fitted:
-                k = int(np.argmin(inside))
-                raise ValueError(
-                    f"points: point {k} {pts[k].tolist()} lies outside the map's extent "
-                    f"{self.extent}; pass outside= to give such points a value"
-                )
-            vis[~inside] = 1.0 if outside is None else float(outside)
-        return vis
-
-    def receiver_points(self) -> tuple[np.ndarray, np.ndarray]:
-        """World points (M, 3) float64 of the texels that have a receiver, and
-        their flat texel indices (M,) into ``visibility.ravel()``."""
-        return _core.receiver_points(self.receiver_depth, self._light_args(), self.extent)
-
-    def _repr_png_(self) -> bytes | None:
-        """The visibility as a small grey PNG, which Jupyter shows for the map:
-        ``round(255 V)`` per texel, mid grey (128) where there is no receiver
-        (subsampled beyond 512 a side, enlarged below 256; see
-        ``softshadow._preview``)."""
-        from . import _preview
-
-        return _preview.png(self.visibility, np.isfinite(self.receiver_depth))
-
-    def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
-        """Shows the visibility (grey where there is no receiver) with
-        matplotlib (the ``plot`` extra); returns the axes."""
-        from . import _preview
-
-        surface = np.isfinite(self.receiver_depth)
-        return _preview.plot(self.visibility, surface, ax, f"{self.method!r}" if title is None else title, "ShadowMap")
 
 
 def soft_shadow_map(
@@ -439,3 +290,137 @@ def soft_shadow_map_from_depth(
         depth_origin=None if size is not None else (0.0, 0.0, 0.0),
         depth_range=r.depth_range,
     )
+
+
+def render(
+    scene: Scene,
+    light: RectLight | DirectionalLight,
+    camera: Camera,
+    method: str | MethodConfig = "auto",
+    *,
+    map_resolution: Any = None,
+    normal_offset: float | None = None,
+    depth_bias: float | None = None,
+    passes: int | None = None,
+    samples: int | None = None,
+    occluder_resolution: Any = None,
+    hierarchy: bool | None = None,
+    precision: str | None = None,
+    backend: str = "cpu",
+    threads: int | None = None,
+    albedo: Any = None,
+) -> Image:
+    """Renders the visibility and shaded images of ``scene`` under ``light`` seen by ``camera``.
+
+    Every mesh casts and receives shadows, its own included (the far side of
+    a closed mesh is in its own umbra). A :class:`RectLight` lights its
+    ``n`` side only: points at or behind its plane get 0.
+
+    The image also holds the direct lighting of Lambertian surfaces
+    (docs/shading.md): ``unshadowed = albedo / pi * E``, E the irradiance
+    from the light's ``radiance`` (or the sun's ``irradiance``) in closed
+    form at the pixel's point and geometric normal (facing the camera), and
+    ``shaded = unshadowed * visibility``. That product is an approximation:
+    the exact shadowed irradiance weights each visible part of the light by
+    its cosine (and 1/r^2), the visibility counts them alike; the two agree
+    where a pixel is fully lit or in umbra. The shading runs on the CPU
+    after the visibility, on every backend.
+
+    method
+        A config or name, as for :func:`soft_shadow_map`. ``exact`` traces
+        stratified shadow rays from each pixel's surface point, offset off
+        the surface as Mitsuba's ``spawn_ray_to`` does. The map methods
+        (``ssm``, ``bitmask``, ``auto``) rasterize light-view occluder layers
+        of every mesh, focused on what the camera sees, and shade each pixel
+        at its own point. ``Auto(error=e)`` plans for the eye view's error
+        (mean |V - V_ref| over the pixels, :func:`softshadow.metrics.compare_images`):
+        the rule's maps where their measured error is within ``e``, else
+        ``exact`` with the samples its measured error law asks for;
+        ``img.plan`` says why (docs/methods/auto.md).
+    map_resolution
+        The light-view maps' (W, H); by default chosen so that a texel
+        covers about one pixel's footprint (the median over the image). A
+        config's ``occluder_resolution`` overrides it.
+    normal_offset, depth_bias
+        The map methods' self-shadowing biases in texels (defaults in the
+        core, see docs/eye_view.md): the surface point moves
+        ``normal_offset`` texels along its normal, then ``depth_bias``
+        texels toward the light.
+    backend
+        ``"cpu"`` (default), ``"gpu"`` or ``"auto"``: on the GPU the first
+        hits, the shadow rays, the occluder layers and the gather at the
+        pixels' points run on the device, with the same answers (see
+        docs/gpu.md; hard lights on the map methods stay on the CPU).
+    albedo
+        Keyword-only. The meshes' diffuse albedo: a number (grey) or an RGB
+        triple for every mesh, or a sequence with one number or triple per
+        mesh of ``scene.meshes`` (three numbers are always one RGB triple).
+        Values in [0, 1]. Default (``None``): 0.8 grey, the core's default.
+
+    Bad values raise ValueError or TypeError naming the argument.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
+    if not isinstance(light, (RectLight, DirectionalLight)):
+        raise TypeError(f"light: must be a softshadow.RectLight or DirectionalLight, got {type(light).__name__}")
+    if not isinstance(camera, Camera):
+        raise TypeError(f"camera: must be a softshadow.Camera, got {type(camera).__name__}")
+    r = _core.render(
+        scene.meshes,
+        light._core_args(),
+        camera,
+        method,
+        map_resolution=map_resolution,
+        normal_offset=None if normal_offset is None else _number("normal_offset", normal_offset),
+        depth_bias=None if depth_bias is None else _number("depth_bias", depth_bias),
+        passes=passes,
+        samples=samples,
+        occluder_resolution=occluder_resolution,
+        hierarchy=hierarchy,
+        precision=precision,
+        backend=backend,
+        threads=threads,
+        emission=light._emission(),
+        albedo=_color(albedo),
+    )
+    return Image(
+        visibility=r.visibility,
+        shaded=r.shaded,
+        unshadowed=r.unshadowed,
+        depth=r.depth,
+        position=r.position,
+        normal=r.normal,
+        mesh_id=r.mesh_id,
+        shadow_maps=tuple(r.shadow_maps),
+        map_extent=r.map_extent,
+        method=r.method,
+        camera=camera,
+        light=light,
+        timings=dict(r.timings),
+        backend=r.backend,
+        threads=r.threads,
+        depth_origin=r.depth_origin,
+        depth_range=r.depth_range,
+        plan=plan_from_core(r.plan, r.method),
+    )
+
+
+def gpu_available() -> bool:
+    """Whether ``backend="gpu"`` can run here: a GPU adapter opens (a software
+    one such as Mesa's lavapipe counts; see :func:`gpu_info`)."""
+    return bool(_core.gpu_available())
+
+
+def gpu_info() -> dict[str, Any]:
+    """The adapter ``backend="gpu"`` uses: ``name``, ``backend`` (the graphics
+    API, "vulkan"), ``device_type`` ("discrete_gpu", "integrated_gpu",
+    "virtual_gpu", "cpu" or "other"), ``driver`` and ``software`` (True for a
+    CPU renderer like lavapipe, which ``backend="auto"`` does not pick).
+    Raises GpuUnavailableError when there is none."""
+    return dict(_core.gpu_info())
+
+
+def _number(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: must be a number, got {type(value).__name__}")
+    return float(value)
