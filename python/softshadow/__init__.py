@@ -10,7 +10,6 @@ docs/ for the conventions.
 
 from ._core import __version__
 from .api import gpu_available, gpu_info, render, soft_shadow_map, soft_shadow_map_from_depth
-from .camera import Camera
 from .errors import GpuUnavailableError, TooLargeError
 from .lights import DirectionalLight, RectLight
 from .methods import (
@@ -36,7 +35,7 @@ from .methods import (
     limits,
 )
 from .results import Decision, Image, Plan, ShadowMap
-from .scene import Scene
+from .scene import Camera, Scene
 
 __all__ = [
     "SlopeScaleBias",

@@ -33,11 +33,10 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
-from .camera import Camera
 from .lights import DirectionalLight, RectLight, _color
 from .methods import MethodConfig
 from .results import Image, ShadowMap, plan_from_core
-from .scene import Scene
+from .scene import Camera, Scene
 
 
 def soft_shadow_map(

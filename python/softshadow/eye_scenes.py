@@ -18,9 +18,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .camera import Camera
 from .lights import DirectionalLight, RectLight
-from .scene import Mesh, Scene
+from .scene import Camera, Mesh, Scene
 from .scenes import bunny_mesh, quad, sphere, torus
 
 EyeScene = tuple[Scene, RectLight | DirectionalLight, Camera]

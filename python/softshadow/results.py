@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from .camera import Camera
 from .lights import DirectionalLight, RectLight
 from .methods import MethodConfig
+from .scene import Camera
 
 
 @dataclass(frozen=True)

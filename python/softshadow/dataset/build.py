@@ -17,10 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from ..camera import Camera
 from ..eye_scenes import box
 from ..lights import DirectionalLight, RectLight
-from ..scene import Mesh, Scene
+from ..scene import Camera, Mesh, Scene
 from ..scenes import bunny_mesh, quad, sphere, torus
 
 
