@@ -49,7 +49,7 @@ def test_study_plane_on_a_small_map(tmp_path):
 
 
 def test_mitsuba_time_at_equal_error_follows_the_sample_law():
-    from softshadow.experiments.study import Point, mitsuba_seconds_at
+    from softshadow.experiments.points import Point, mitsuba_seconds_at
 
     # error = 0.4 / sqrt(k), time = k ms: the interpolation is exact inside
     # and the extrapolation keeps the law outside.
@@ -62,7 +62,7 @@ def test_mitsuba_time_at_equal_error_follows_the_sample_law():
 
 @pytest.mark.slow
 def test_study_eye_view_and_scherzer_parts_write_tables_plots_and_the_readme_block(tmp_path):
-    from softshadow.study import main
+    from softshadow.experiments.study import main
 
     out = tmp_path / "study"
     readme = tmp_path / "README.md"
@@ -85,6 +85,6 @@ def test_study_eye_view_and_scherzer_parts_write_tables_plots_and_the_readme_blo
     head, at_512 = alias[0], next(row for row in alias if row[0] == "512")
     assert float(at_512[head.index("unfocused")]) > 0
     text = readme.read_text()
-    assert text.startswith("intro\n<!-- study-summary:start -->\nFrom `python -m softshadow.study")
+    assert text.startswith("intro\n<!-- study-summary:start -->\nFrom `python -m softshadow.experiments.study")
     assert "old" not in text and text.endswith("<!-- study-summary:end -->\nrest\n")
     assert "| shadow map, PCF |" in text
