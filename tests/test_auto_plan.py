@@ -193,8 +193,8 @@ def contact_boxes_eye():
     """The eye scene where the maps and exact err most, with its Mitsuba
     reference (1024 samples a pixel) at 160x120."""
     pytest.importorskip("mitsuba")
-    from softshadow.eye_scenes import EYE_SCENES
     from softshadow.reference import render_visibility
+    from softshadow.scenes.eye_view import EYE_SCENES
 
     scene, light, cam = EYE_SCENES["contact_boxes"]((160, 120))
     return scene, light, cam, render_visibility(scene, light, cam, samples=1024)

@@ -1,6 +1,6 @@
 """The eye view (``softshadow.render``) against Mitsuba, and by its properties.
 
-Every scene of ``softshadow.eye_scenes`` is rendered at 160x120 and compared
+Every scene of ``softshadow.scenes.eye_view`` is rendered at 160x120 and compared
 with ``softshadow.reference.render_visibility`` (1024 stratified samples per
 pixel) on the pixels where both see the same mesh at the same place. The
 thresholds are the errors measured at this resolution (see MEASURED) with a
@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 import softshadow as ss
-from softshadow.eye_scenes import EYE_SCENES, box
 from softshadow.metrics import compare_images
-from softshadow.scenes import quad, sphere
+from softshadow.scenes import box, quad, sphere
+from softshadow.scenes.eye_view import EYE_SCENES
 
 RES = (160, 120)
 REFERENCE_SAMPLES = 1024

@@ -48,7 +48,7 @@ def test_demo_renders_the_eye_view_beside_mitsuba(tmp_path, capsys):
     pytest.importorskip("mitsuba")
     pytest.importorskip("matplotlib")
     import softshadow as ss
-    from softshadow import eye_scenes
+    from softshadow.scenes import eye_view
 
     assert main(["--out", str(tmp_path), "--resolution", "96", "72", "--samples", "16"]) == 0
     out = capsys.readouterr().out
@@ -57,7 +57,7 @@ def test_demo_renders_the_eye_view_beside_mitsuba(tmp_path, capsys):
     img = io.read_exr(tmp_path / "bunny_on_floor.exr")
     assert img["V"].shape == (72, 96)
     assert {"V", "depth", "mesh_id", "mask", "position.x", "normal.z"} <= set(img)
-    scene, light, camera = eye_scenes.bunny_on_floor((96, 72))
+    scene, light, camera = eye_view.bunny_on_floor((96, 72))
     np.testing.assert_array_equal(img["V"], ss.render(scene, light, camera).visibility)
     ref = io.read_exr(tmp_path / "bunny_on_floor_reference.exr")
     assert set(ref) == {"V", "mask"} and ref["V"].shape == (72, 96)

@@ -13,7 +13,7 @@ import pytest
 from _png import decode_grey_png
 
 import softshadow as ss
-from softshadow import eye_scenes
+from softshadow.scenes import eye_view
 
 NOTEBOOK = Path(__file__).resolve().parent.parent / "examples" / "quickstart.ipynb"
 
@@ -67,7 +67,7 @@ def test_large_maps_are_subsampled_not_resampled(encoder):
 
 
 def test_image_png_shows_the_visibility_and_grey_where_no_surface(encoder):
-    scene, light, camera = eye_scenes.bunny_on_floor((96, 72))
+    scene, light, camera = eye_view.bunny_on_floor((96, 72))
     img = ss.render(scene, light, camera, method="ssm")
     assert (~img.mask).any() and (img.visibility[img.mask] < 0.5).any()
     grey = decode_grey_png(img._repr_png_())

@@ -43,7 +43,7 @@ def ss_one_pass(env):
 
 def test_eye_view_example_runs():
     text = README.read_text()
-    block = re.search(r"```python\n(import softshadow as ss\nfrom softshadow import eye_scenes.*?)```", text, re.S)
+    block = re.search(r"```python\n(import softshadow as ss\nfrom softshadow import scenes\n.*?)```", text, re.S)
     assert block, "the eye-view example is missing from the README"
     env: dict = {}
     exec(compile(block.group(1), "README.md", "exec"), env)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import softshadow as ss
-from softshadow import eye_scenes, scenes
+from softshadow import scenes
 
 RNG_SEED = 11
 
@@ -233,7 +233,7 @@ def test_exact_shading_is_near_mitsuba_direct(name):
     pytest.importorskip("mitsuba")
     from softshadow.reference import render_direct
 
-    scene, light, cam = getattr(eye_scenes, name)((80, 60))
+    scene, light, cam = getattr(scenes.eye_view, name)((80, 60))
     if isinstance(light, ss.DirectionalLight):
         # Mitsuba's directional emitter is a delta direction: a hard sun.
         light = ss.DirectionalLight(light.direction, light.up, angular_size=0.0, irradiance=(1.0, 0.9, 0.8))

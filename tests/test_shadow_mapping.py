@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import softshadow as ss
-from softshadow.eye_scenes import EYE_SCENES, large_city
 from softshadow.scenes import quad, sphere
+from softshadow.scenes.eye_view import EYE_SCENES, large_city
 
 RES = (160, 120)
 

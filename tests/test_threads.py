@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import softshadow as ss
-from softshadow import eye_scenes, scenes
+from softshadow import scenes
 
 THREADS = 8
 ROUNDS = 3  # each call runs this many times in the pool, shuffled with the others
@@ -51,8 +51,8 @@ def light_view_calls(backend: str) -> list[tuple[str, Callable[[], Any]]]:
 
 def eye_view_calls(backend: str) -> list[tuple[str, Callable[[], Any]]]:
     res = (64, 48) if backend == "gpu" else (128, 96)
-    bunny = eye_scenes.bunny_on_floor(res)
-    torus = eye_scenes.torus_self(res)
+    bunny = scenes.eye_view.bunny_on_floor(res)
+    torus = scenes.eye_view.torus_self(res)
     return [
         ("render ssm bunny", lambda: ss.render(*bunny, method="ssm", backend=backend)),
         ("render bitmask torus", lambda: ss.render(*torus, method="bitmask", backend=backend)),

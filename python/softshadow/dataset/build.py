@@ -17,10 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from ..eye_scenes import box
 from ..lights import DirectionalLight, RectLight
 from ..scene import Camera, Mesh, Scene
-from ..scenes import bunny_mesh, quad, sphere, torus
+from ..scenes.primitives import box, bunny_mesh, quad, sphere, torus
 
 
 @functools.lru_cache(maxsize=64)

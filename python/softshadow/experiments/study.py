@@ -36,10 +36,10 @@ import numpy as np
 
 from .. import PCSS, Auto, Smoothies, metrics, scenes
 from ..api import soft_shadow_map
-from ..eye_scenes import EYE_SCENES
 from ..lights import RectLight
 from ..results import ShadowMap
 from ..scene import Scene
+from ..scenes.eye_view import EYE_SCENES
 from .eye_plane import eye_plane, markdown_eye_plane, markdown_eye_summary
 from .points import Point, median_seconds, mitsuba_seconds_at
 

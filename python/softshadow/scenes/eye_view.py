@@ -1,4 +1,4 @@
-"""Built-in eye-view scenes: every mesh casts and receives, seen through a
+"""The built-in eye-view scenes: every mesh casts and receives, seen through a
 camera (numpy only). Each builder returns ``(scene, light, camera)`` at the
 resolution asked for; the tests check them against Mitsuba and
 ``benchmarks/bench_eye.py`` times them.
@@ -10,6 +10,9 @@ resolution asked for; the tests check them against Mitsuba and
   under a large light close above (wide penumbrae that harden at contact).
 * ``city``: a block of 6 x 6 box buildings of varied heights lit by a small
   sun (0.53 degrees), seen from above at an angle.
+
+Reached as ``softshadow.scenes.eye_view.<builder>``, not re-exported by
+:mod:`softshadow.scenes`, whose ``bunny_on_floor`` is the light view's.
 """
 
 from __future__ import annotations
@@ -18,37 +21,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .lights import DirectionalLight, RectLight
-from .scene import Camera, Mesh, Scene
-from .scenes import bunny_mesh, quad, sphere, torus
+from ..lights import DirectionalLight, RectLight
+from ..scene import Camera, Scene
+from .primitives import box, bunny_mesh, quad, rotated, sphere, torus
 
 EyeScene = tuple[Scene, RectLight | DirectionalLight, Camera]
-
-
-def box(center: tuple[float, float, float], extents: tuple[float, float, float]) -> Mesh:
-    """An axis-aligned closed box (12 triangles, outward-facing)."""
-    c = np.asarray(center, dtype=np.float64)
-    h = 0.5 * np.asarray(extents, dtype=np.float64)
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
-    v = c + corners * h
-    # Corner index = 4 (x > 0) + 2 (y > 0) + (z > 0).
-    faces = [
-        [0, 1, 3], [0, 3, 2],  # -x
-        [4, 6, 7], [4, 7, 5],  # +x
-        [0, 4, 5], [0, 5, 1],  # -y
-        [2, 3, 7], [2, 7, 6],  # +y
-        [0, 2, 6], [0, 6, 4],  # -z
-        [1, 5, 7], [1, 7, 3],  # +z
-    ]  # fmt: skip
-    return v, np.asarray(faces, dtype=np.uint32)
-
-
-def _rotate_x(mesh: Mesh, degrees: float, about: tuple[float, float, float]) -> Mesh:
-    v, f = mesh
-    a = np.radians(degrees)
-    r = np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
-    p = np.asarray(about)
-    return (v - p) @ r.T + p, f
 
 
 def bunny_on_floor(resolution: tuple[int, int] = (640, 480)) -> EyeScene:
@@ -61,7 +38,7 @@ def bunny_on_floor(resolution: tuple[int, int] = (640, 480)) -> EyeScene:
 
 
 def torus_self(resolution: tuple[int, int] = (640, 480)) -> EyeScene:
-    ring = _rotate_x(torus((0.0, 0.9, 0.0), 0.6, 0.22), 55.0, (0.0, 0.9, 0.0))
+    ring = rotated(torus((0.0, 0.9, 0.0), 0.6, 0.22), 55.0, "x", about=(0.0, 0.9, 0.0))
     scene = Scene(meshes=[ring, quad((0.0, 0.0, 0.0), 4.0)])
     light = RectLight(center=(0.3, 4.0, 0.8), normal=(-0.3, -4.0, -0.8), up=(0.0, 0.0, 1.0), size=(0.8, 0.8))
     cam = Camera.look_at(
