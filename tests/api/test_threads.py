@@ -3,7 +3,7 @@
 the rayon pool, the block cache and, on the GPU, the one device) get the same
 results, bit for bit, as the same calls made one after another.
 
-GPU calls need an adapter (lavapipe in CI); see tests/test_gpu.py for the
+GPU calls need an adapter (lavapipe in CI); see tests/gpu/test_gpu.py for the
 SOFTSHADOW_REQUIRE_GPU rule.
 """
 

@@ -178,7 +178,7 @@ def test_threads_cap_the_call_and_change_no_bit(monkeypatch):
 def test_the_docs_option_tables_are_the_cores():
     from softshadow.experiments import method_docs
 
-    docs = Path(__file__).resolve().parent.parent / "docs" / "methods"
+    docs = Path(__file__).resolve().parents[2] / "docs" / "methods"
     assert method_docs.main(["--check", "--docs", str(docs)]) == 0, "run python -m softshadow.experiments.method_docs"
 
 

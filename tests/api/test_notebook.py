@@ -15,7 +15,7 @@ from _png import decode_grey_png
 import softshadow as ss
 from softshadow.scenes import eye_view
 
-NOTEBOOK = Path(__file__).resolve().parent.parent / "examples" / "quickstart.ipynb"
+NOTEBOOK = Path(__file__).resolve().parents[2] / "examples" / "quickstart.ipynb"
 
 
 def expected_grey(visibility: np.ndarray, surface: np.ndarray) -> np.ndarray:

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import softshadow as ss
 
-PACKAGE_ROOT = Path(__file__).resolve().parent.parent / "python" / "softshadow"
+PACKAGE_ROOT = Path(__file__).resolve().parents[2] / "python" / "softshadow"
 #: Compiled modules: not sources, not nodes.
 EXCLUDED = {"softshadow._core"}
 

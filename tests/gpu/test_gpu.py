@@ -286,7 +286,7 @@ def test_bad_backends_name_the_argument():
 
 
 def test_the_gpu_docs_example_runs(gpu):
-    text = (Path(__file__).resolve().parent.parent / "docs" / "gpu.md").read_text()
+    text = (Path(__file__).resolve().parents[2] / "docs" / "gpu.md").read_text()
     block = re.search(r"# GPU backend\n\n```python\n(.*?)```", text, re.S)
     assert block, "the GPU example is missing from docs/gpu.md"
     env: dict = {}
@@ -360,7 +360,7 @@ def test_a_plan_with_measured_layers_and_doubled_maps_runs_the_same_on_the_gpu(g
     """The planner measures the occluders on the CPU whatever the backend;
     the GPU then runs what it planned: one layer, three, and maps at twice
     the output's side, bit for bit the CPU's."""
-    from test_auto_plan import side_by_side, stacked
+    from methods.test_auto_plan import side_by_side, stacked
 
     for make, target, passes in [(side_by_side, 0.01, 1), (stacked, 0.01, 3), (scenes.fence, 0.005, 2)]:
         scene, light = make()

@@ -8,7 +8,7 @@ from softshadow import metrics, scenes
 
 
 def test_plate_matches_the_closed_form():
-    from test_closed_form import exact_visibility
+    from .test_closed_form import exact_visibility
 
     scene, light = scenes.square_plate(side=1.0, height=2.0)
     sm = ss.soft_shadow_map(scene, light, resolution=48, method="exact", samples=1024)

@@ -26,7 +26,7 @@ from softshadow.dataset.build import build_camera, build_light, build_scene
 from softshadow.dataset.item import item_files
 from softshadow.dataset.manifest import read_manifest
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 SMALL = """
 seed = 3
