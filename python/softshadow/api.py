@@ -95,19 +95,23 @@ def soft_shadow_map(
         clipped), and an occluder at or beyond a receiver's depth does not
         shadow that receiver.
     method
-        A typed config, ``Ssm(...)``, ``Bitmask(...)``, ``Exact(...)`` or
-        ``Auto()``, or a method's name (``"ssm"``, ``"bitmask"``, ``"exact"``,
+        A typed config, ``Ssm(...)``, ``Bitmask(...)``, ``Exact(...)``,
+        ``PCSS(...)``, ``Smoothies(...)`` or ``Auto()``, or a method's name
+        (``"ssm"``, ``"bitmask"``, ``"exact"``, ``"pcss"``, ``"smoothies"``,
         ``"auto"``) with its options given beside it (``method="bitmask",
         samples=64`` is ``method=Bitmask(samples=64)``). ``"ssm"``: soft shadow
         maps as published (Atty et al. 2005). ``"bitmask"``: the micro-patches
         mark the light samples they hide in a bit mask per receiver, merged by
         OR (Schwarz & Stamminger 2007). ``"exact"``: ray casting against the
         occluder triangles with stratified, deterministically jittered light
-        samples. ``"auto"``: ``"ssm"`` with two passes and occluder maps at a
-        quarter of ``resolution`` (at least 64), the settings the study found
-        furthest ahead of ray tracing at equal error. The result's ``method``
-        is the config that ran. :func:`softshadow.capabilities` lists every
-        option with its default, limits and the backends that restrict it.
+        samples. ``"pcss"``: percentage-closer soft shadows (Fernando 2005);
+        ``"smoothies"``: Chan & Durand 2003 (docs/methods/). ``"auto"``:
+        ``"ssm"`` with two passes and occluder maps at a quarter of
+        ``resolution`` (at least 64), the settings the study found furthest
+        ahead of ray tracing at equal error. ``ShadowMapping`` reads a camera:
+        it is the eye view's (:func:`render`). The result's ``method`` is the
+        config that ran. :func:`softshadow.capabilities` lists every method
+        and option with its default, limits and the backends that restrict it.
     passes, samples, occluder_resolution, hierarchy, precision
         The options of a method given by name (refused beside a typed config,
         and where they do not apply): ``passes``, the occluder depth layers
