@@ -21,12 +21,12 @@ import sys
 import numpy as np
 from _report import DOCS, Report, add_output_arguments, command_line
 
-from softshadow.eye_scenes import EYE_SCENES
+from softshadow.scenes.eye_view import EYE_SCENES
 
 CHILD = r"""
 import json, resource, sys, time
 import softshadow as ss
-from softshadow.eye_scenes import EYE_SCENES
+from softshadow.scenes.eye_view import EYE_SCENES
 name, w, h, n = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 scene, light, cam = EYE_SCENES[name]((w, h))
 for _ in range(3):

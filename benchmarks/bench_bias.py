@@ -2,7 +2,7 @@
 
     python benchmarks/bench_bias.py [--resolution 320 240] [--method ssm] [--no-write]
 
-On every scene of ``softshadow.eye_scenes`` (the bunny on its floor, the
+On every scene of ``softshadow.scenes.eye_view`` (the bunny on its floor, the
 self-shadowing torus, boxes and a sphere in contact under a large light, the
 city under the sun), for each pair (normal_offset, depth_bias) of the grid
 below, ``softshadow.render`` with the method is compared with a 1024-sample
@@ -27,9 +27,9 @@ import numpy as np
 from _report import DOCS, Report, add_output_arguments, command_line
 
 import softshadow as ss
-from softshadow.eye_scenes import EYE_SCENES
 from softshadow.metrics import compare_images
 from softshadow.reference import render_visibility
+from softshadow.scenes.eye_view import EYE_SCENES
 
 NORMAL_OFFSETS = (0.0, 0.25, 0.5, 1.0, 2.0)
 DEPTH_BIASES = (0.0, 0.5, 1.0, 2.0)

@@ -32,7 +32,7 @@ from _report import CACHE, DOCS, Report, add_output_arguments, command_line, des
 
 import softshadow as ss
 from softshadow import metrics, reference, scenes
-from softshadow.experiments.study import median_seconds as median_time
+from softshadow.experiments.points import median_seconds as median_time
 from softshadow.reference.cache import cached_reference_map
 
 SCENE = "bunny_floating"

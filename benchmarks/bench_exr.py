@@ -2,7 +2,7 @@
 
     python benchmarks/bench_exr.py [--resolution 640 480] [--repeats 7] [--no-write]
 
-The channels of one eye-view image (``softshadow.eye_scenes`` bunny_on_floor,
+The channels of one eye-view image (``softshadow.scenes.eye_view`` bunny_on_floor,
 ``ss.render``'s default method: visibility, shaded and unshadowed RGB,
 depth, normal, mesh id, mask; 16 float32 channels), written with each
 compression ``softshadow.io.write_exr`` takes (``outputs.compression`` of a
@@ -24,7 +24,7 @@ from _report import DOCS, Report, add_output_arguments, command_line
 
 import softshadow as ss
 from softshadow import io
-from softshadow.eye_scenes import EYE_SCENES
+from softshadow.scenes.eye_view import EYE_SCENES
 
 
 def same_pixels(written: dict[str, np.ndarray], read: dict[str, np.ndarray]) -> bool:

@@ -3,7 +3,7 @@ scenes, and Mitsuba's time at equal error.
 
     python benchmarks/bench_eye.py [--resolution 640 480] [--repeats 7] [--scenes ...] [--no-write]
 
-For each scene of ``softshadow.eye_scenes.EYE_SCENES`` at the resolution,
+For each scene of ``softshadow.scenes.eye_view.EYE_SCENES`` at the resolution,
 the measurement of ``softshadow.experiments.eye_plane`` (shared with the
 study): the reference (``--reference-samples`` stratified light samples a
 pixel), Mitsuba's whole eye-view job at 1 to 256 samples
@@ -23,7 +23,7 @@ import argparse
 from _report import DOCS, ROOT, Report, add_output_arguments, command_line, runs
 
 from softshadow.experiments.eye_plane import best_within, eye_plane, markdown_eye_plane
-from softshadow.eye_scenes import EYE_SCENES
+from softshadow.scenes.eye_view import EYE_SCENES
 
 README = ROOT / "README.md"
 START, END = "<!-- eye-table:start -->", "<!-- eye-table:end -->"

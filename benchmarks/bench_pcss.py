@@ -5,7 +5,7 @@
 Light view: each study scene at 256² (occluder maps at the output's
 resolution), error (the paper's §4.2.1 metric) against a 1024-sample
 Mitsuba reference (cached in ``.cache/references/`` like the tests'). Eye
-view: each scene of ``softshadow.eye_scenes`` at 320×240, mean |V - V_ref|
+view: each scene of ``softshadow.scenes.eye_view`` at 320×240, mean |V - V_ref|
 over the visible pixels against 256-sample ``exact``. Times are medians of
 ``--repeats``, end to end from the meshes, the tap counts taken alternately
 in one run. Writes ``docs/benchmarks/pcss.md``.
@@ -23,8 +23,8 @@ from _report import CACHE, DOCS, Report, add_output_arguments, command_line, run
 
 import softshadow as ss
 from softshadow import metrics, scenes
-from softshadow.eye_scenes import EYE_SCENES
 from softshadow.reference.cache import cached_reference_map
+from softshadow.scenes.eye_view import EYE_SCENES
 
 
 def alternate(fns: dict[int, Any], repeats: int) -> tuple[dict[int, float], dict[int, Any]]:

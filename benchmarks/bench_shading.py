@@ -4,7 +4,7 @@
     python benchmarks/bench_shading.py [--resolution 320 240] [--mitsuba-samples 1024]
         [--exact-samples 1024] [--repeats 3] [--scenes ...] [--no-write]
 
-For each scene of ``softshadow.eye_scenes.EYE_SCENES`` (the lights' default
+For each scene of ``softshadow.scenes.eye_view.EYE_SCENES`` (the lights' default
 emission, 1, and the default albedo, 0.8 grey; the sun of ``city`` made hard,
 angular size 0, since Mitsuba's ``directional`` emitter is a delta
 direction), the reference is ``softshadow.reference.render_direct`` at
@@ -34,8 +34,8 @@ import numpy as np
 from _report import DOCS, Report, add_output_arguments, command_line, runs
 
 import softshadow as ss
-from softshadow.eye_scenes import EYE_SCENES
 from softshadow.reference import render_direct
+from softshadow.scenes.eye_view import EYE_SCENES
 
 
 def relative_error(ours: np.ndarray, reference: np.ndarray, mask: np.ndarray) -> float:

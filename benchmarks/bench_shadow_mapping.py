@@ -4,7 +4,7 @@ smoothies, measured.
     python benchmarks/bench_shadow_mapping.py [--resolution 640 480] [--repeats 3] [--no-write]
 
 * Bias methods against acne and peter-panning: on every scene of
-  ``softshadow.eye_scenes`` (2048² maps), each bias method of
+  ``softshadow.scenes.eye_view`` (2048² maps), each bias method of
   ``ss.ShadowMapping`` against the exact hard shadow (``exact`` with the
   light shrunk to its centre, or the sun to its direction): acne is the
   fraction of visible pixels lit there and shadowed by the map,
@@ -30,7 +30,7 @@ import argparse
 from _report import DOCS, ROOT, Report, add_output_arguments, command_line
 
 from softshadow.experiments import scherzer
-from softshadow.eye_scenes import EYE_SCENES
+from softshadow.scenes.eye_view import EYE_SCENES
 
 PAGE = ROOT / "docs" / "methods" / "shadow_mapping.md"
 START, END = "<!-- aliasing:start -->", "<!-- aliasing:end -->"

@@ -43,7 +43,7 @@ from _report import CACHE, DOCS, Report, add_output_arguments, command_line, run
 
 import softshadow as ss
 from softshadow import metrics, reference, scenes
-from softshadow.experiments.study import Point, mitsuba_seconds_at
+from softshadow.experiments.points import Point, mitsuba_seconds_at
 from softshadow.reference.cache import cached_reference_map
 
 STUDY = ("bunny_floating", "bunny_on_floor", "two_spheres", "torus")

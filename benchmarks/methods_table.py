@@ -35,7 +35,7 @@ import numpy as np
 
 import softshadow as ss
 from softshadow import metrics, reference, scenes
-from softshadow.experiments.study import Point, mitsuba_seconds_at
+from softshadow.experiments.points import Point, mitsuba_seconds_at
 from softshadow.reference.cache import cached_reference_map
 
 ROOT = Path(__file__).resolve().parent.parent

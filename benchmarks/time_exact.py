@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 import softshadow as ss
-from softshadow import eye_scenes, scenes
+from softshadow import scenes
 
 
 def digest(a: np.ndarray) -> str:
@@ -31,7 +31,7 @@ def main() -> None:
             ts.append(time.perf_counter() - t)
         assert v is not None
         print(f"{name:18s} {min(ts) * 1e3:7.0f} ms {digest(v)}")
-    for name, make_eye in eye_scenes.EYE_SCENES.items():
+    for name, make_eye in scenes.eye_view.EYE_SCENES.items():
         scene, light, cam = make_eye((320, 240))
         t = time.perf_counter()
         img = ss.render(scene, light, cam, method=ss.Exact(samples=64))

@@ -1,18 +1,28 @@
 """softshadow: soft shadows cast by rectangular area lights and the sun.
 
-Soft shadow maps (Atty et al. 2005), their bitmask variant and exact ray
-casting, computed by a Rust core on all CPU cores or on a GPU through wgpu
-(``backend="gpu"``). Pick a method with a typed config (``Ssm``,
-``Bitmask``, ``Exact``, ``Auto``, ``ShadowMapping``) or its name; :func:`capabilities` lists
-every method's options, defaults, limits and backends. See the README and
-docs/ for the conventions.
+Soft shadow maps (Atty et al. 2005), their bitmask variant, ray casting,
+PCSS, Smoothies and Scherzer's shadow mapping, computed by a Rust core on
+all CPU cores or on a GPU through wgpu (``backend="gpu"``). Pick a method
+with a typed config (``Ssm``, ``Bitmask``, ``Exact``, ``PCSS``,
+``Smoothies``, ``ShadowMapping``, ``Auto``) or its name;
+:func:`capabilities` lists every method's options, defaults, limits and
+backends. See the README and docs/ for the conventions.
+
+What is exported here lives in modules that say what they hold:
+:mod:`.api` (the calls: ``soft_shadow_map``, ``soft_shadow_map_from_depth``,
+``render``, ``gpu_available``, ``gpu_info``), :mod:`.results` (``ShadowMap``,
+``Image``, ``Plan``, ``Decision``), :mod:`.lights` (``RectLight``,
+``DirectionalLight``), :mod:`.scene` (``Scene``, ``Camera``), :mod:`.methods`
+(the configs, ``capabilities``, ``limits``) and :mod:`.errors`. Built-in
+scenes are in :mod:`softshadow.scenes`, files in :mod:`softshadow.io`, error
+metrics in :mod:`softshadow.metrics`, Mitsuba references in
+:mod:`softshadow.reference`.
 """
 
 from ._core import __version__
-from .backend import gpu_available, gpu_info
-from .camera import Camera
+from .api import gpu_available, gpu_info, render, soft_shadow_map, soft_shadow_map_from_depth
 from .errors import GpuUnavailableError, TooLargeError
-from .light import DirectionalLight, RectLight
+from .lights import DirectionalLight, RectLight
 from .methods import (
     PCF,
     PCSS,
@@ -35,38 +45,36 @@ from .methods import (
     capabilities,
     limits,
 )
-from .plan import Decision, Plan
-from .render import Image, render
-from .scene import Scene
-from .shadow_map import ShadowMap, soft_shadow_map, soft_shadow_map_from_depth
+from .results import Decision, Image, Plan, ShadowMap
+from .scene import Camera, Scene
 
 __all__ = [
-    "SlopeScaleBias",
-    "Smoothies",
-    "ShadowMapping",
-    "MidpointBias",
-    "LinearDepthBias",
-    "LiSPSM",
-    "EyeSpaceBlur",
-    "ConstantBias",
-    "BackFaces",
-    "PCF",
     "Auto",
+    "BackFaces",
     "Bitmask",
     "Camera",
+    "ConstantBias",
     "Decision",
     "DirectionalLight",
     "Exact",
+    "EyeSpaceBlur",
     "GpuUnavailableError",
     "Image",
+    "LiSPSM",
+    "LinearDepthBias",
     "MethodConfig",
     "MethodInfo",
+    "MidpointBias",
     "OptionInfo",
+    "PCF",
     "PCSS",
     "Plan",
     "RectLight",
     "Scene",
     "ShadowMap",
+    "ShadowMapping",
+    "SlopeScaleBias",
+    "Smoothies",
     "Ssm",
     "TooLargeError",
     "capabilities",

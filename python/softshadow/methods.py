@@ -1,8 +1,11 @@
 """The methods a user picks, as typed configs, and the core's table of them.
 
-``Ssm``, ``Bitmask``, ``Exact`` and ``Auto`` are the core's classes
-(frozen, keyword-only, compared by value, picklable); their options,
-defaults and limits are the core's and :func:`capabilities` publishes them.
+``Ssm``, ``Bitmask``, ``Exact``, ``PCSS``, ``Smoothies``, ``ShadowMapping``
+(with its bias, filter and warp options: ``ConstantBias``, ``SlopeScaleBias``,
+``LinearDepthBias``, ``BackFaces``, ``MidpointBias``, ``PCF``, ``LiSPSM``,
+``EyeSpaceBlur``) and ``Auto`` are the core's classes (frozen,
+keyword-only, compared by value, picklable); their options, defaults and
+limits are the core's and :func:`capabilities` publishes them.
 An option left ``None`` is resolved when the config runs (the result's
 ``method`` is the resolved config).
 """
@@ -37,10 +40,12 @@ MethodConfig = Ssm | Bitmask | Exact | Auto | PCSS | ShadowMapping | Smoothies
 
 
 def capabilities() -> dict[str, MethodInfo]:
-    """Per method (``"ssm"``, ``"bitmask"``, ``"exact"``, ``"auto"``): its
-    config class, options (kind, default, limits or allowed values, values a
-    backend restricts), the backends of this build that run it, and what it
-    reads of the occluders (``"occluder_layers"``, ``"occluder_triangles"``)."""
+    """Per method (``"ssm"``, ``"bitmask"``, ``"exact"``, ``"pcss"``,
+    ``"smoothies"``, ``"shadow_mapping"``, ``"auto"``): its config class,
+    options (kind, default, limits or allowed values, values a backend
+    restricts), the backends of this build that run it, and what it reads
+    (``"occluder_layers"``, ``"occluder_triangles"``, or for the eye view's
+    ``"shadow_mapping"`` ``"scene_triangles"`` and ``"camera"``)."""
     return dict(_core.capabilities())
 
 

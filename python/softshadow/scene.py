@@ -1,5 +1,11 @@
-"""Scenes: meshes that all cast and receive shadows, or the paper's split
-(occluders cast shadows, receivers catch them)."""
+"""What is seen, and from where: the :class:`Scene` (meshes that all cast
+and receive shadows, or the paper's split: occluders cast shadows, receivers
+catch them) and the eye view's pinhole :class:`Camera`.
+
+``Camera`` is the core's class (frozen, compared by value, picklable): its
+conventions and every value check live in ``src/geom/camera.rs``
+(docs/conventions.md#camera).
+"""
 
 from __future__ import annotations
 
@@ -9,8 +15,11 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from ._core import Camera
 
 Mesh = tuple[np.ndarray, np.ndarray]
+
+__all__ = ["Camera", "Mesh", "Scene", "as_mesh"]
 
 
 def as_mesh(obj: Any, name: str) -> Mesh:

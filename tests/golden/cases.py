@@ -205,7 +205,7 @@ def _light_view_sun() -> ss.DirectionalLight:
 
 
 def _eye_view_cases(backends: list[str]) -> Iterator[tuple[str, Callable[[], dict[str, np.ndarray | None]]]]:
-    from softshadow.eye_scenes import EYE_SCENES
+    from softshadow.scenes.eye_view import EYE_SCENES
 
     for name in EYE_SCENE_NAMES:
         scene, light, cam = EYE_SCENES[name](EYE_RES)
@@ -270,7 +270,7 @@ def _planned(sm: ss.ShadowMap) -> dict[str, np.ndarray | None]:
 
 
 def _more_light_view_cases(backends: list[str]) -> Iterator[tuple[str, Callable[[], dict[str, np.ndarray | None]]]]:
-    from softshadow.eye_scenes import EYE_SCENES
+    from softshadow.scenes.eye_view import EYE_SCENES
 
     for name in ("bunny_on_floor", "contact_boxes"):
         scene, _, _ = EYE_SCENES[name](EYE_RES)

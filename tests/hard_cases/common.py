@@ -25,7 +25,7 @@ _CAPS = ss.capabilities()
 # is a rule that resolves to one of them; a method that reads a camera has
 # the eye view only). Its GPU twin is what lets a method join these lists; a
 # CPU-only method has its hard cases in
-# tests/test_shadow_mapping.py until its GPU twin joins these lists.
+# tests/methods/test_shadow_mapping.py until its GPU twin joins these lists.
 _ALL = set(_CAPS["ssm"].backends)
 METHODS = tuple(
     name for name in _CAPS if name != "auto" and "camera" not in _CAPS[name].reads and set(_CAPS[name].backends) == _ALL

@@ -7,7 +7,7 @@ where it hides nothing. Geometry at or behind the light's plane cannot block
 a segment from the light to a receiver in front of it, so it casts no shadow:
 the rasterizer clips it (at 1e-9 of the scene's depth) and the ray caster's
 segments never reach it. Fitting the extent needs every occluder vertex in
-front of the light (test_inputs.py); with an explicit extent such scenes work.
+front of the light (tests/api/test_bad_input.py); with an explicit extent such scenes work.
 """
 
 import numpy as np

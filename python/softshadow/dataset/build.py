@@ -17,11 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from ..camera import Camera
-from ..eye_scenes import box
-from ..light import DirectionalLight, RectLight
-from ..scene import Mesh, Scene
-from ..scenes import bunny_mesh, quad, sphere, torus
+from ..lights import DirectionalLight, RectLight
+from ..scene import Camera, Mesh, Scene
+from ..scenes.primitives import box, bunny_mesh, quad, sphere, torus
 
 
 @functools.lru_cache(maxsize=64)

@@ -113,7 +113,7 @@ def render_item(
         channels["mask"] = ref.mask.astype(np.float32)
         record["method"] = {"name": REFERENCE, "samples": ref.samples, "jitter_seed": jitter_seed}
     else:
-        from ..render import render
+        from ..api import render
         from .spec import make_config
 
         shading = shading_available()

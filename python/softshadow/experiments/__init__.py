@@ -7,7 +7,7 @@ change between releases.
 
 ``study``
     What accuracy costs in time, in light view and eye view, and the papers'
-    experiments, against Mitsuba references (``python -m softshadow.study``;
+    experiments, against Mitsuba references (``python -m softshadow.experiments.study``;
     needs the ``reference`` and ``study`` extras).
 ``eye_plane``, ``scherzer``
     The study's eye-view measurements (every family against Mitsuba's whole

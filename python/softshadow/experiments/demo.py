@@ -3,7 +3,7 @@ itself, rendered by softshadow beside Mitsuba 3's reference.
 
     python -m softshadow.experiments.demo [--out DIR] [--resolution W H] [--method M] [--samples K]
 
-The scene is :func:`softshadow.eye_scenes.bunny_on_floor` (a 1 x 1 light off
+The scene is :func:`softshadow.scenes.eye_view.bunny_on_floor` (a 1 x 1 light off
 to the bunny's side). softshadow renders it with ``method`` (default
 ``"auto"``, the library's default); Mitsuba traces the same pixel-centre
 rays and K stratified shadow rays per pixel
@@ -34,9 +34,10 @@ from typing import Any
 
 import numpy as np
 
-from .. import eye_scenes
-from ..light import RectLight
-from ..render import Image, render
+from ..api import render
+from ..lights import RectLight
+from ..results import Image
+from ..scenes import eye_view
 
 #: The signed difference's colour scale: |V - V_Mitsuba| beyond this saturates.
 DIFF_RANGE = 0.25
@@ -59,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise ImportError("the demo's figure needs matplotlib: pip install softshadow[plot]") from e
 
-    scene, light, camera = eye_scenes.bunny_on_floor((width, height))
+    scene, light, camera = eye_view.bunny_on_floor((width, height))
     assert isinstance(light, RectLight)  # the scene's light is a rectangle
     print(f"scene: bunny_on_floor, {sum(len(f) for _, f in scene.meshes)} triangles; camera {width}x{height}")
     print(f"light: center {light.center}, normal {light.normal}, size {light.size}")

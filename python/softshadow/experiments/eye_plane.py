@@ -1,7 +1,7 @@
 """The accuracy-time plane in eye view: every method family against
 Mitsuba's whole eye-view job, on one scene, timed in one run.
 
-For a scene of :data:`softshadow.eye_scenes.EYE_SCENES`:
+For a scene of :data:`softshadow.scenes.eye_view.EYE_SCENES`:
 
 * the reference: :func:`softshadow.reference.render_visibility` with many
   stratified light samples a pixel;
@@ -38,8 +38,8 @@ from .. import (
     Smoothies,
     render,
 )
-from ..eye_scenes import EYE_SCENES
 from ..metrics import compare_images
+from ..scenes.eye_view import EYE_SCENES
 from .points import Point, mitsuba_seconds_at
 
 #: 1 and 4 besides 16, 64 and 256: Mitsuba's error at low counts is small on

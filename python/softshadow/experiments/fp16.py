@@ -24,9 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from ..api import soft_shadow_map, soft_shadow_map_from_depth
 from ..io import to_uint8, write_png
-from ..scenes import bunny_floating
-from ..shadow_map import soft_shadow_map, soft_shadow_map_from_depth
+from ..scenes.light_view import bunny_floating
 
 # A micro-patch must hide at least 2^-10 of the light (Appendix A): its
 # back-projection at least 1/32 of the light's width, per axis.

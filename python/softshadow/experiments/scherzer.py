@@ -41,7 +41,7 @@ from .. import (
     Smoothies,
     render,
 )
-from ..eye_scenes import EYE_SCENES, large_city
+from ..scenes.eye_view import EYE_SCENES, large_city
 
 BIASES: list[tuple[str, Any]] = [
     ("none (ConstantBias(constant=0))", ConstantBias(constant=0)),

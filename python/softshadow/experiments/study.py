@@ -35,12 +35,13 @@ from typing import Any
 import numpy as np
 
 from .. import PCSS, Auto, Smoothies, metrics, scenes
-from ..eye_scenes import EYE_SCENES
-from ..light import RectLight
+from ..api import soft_shadow_map
+from ..lights import RectLight
+from ..results import ShadowMap
 from ..scene import Scene
-from ..shadow_map import ShadowMap, soft_shadow_map
+from ..scenes.eye_view import EYE_SCENES
 from .eye_plane import eye_plane, markdown_eye_plane, markdown_eye_summary
-from .points import Point, median_seconds, mitsuba_seconds_at  # importable from here too, as before
+from .points import Point, median_seconds, mitsuba_seconds_at
 
 PLANE_SCENES = ("bunny_floating", "bunny_on_floor", "two_spheres", "torus")
 #: Builds an experiment's scene and light from the value of its parameter.
@@ -319,7 +320,7 @@ README_START, README_END = "<!-- study-summary:start -->", "<!-- study-summary:e
 
 
 def command(argv: list[str] | None) -> str:
-    return " ".join(["python -m softshadow.study", *(argv if argv is not None else sys.argv[1:])])
+    return " ".join(["python -m softshadow.experiments.study", *(argv if argv is not None else sys.argv[1:])])
 
 
 def write_readme_block(path: str, lines: list[str]) -> None:
@@ -453,7 +454,7 @@ def _plot_bias(bias: dict[str, dict[str, tuple[float, float]]], path: str) -> No
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m softshadow.study", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="python -m softshadow.experiments.study", description=__doc__.split("\n")[0])
     p.add_argument("--out", default="study", help="output folder (default: study)")
     p.add_argument("--resolution", type=int, default=256, help="map size for the accuracy-time plane")
     p.add_argument("--repeats", type=int, default=7, help="timing repeats (medians are reported)")

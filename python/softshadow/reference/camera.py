@@ -7,7 +7,7 @@ principal point off the image's centre becomes Mitsuba's
 with the opposite sign: OpenCV's ``cx`` sits ``cx - (W - 1)/2`` pixels right
 of the centre, which is an offset of ``((W - 1)/2 - cx)/W`` in Mitsuba's
 terms (its offset moves the image, not the principal point; measured
-against ``sensor.sample_ray`` in tests/test_camera.py). The film samples pixel centres (a box
+against ``sensor.sample_ray`` in tests/eye_view/test_camera.py). The film samples pixel centres (a box
 filter, a stratified sampler without jitter, float32 output), so
 ``sensor.sample_ray`` at ``((i + 1/2)/W, (j + 1/2)/H)`` is the ray through
 pixel ``[j, i]``.

@@ -19,7 +19,7 @@ Pixel ``[j, i]`` (row j from the top) is the ray Mitsuba's perspective sensor
 for the camera (:func:`camera_sensor`) samples at film position
 ``((i + 1/2)/W, (j + 1/2)/H)``, which is the camera's
 ``ray_directions()[j, i]`` from ``camera.eye`` (checked in
-tests/test_camera.py). The sensor starts its rays on the near plane
+tests/eye_view/test_camera.py). The sensor starts its rays on the near plane
 (``near_clip``, 0.01), so surfaces nearer than that are not seen, and
 positions are taken from the intersection's ``p``, never from ``eye + t d``.
 ``depth`` is the distance of ``p`` along the optical axis,

@@ -1,0 +1,2 @@
+"""The dataset command (softshadow.dataset): determinism, resume, Dask, and
+faults."""

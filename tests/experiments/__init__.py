@@ -1,0 +1,1 @@
+"""The research commands (softshadow.experiments): the study and the demo."""

@@ -1,0 +1,2 @@
+"""The package as a whole: its import layering and top-level exports, the
+README's examples."""

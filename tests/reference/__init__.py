@@ -1,0 +1,2 @@
+"""The Mitsuba references (softshadow.reference) and the metrics
+(softshadow.metrics)."""
