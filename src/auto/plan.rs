@@ -529,7 +529,7 @@ impl Plan {
 /// The eye view's error (mean |V - V_ref| over the pixels both renderers
 /// see, `softshadow.metrics.compare_images`) of the rule's maps, worst
 /// measured on the eye-view scenes: 0.0237 at 160x120 (contact_boxes,
-/// tests/test_eye.py), 0.023 at 640x480 (docs/benchmarks/eye.md). The map
+/// tests/eye_view/test_eye.py), 0.023 at 640x480 (docs/benchmarks/eye.md). The map
 /// methods at full resolution do no better there (their biases and the
 /// tangent-plane bound dominate): below it only `exact` helps.
 pub const EYE_RULE_ERROR: f64 = 0.024;

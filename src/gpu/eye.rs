@@ -49,7 +49,7 @@ use super::gather::{
 };
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
-use super::refusals::{check_side, point_light_on_gpu};
+use super::refusals::{check_method, check_side, point_light_on_gpu};
 use super::shading::gather_params;
 use super::timing::{merged, StageTimer};
 use crate::backend::Backend;
@@ -182,15 +182,10 @@ impl EyeStages for GpuEye {
     // does not resolve there, a hard light for the map methods.
     fn check(&self, call: &EyeCall) -> Result<()> {
         let kernel = resolve_at_camera(call, Backend::Gpu)?.kernel();
-        if !kernel.traces() {
-            if call.light.is_hard() {
-                return Err(point_light_on_gpu("size"));
-            }
-            if !matches!(kernel, Method::Pcss { .. }) {
-                gather::check_method(kernel)?;
-            }
+        if !kernel.traces() && call.light.is_hard() {
+            return Err(point_light_on_gpu("size"));
         }
-        Ok(())
+        check_method(kernel)
     }
 
     fn first_hits(&mut self, camera: &Camera, scene: &SceneTriangles) -> Result<GBuffer> {

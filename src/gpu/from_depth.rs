@@ -8,7 +8,7 @@ use super::dispatch::upload;
 use super::gather;
 use super::pcss::PcssShading;
 use super::readback::{submit_and_read, visibility, with_error_scopes};
-use super::refusals::{check_side, point_light_on_gpu};
+use super::refusals::{check_method, check_side, point_light_on_gpu};
 use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::Result;
@@ -20,9 +20,7 @@ use crate::timing::{Stopwatch, Timings};
 /// What the GPU refuses of depth maps before any work: a method it has no
 /// kernel for, a map side beyond its fixed-point coordinates.
 pub(crate) fn check(method: Method, grid: &MapGrid, occluder_grid: &MapGrid) -> Result<()> {
-    if !matches!(method, Method::Pcss { .. }) {
-        gather::check_method(method)?;
-    }
+    check_method(method)?;
     check_side("receiver_depth", (grid.width, grid.height))?;
     check_side(
         "occluder_depth",

@@ -18,7 +18,7 @@ use super::gather;
 use super::pcss::PcssShading;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
-use super::refusals::check_side;
+use super::refusals::{check_method, check_side};
 use super::shading::{check_size, Shading};
 use super::smoothies::{self, Receivers, SmoothieShading};
 use super::timing::StageTimer;
@@ -43,12 +43,7 @@ enum Stage {
 /// What the GPU refuses of a mesh call before any work: a method it has
 /// no kernel for, a map side beyond its fixed-point coordinates.
 pub(crate) fn check(s: &MapSettings) -> Result<()> {
-    // Map methods shade occluder maps; `exact` traces the triangles.
-    let traced = s.method.traces();
-    let pcss = matches!(s.method, Method::Pcss { .. });
-    if !traced && !pcss {
-        gather::check_method(s.method)?;
-    }
+    check_method(s.method)?;
     check_side("resolution", (s.width, s.height))?;
     if let Some(o) = s.occluder_resolution {
         check_side("occluder_resolution", o)?;

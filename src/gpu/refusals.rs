@@ -1,8 +1,9 @@
 //! What the GPU backend refuses before any device work, shared by its
-//! stages: maps larger than its fixed-point coordinates allow, and point
-//! lights, which have no GPU kernel.
+//! stages: a method it has no kernel for, maps larger than its fixed-point
+//! coordinates allow, and point lights, which have no GPU kernel.
 
 use crate::error::{Error, Result};
+use crate::methods::Method;
 
 /// The largest map side on the GPU (`crate::backend::GPU_MAX_SIDE`).
 pub(crate) const MAX_SIDE: usize = crate::backend::GPU_MAX_SIDE;
@@ -27,4 +28,15 @@ pub(crate) fn point_light_on_gpu(arg: &str) -> Error {
         arg,
         "a point light (size 0) runs on the CPU backend only; use backend=\"cpu\"",
     )
+}
+
+/// Refuses a method the GPU has no kernel for. `exact` (exact.rs), PCSS
+/// (pcss.rs) and Smoothies (smoothies.rs) have kernels of their own; the
+/// gather methods are refused by the variant they would run
+/// (`gather::check_method`).
+pub(crate) fn check_method(method: Method) -> Result<()> {
+    if method.traces() || matches!(method, Method::Pcss { .. }) {
+        return Ok(());
+    }
+    super::gather::check_method(method)
 }
