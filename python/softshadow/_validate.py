@@ -51,3 +51,14 @@ def depth_map(name: str, value: Any) -> np.ndarray:
     if value.size == 0:
         raise ValueError(f"{name}: must not be empty, got shape {value.shape}")
     return np.ascontiguousarray(value, dtype=np.float32)
+
+
+def color(value: Any) -> Any:
+    """NumPy arrays and scalars, at any depth of lists and tuples, as plain
+    Python numbers and lists (what the core's conversion reads); anything
+    else unchanged (the core names its type)."""
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [color(v) for v in value]
+    return value

@@ -33,7 +33,7 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
-from .lights import DirectionalLight, RectLight, _color
+from .lights import DirectionalLight, RectLight
 from .methods import MethodConfig
 from .results import Image, ShadowMap, plan_from_core
 from .scene import Camera, Scene
@@ -384,7 +384,7 @@ def render(
         backend=backend,
         threads=threads,
         emission=light._emission(),
-        albedo=_color(albedo),
+        albedo=check.color(albedo),
     )
     return Image(
         visibility=r.visibility,

@@ -8,7 +8,8 @@
 //!   description of its options; `configs.rs` (`Ssm`, `Bitmask`, `Exact`,
 //!   `Auto`, the string form) and `shadow_configs.rs` (ShadowMapping and
 //!   its parts, PCSS, Smoothies) describe them.
-//! * `camera.rs`: the eye view's `Camera`.
+//! * `camera.rs`: the eye view's `Camera`; `lights.rs`: `RectLight`,
+//!   `DirectionalLight`.
 //! * `entry.rs`: the entry points.
 //! * `eye.rs`: the eye view's `render` and its result.
 //! * `results.rs`: the typed results.
@@ -25,6 +26,7 @@ mod entry;
 mod errors;
 mod eye;
 mod gpu;
+mod lights;
 mod results;
 mod shadow_configs;
 
@@ -41,6 +43,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     configs::register(m)?;
     shadow_configs::register(m)?;
     m.add_class::<camera::PyCamera>()?;
+    m.add_class::<lights::PyRectLight>()?;
+    m.add_class::<lights::PyDirectionalLight>()?;
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;
     m.add_class::<eye::EyeResult>()?;

@@ -1,0 +1,475 @@
+//! The lights as Python classes (`softshadow.RectLight`,
+//! `softshadow.DirectionalLight`), like `Camera`: frozen, compared and
+//! hashed by value, picklable, their frames and value checks the core's
+//! (`geom::light::RectLight`, `geom::sun::DirectionalLight`) and their
+//! emission checked by the core's shading (`eye::shading::emission`).
+//!
+//! A light's emission is RGB (a number is grey): a rectangle's `radiance`
+//! (uniform, Lambertian, on its `n` side only) and the sun's `irradiance`
+//! (on a surface facing it). Only the eye view's shaded images read it;
+//! visibility never does.
+
+use super::convert::Light;
+use super::errors;
+use super::eye::{irradiance, light_emission};
+use crate::geom::light::RectLight;
+use crate::geom::sun::DirectionalLight;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyReadonlyArray2};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+/// A float vector of length `N` as NumPy reads it (`np.asarray(value,
+/// float64)`): TypeError for what is not numbers, ValueError for another
+/// length, each naming `arg`; the core checks the values.
+fn vector<const N: usize>(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
+    let py = value.py();
+    let np = py.import("numpy")?;
+    let a = np
+        .call_method1("asarray", (value, "float64"))
+        .map_err(|_| {
+            let got = value.repr().map(|r| r.to_string()).unwrap_or_default();
+            PyTypeError::new_err(format!(
+                "{arg}: must be a sequence of {N} numbers, got {got}"
+            ))
+        })?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    if shape != [N] {
+        let shape = PyTuple::new(py, &shape)?.repr()?.to_string();
+        return Err(PyValueError::new_err(format!(
+            "{arg}: must have {N} components, got shape {shape}"
+        )));
+    }
+    let v: Vec<f64> = a.call_method0("tolist")?.extract()?;
+    Ok(std::array::from_fn(|k| v[k]))
+}
+
+/// A number (both components) or a pair of numbers.
+fn pair(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; 2]> {
+    let py = value.py();
+    let real = py.import("numbers")?.getattr("Real")?;
+    if value.is_instance(&real)? && !value.is_instance_of::<pyo3::types::PyBool>() {
+        let x: f64 = value.extract()?;
+        return Ok([x, x]);
+    }
+    vector::<2>(arg, value)
+}
+
+/// An emission as the core reads it: NumPy values as plain numbers and
+/// lists, anything else as given (the core names its type).
+fn color<'py>(value: Option<&Bound<'py, PyAny>>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    fn plain<'py>(v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let py = v.py();
+        let np = py.import("numpy")?;
+        if v.is_instance(&np.getattr("ndarray")?)? || v.is_instance(&np.getattr("generic")?)? {
+            return v.call_method0("tolist");
+        }
+        if v.is_instance_of::<pyo3::types::PyList>() || v.is_instance_of::<PyTuple>() {
+            let items: Vec<Bound<'py, PyAny>> =
+                v.try_iter()?.map(|i| plain(&i?)).collect::<PyResult<_>>()?;
+            return Ok(pyo3::types::PyList::new(py, items)?.into_any());
+        }
+        Ok(v.clone())
+    }
+    value.filter(|v| !v.is_none()).map(plain).transpose()
+}
+
+/// Points or normals (N, 3) of reals as C-contiguous float64.
+fn rows3<'py>(arg: &str, value: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    let np = value.py().import("numpy")?;
+    let a = np.call_method1("asarray", (value,))?;
+    let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !"fiu".contains(kind.as_str()) || kind.len() != 1 {
+        let dtype = a.getattr("dtype")?.str()?.to_string();
+        return Err(PyTypeError::new_err(format!(
+            "{arg}: must be real numbers, got dtype {dtype}"
+        )));
+    }
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    if shape.len() != 2 || shape[1] != 3 {
+        let shape = PyTuple::new(value.py(), &shape)?.repr()?.to_string();
+        return Err(PyValueError::new_err(format!(
+            "{arg}: must have shape (N, 3), got {shape}"
+        )));
+    }
+    np.call_method1("ascontiguousarray", (a, "float64"))?
+        .extract()
+}
+
+fn array3<'py>(py: Python<'py>, v: glam::DVec3) -> Bound<'py, PyAny> {
+    numpy::PyArray1::from_slice(py, &v.to_array()).into_any()
+}
+
+fn tuple<const N: usize>(v: [f64; N]) -> Vec<f64> {
+    v.to_vec()
+}
+
+/// A tuple of floats as Python writes it.
+fn repr(py: Python<'_>, v: &[f64]) -> PyResult<String> {
+    Ok(PyTuple::new(py, v)?.repr()?.to_string())
+}
+
+/// Bits that compare and hash as the values do (0.0 and -0.0 alike).
+fn key<const N: usize>(v: &[f64; N]) -> [u64; N] {
+    v.map(|x| if x == 0.0 { 0 } else { x.to_bits() })
+}
+
+/// A rectangular area light that emits uniformly over its whole rectangle.
+///
+/// Frame: ``n = normalize(normal)`` points from the light into the scene,
+/// ``v = normalize(up - (up . n) n)`` and ``u = n x v``. ``size`` is the full
+/// width along ``u`` and the full height along ``v`` (a number: both).
+///
+/// ``radiance`` (keyword-only) is the radiance it emits, uniform and
+/// Lambertian, on its ``n`` side only: a number (grey) or an RGB triple, each
+/// finite and >= 0; ``None`` takes the core's default, 1.0. Stored as an RGB
+/// triple. Only the eye view's shaded images read it (docs/shading.md).
+///
+/// Raises ValueError for a non-finite center, a zero-length ``normal`` or
+/// ``up``, an ``up`` within 1e-6 rad of parallel to ``normal``, a size that
+/// is neither finite and > 0 nor (0, 0), or a negative or non-finite
+/// ``radiance``. Size (0, 0) is a point light: every method then gives the
+/// hard shadow map, the limit they converge to as the size shrinks (it has
+/// no area, so it lights no shaded image).
+#[pyclass(frozen, module = "softshadow._core", name = "RectLight")]
+#[derive(Clone)]
+pub struct PyRectLight {
+    center: [f64; 3],
+    normal: [f64; 3],
+    up: [f64; 3],
+    size: [f64; 2],
+    radiance: [f64; 3],
+    pub light: RectLight,
+}
+
+#[pymethods]
+impl PyRectLight {
+    #[new]
+    #[pyo3(signature = (center, normal, up, size=None, *, radiance=None))]
+    fn new(
+        center: &Bound<'_, PyAny>,
+        normal: &Bound<'_, PyAny>,
+        up: &Bound<'_, PyAny>,
+        size: Option<&Bound<'_, PyAny>>,
+        radiance: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let c = vector::<3>("center", center)?;
+        let n = vector::<3>("normal", normal)?;
+        let u = vector::<3>("up", up)?;
+        let s = match size {
+            Some(s) => pair("size", s)?,
+            None => [1.0, 1.0],
+        };
+        let light = errors::guard(|| Ok(RectLight::new(c, n, u, s)?))?;
+        let radiance = light_emission("radiance", color(radiance)?)?;
+        Ok(PyRectLight {
+            center: c,
+            normal: n,
+            up: u,
+            size: s,
+            radiance,
+            light,
+        })
+    }
+
+    /// The light that depth-map input is expressed in: center at the
+    /// origin, ``n = +z``, ``v = +y`` (so ``u = -x``).
+    #[classmethod]
+    fn canonical(_cls: &Bound<'_, pyo3::types::PyType>, size: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let py = size.py();
+        let zero = (0.0, 0.0, 0.0).into_pyobject(py)?.into_any();
+        let z = (0.0, 0.0, 1.0).into_pyobject(py)?.into_any();
+        let y = (0.0, 1.0, 0.0).into_pyobject(py)?.into_any();
+        Self::new(&zero, &z, &y, Some(size), None)
+    }
+
+    #[getter]
+    fn center(&self) -> (f64, f64, f64) {
+        self.center.into()
+    }
+    #[getter]
+    fn normal(&self) -> (f64, f64, f64) {
+        self.normal.into()
+    }
+    #[getter]
+    fn up(&self) -> (f64, f64, f64) {
+        self.up.into()
+    }
+    #[getter]
+    fn size(&self) -> (f64, f64) {
+        self.size.into()
+    }
+    #[getter]
+    fn radiance(&self) -> (f64, f64, f64) {
+        self.radiance.into()
+    }
+    /// Unit vector along the light's width (map columns grow along it).
+    #[getter]
+    fn u<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.u)
+    }
+    /// Unit vector along the light's height (map rows grow against it).
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.v)
+    }
+    /// Unit normal from the rectangle into the scene.
+    #[getter]
+    fn n<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.n)
+    }
+    /// Width times height.
+    #[getter]
+    fn area(&self) -> f64 {
+        self.size[0] * self.size[1]
+    }
+    /// The four corners (4, 3): (-u,-v), (+u,-v), (+u,+v), (-u,+v).
+    fn corners<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let c = glam::DVec3::from_array(self.center);
+        let hu = 0.5 * self.size[0] * self.light.u;
+        let hv = 0.5 * self.size[1] * self.light.v;
+        let k = [c - hu - hv, c + hu - hv, c + hu + hv, c - hu + hv];
+        let a = Array2::from_shape_vec((4, 3), k.iter().flat_map(|p| p.to_array()).collect())
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py).into_any())
+    }
+    /// The unshadowed irradiance (N, 3) float64, RGB, radiance included, at
+    /// world ``points`` (N, 3) on surfaces with ``normals`` (N, 3; any
+    /// length, not zero), in closed form: Lambert's polygon formula after
+    /// clipping the rectangle to each point's upper hemisphere (0 at or
+    /// behind its plane). No shadows: :func:`softshadow.render` multiplies
+    /// by the visibility. See docs/shading.md.
+    fn irradiance_at<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: &Bound<'py, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let p = rows3("points", points)?;
+        let n = rows3("normals", normals)?;
+        let e = self.radiance.into_pyobject(py)?.into_any();
+        irradiance(py, self.core_light(), p, n, Some(e))
+    }
+    fn _core_args(&self) -> ([f64; 3], [f64; 3], [f64; 3], [f64; 2]) {
+        (self.center, self.normal, self.up, self.size)
+    }
+    fn _emission(&self) -> (f64, f64, f64) {
+        self.radiance.into()
+    }
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<PyRectLight>().is_ok_and(|o| {
+            let o = o.get();
+            key(&self.center) == key(&o.center)
+                && key(&self.normal) == key(&o.normal)
+                && key(&self.up) == key(&o.up)
+                && key(&self.size) == key(&o.size)
+                && key(&self.radiance) == key(&o.radiance)
+        })
+    }
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (
+            key(&self.center),
+            key(&self.normal),
+            key(&self.up),
+            key(&self.size),
+            key(&self.radiance),
+        )
+            .hash(&mut h);
+        h.finish()
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        let args = PyTuple::new(
+            py,
+            [
+                PyTuple::new(py, tuple(self.center))?,
+                PyTuple::new(py, tuple(self.normal))?,
+                PyTuple::new(py, tuple(self.up))?,
+                PyTuple::new(py, tuple(self.size))?,
+            ],
+        )?;
+        let kw = PyDict::new(py);
+        kw.set_item("radiance", PyTuple::new(py, tuple(self.radiance))?)?;
+        Ok((args, kw))
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!(
+            "RectLight(center={}, normal={}, up={}, size={}, radiance={})",
+            repr(py, &self.center)?,
+            repr(py, &self.normal)?,
+            repr(py, &self.up)?,
+            repr(py, &self.size)?,
+            repr(py, &self.radiance)?,
+        ))
+    }
+}
+
+impl PyRectLight {
+    fn core_light(&self) -> Light {
+        Light::Rect(self._core_args())
+    }
+}
+
+/// A directional light (the sun): a rectangle of directions at infinity.
+///
+/// Frame: ``n = normalize(direction)`` is the direction the light travels,
+/// ``v = normalize(up - (up . n) n)``, ``u = n x v``. The light is the set of
+/// travel directions ``n + x u + y v`` with ``|x| <= tan(a_u / 2)`` and
+/// ``|y| <= tan(a_v / 2)``, uniform in (x, y); ``angular_size = (a_u, a_v)``
+/// are full angles in degrees (the sun is about 0.53; a number: both).
+/// ``(0, 0)`` is a hard directional light. Its light-view maps are
+/// orthographic (see docs/conventions.md).
+///
+/// ``irradiance`` (keyword-only) is the irradiance on a surface facing the
+/// sun: a number (grey) or an RGB triple, each finite and >= 0; ``None``
+/// takes the core's default, 1.0. Stored as an RGB triple. The shaded
+/// images take the cosine toward the sun's centre and ignore its angular
+/// size there (a relative error below ``a**2 / 4`` for a disc of angular
+/// radius ``a`` above the horizon; docs/shading.md).
+///
+/// Raises ValueError for a non-finite or zero ``direction`` or ``up``, an
+/// ``up`` parallel to ``direction``, an angle that is negative, NaN, or
+/// beyond 179 degrees (and one zero angle beside a non-zero one), or a
+/// negative or non-finite ``irradiance``.
+#[pyclass(frozen, module = "softshadow._core", name = "DirectionalLight")]
+#[derive(Clone)]
+pub struct PyDirectionalLight {
+    direction: [f64; 3],
+    up: [f64; 3],
+    angular_size: [f64; 2],
+    irradiance: [f64; 3],
+    pub light: DirectionalLight,
+}
+
+#[pymethods]
+impl PyDirectionalLight {
+    #[new]
+    #[pyo3(signature = (direction, up, angular_size=None, *, irradiance=None))]
+    fn new(
+        direction: &Bound<'_, PyAny>,
+        up: &Bound<'_, PyAny>,
+        angular_size: Option<&Bound<'_, PyAny>>,
+        irradiance: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let d = vector::<3>("direction", direction)?;
+        let u = vector::<3>("up", up)?;
+        let a = match angular_size {
+            Some(a) => pair("angular_size", a)?,
+            None => [0.53, 0.53],
+        };
+        let light = errors::guard(|| Ok(DirectionalLight::new(d, u, a)?))?;
+        let irradiance = light_emission("irradiance", color(irradiance)?)?;
+        Ok(PyDirectionalLight {
+            direction: d,
+            up: u,
+            angular_size: a,
+            irradiance,
+            light,
+        })
+    }
+
+    #[getter]
+    fn direction(&self) -> (f64, f64, f64) {
+        self.direction.into()
+    }
+    #[getter]
+    fn up(&self) -> (f64, f64, f64) {
+        self.up.into()
+    }
+    #[getter]
+    fn angular_size(&self) -> (f64, f64) {
+        self.angular_size.into()
+    }
+    #[getter]
+    fn irradiance(&self) -> (f64, f64, f64) {
+        self.irradiance.into()
+    }
+    /// Unit vector along the first angle (map columns grow along it).
+    #[getter]
+    fn u<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.u)
+    }
+    /// Unit vector along the second angle (map rows grow against it).
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.v)
+    }
+    /// The direction the light travels (unit).
+    #[getter]
+    fn n<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.n)
+    }
+    /// The unshadowed irradiance (N, 3) float64, RGB, irradiance included,
+    /// at world ``points`` (N, 3) on surfaces with ``normals`` (N, 3; any
+    /// length, not zero): ``irradiance * max(0, n . s)``. No shadows:
+    /// :func:`softshadow.render` multiplies by the visibility. See
+    /// docs/shading.md.
+    fn irradiance_at<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: &Bound<'py, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let p = rows3("points", points)?;
+        let n = rows3("normals", normals)?;
+        let e = self.irradiance.into_pyobject(py)?.into_any();
+        irradiance(py, Light::Sun(self._core_args()), p, n, Some(e))
+    }
+    fn _core_args(&self) -> ([f64; 3], [f64; 3], [f64; 2]) {
+        (self.direction, self.up, self.angular_size)
+    }
+    fn _emission(&self) -> (f64, f64, f64) {
+        self.irradiance.into()
+    }
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<PyDirectionalLight>().is_ok_and(|o| {
+            let o = o.get();
+            key(&self.direction) == key(&o.direction)
+                && key(&self.up) == key(&o.up)
+                && key(&self.angular_size) == key(&o.angular_size)
+                && key(&self.irradiance) == key(&o.irradiance)
+        })
+    }
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (
+            key(&self.direction),
+            key(&self.up),
+            key(&self.angular_size),
+            key(&self.irradiance),
+        )
+            .hash(&mut h);
+        h.finish()
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        let args = PyTuple::new(
+            py,
+            [
+                PyTuple::new(py, tuple(self.direction))?,
+                PyTuple::new(py, tuple(self.up))?,
+                PyTuple::new(py, tuple(self.angular_size))?,
+            ],
+        )?;
+        let kw = PyDict::new(py);
+        kw.set_item("irradiance", PyTuple::new(py, tuple(self.irradiance))?)?;
+        Ok((args, kw))
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!(
+            "DirectionalLight(direction={}, up={}, angular_size={}, irradiance={})",
+            repr(py, &self.direction)?,
+            repr(py, &self.up)?,
+            repr(py, &self.angular_size)?,
+            repr(py, &self.irradiance)?,
+        ))
+    }
+}
