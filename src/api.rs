@@ -16,7 +16,7 @@ use crate::frame::{orthographic_maps, MapSettings, ShadowResult};
 use crate::geom::light::{check_light_size, is_point, MapGrid};
 use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::mesh::MeshRef;
-use crate::methods::config::{check_resolution, CallContext};
+use crate::methods::config::{check_resolution, AutoConfig, CallContext};
 use crate::methods::MethodConfig;
 use crate::pipeline;
 use crate::threads;
@@ -101,7 +101,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
     );
     let ctx = CallContext { backend, ..ctx };
     let target = match call.method {
-        MethodConfig::Auto(_, t) if !t.is_none() => Some(t),
+        MethodConfig::Auto(a) if !a.target.is_none() => Some(a.target),
         _ => None,
     };
     let method = call.method.resolve(&ctx)?;
@@ -351,9 +351,12 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
     // planned config then runs as if the user had given it.
     let t0 = std::time::Instant::now();
     let mut plan = match call.method {
-        MethodConfig::Auto(given, target) if !target.is_none() => Some(crate::auto::plan_eye(
-            &target,
-            MethodConfig::Auto(given, Default::default()),
+        MethodConfig::Auto(a) if !a.target.is_none() => Some(crate::auto::plan_eye(
+            &a.target,
+            MethodConfig::Auto(AutoConfig {
+                target: Default::default(),
+                ..a
+            }),
         )),
         _ => None,
     };

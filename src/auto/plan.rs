@@ -804,7 +804,7 @@ mod tests {
 
     #[test]
     fn the_eye_view_takes_the_rule_for_loose_targets_and_exact_below() {
-        let rule = MethodConfig::Auto(SsmConfig::default(), Target::default());
+        let rule = MethodConfig::Auto(crate::methods::config::AutoConfig::default());
         let pick = |e: f64| plan_eye(&Target::new(Some(e), None).unwrap(), rule).config;
         assert_eq!(pick(0.05), rule);
         assert!(matches!(pick(0.01), MethodConfig::Exact(c) if c.samples == 81));

@@ -9,13 +9,23 @@
 //! once, when the config is built: the bindings and the Python package only
 //! convert types.
 //!
-//! The defaults and limits below are the ones the capabilities table
-//! (`capabilities.rs`) publishes.
+//! Each config describes itself once (`MethodSpec`): its name, its config
+//! from the string form's loose options, its resolution for a call, its
+//! kernel, the maps it reads and its row of the capabilities table; the
+//! registry (`method_configs!`) lists the configs once and makes the
+//! `MethodConfig` enum and its dispatch from that list. A new method is its
+//! config, its `MethodSpec` and one line of the registry here, beside its
+//! kernel (`registry.rs`), its bindings class (`config_class!`) and its GPU
+//! stage. The defaults and limits below are the ones the capabilities table
+//! publishes.
 
+use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::Input;
 use super::{bitmask, ssm::Precision, Method, HIERARCHY_DEFAULT_BITMASK, HIERARCHY_DEFAULT_SSM};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 pub use crate::geom::light::check_resolution;
+use crate::geom::light::MAX_TEXELS;
 pub use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::shadow_mapping::config::{check_real, Real};
 use crate::methods::smoothies::Falloff;
@@ -62,26 +72,6 @@ pub struct BitmaskConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ExactConfig {
     pub samples: u32,
-}
-
-/// What a user picks: a method with its options, or `Auto`: without a
-/// target a rule that resolves to `Ssm` (the `SsmConfig` it holds are
-/// options given beside `method="auto"`, which override the rule's:
-/// `ss.Auto()` holds none); with a target (`ss.Auto(error=...)`) a plan made
-/// from the scene (`plan.rs`, light-view maps from meshes), elsewhere the rule.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum MethodConfig {
-    Auto(SsmConfig, super::target::Target),
-    Ssm(SsmConfig),
-    Bitmask(BitmaskConfig),
-    Exact(ExactConfig),
-    /// Scherzer 2005's practical shadow mapping (hard shadows from the
-    /// light's centre or direction; `shadow_mapping/`).
-    ShadowMapping(ShadowMappingConfig),
-    /// Chan & Durand 2003's smoothies (`smoothies/`).
-    Smoothies(SmoothiesConfig),
-    /// Fernando 2005's percentage-closer soft shadows (`pcss.rs`).
-    Pcss(PcssConfig),
 }
 
 /// PCSS: blocker search, penumbra estimate and PCF on the shadow map.
@@ -237,17 +227,6 @@ impl LooseOptions<'_> {
         v
     }
 }
-
-/// The method names a user can pass as `method=`, in the table's order.
-pub const METHOD_NAMES: [&str; 7] = [
-    "ssm",
-    "bitmask",
-    "exact",
-    "pcss",
-    "smoothies",
-    "shadow_mapping",
-    "auto",
-];
 
 /// Light samples of `exact`: 1 to MAX_SAMPLES.
 pub fn check_exact_samples(n: i64) -> Result<u32> {
@@ -470,115 +449,135 @@ fn resolve_maps(
     }
 }
 
-impl MethodConfig {
-    /// The config named `name` with the loose options given: each must apply
-    /// to that method.
-    pub fn from_name(name: &str, o: &LooseOptions) -> Result<Self> {
-        let refuse = |opt: &str, applies: &str| {
-            Err(Error::invalid(
-                opt,
-                format!("applies to {applies}, not to {name:?}"),
-            ))
-        };
-        let c = match name {
-            "ssm" => {
-                if o.samples.is_some() {
-                    return refuse("samples", "the sampling methods (\"bitmask\", \"exact\")");
-                }
-                MethodConfig::Ssm(SsmConfig::new(
-                    o.passes,
-                    o.occluder_resolution,
-                    o.hierarchy,
-                    o.precision,
-                )?)
-            }
-            "bitmask" => {
-                if o.precision.is_some() {
-                    return refuse(
-                        "precision",
-                        "\"ssm\" (sums of occlusions); the other methods count samples exactly",
-                    );
-                }
-                MethodConfig::Bitmask(BitmaskConfig::new(
-                    o.samples,
-                    o.passes,
-                    o.occluder_resolution,
-                    o.hierarchy,
-                    None,
-                )?)
-            }
-            "exact" => {
-                // `passes` beside "exact" is accepted and has no effect (the
-                // string form always allowed it: it reads no layers).
-                if let Some(p) = o.passes {
-                    check_passes(p)?;
-                }
-                for (given, opt) in [
-                    (o.occluder_resolution.is_some(), "occluder_resolution"),
-                    (o.hierarchy.is_some(), "hierarchy"),
-                ] {
-                    if given {
-                        return refuse(
-                            opt,
-                            "the occluder-map methods (\"ssm\", \"bitmask\"); \"exact\" traces the occluder triangles",
-                        );
-                    }
-                }
-                if o.precision.is_some() {
-                    return refuse(
-                        "precision",
-                        "\"ssm\" (sums of occlusions); the other methods count samples exactly",
-                    );
-                }
-                MethodConfig::Exact(ExactConfig::new(o.samples)?)
-            }
-            "auto" => {
-                // The rule's choice is "ssm": its options given beside
-                // "auto" replace the rule's.
-                if o.samples.is_some() {
-                    return refuse("samples", "the sampling methods (\"bitmask\", \"exact\")");
-                }
-                MethodConfig::Auto(
-                    SsmConfig::new(o.passes, o.occluder_resolution, o.hierarchy, o.precision)?,
-                    Default::default(),
-                )
-            }
-            "pcss" => {
-                if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
-                    return refuse(opt, "other methods; give PCSS(...) its own options");
-                }
-                MethodConfig::Pcss(PcssConfig::new(None, o.occluder_resolution)?)
-            }
-            "smoothies" => {
-                if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
-                    return refuse(opt, "other methods; give Smoothies(...) its own options");
-                }
-                MethodConfig::Smoothies(SmoothiesConfig::new(
-                    None,
-                    None,
-                    None,
-                    o.occluder_resolution,
-                )?)
-            }
-            "shadow_mapping" => {
-                if let Some(opt) = o.given().first() {
-                    return refuse(
-                        opt,
-                        "the soft shadow map methods; give ShadowMapping(...) its own options",
-                    );
-                }
-                MethodConfig::ShadowMapping(ShadowMappingConfig::default())
-            }
-            other => {
-                return Err(Error::invalid(
+/// What `ss.Auto` holds: the options given beside `method="auto"` (they
+/// override the rule's: `ss.Auto()` holds none) and the target. Without a
+/// target a rule that resolves to `Ssm`; with one (`ss.Auto(error=...)`) a
+/// plan made from the scene (`crate::auto`), elsewhere the rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct AutoConfig {
+    pub given: SsmConfig,
+    pub target: super::target::Target,
+}
+
+/// One method's config as the registry (`method_configs!` below) reads it:
+/// its name, its config from the string form, its resolution for a call,
+/// its kernel and the occluder maps it reads.
+pub trait MethodSpec: Copy {
+    /// The name a user passes as `method=`.
+    const NAME: &'static str;
+    /// The config of the string form (`method="bitmask", samples=64`): each
+    /// loose option given must apply to the method; `refuse(option,
+    /// applies_to)` says one does not.
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self>;
+    /// The config that runs for `ctx`: every call-dependent default filled
+    /// in, backend restrictions checked ("auto" replaced by its rule).
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig>;
+    /// The kernel of a config; resolve it first for the backend's defaults.
+    fn kernel(&self) -> Method;
+    /// Occluder layers of a resolved config (0 for methods that read none).
+    fn passes(&self) -> u32 {
+        0
+    }
+    /// Occluder maps' (W, H) of a resolved config (None for methods that
+    /// read no maps).
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        None
+    }
+    /// The method's row of `capabilities()`: its options, defaults,
+    /// limits, backends and what it reads.
+    fn info() -> MethodInfo;
+}
+
+/// The registry of method configs: one line a method makes its
+/// `MethodConfig` variant, its name in `METHOD_NAMES` and the dispatch of
+/// every `MethodConfig` method to its `MethodSpec`.
+macro_rules! method_configs {
+    ($($(#[doc = $doc:literal])* $variant:ident($config:ty),)*) => {
+        /// What a user picks: a method with its options, or `Auto` (see
+        /// `AutoConfig`).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum MethodConfig {
+            $($(#[doc = $doc])* $variant($config),)*
+        }
+
+        /// The method names a user can pass as `method=`, in the table's order.
+        pub const METHOD_NAMES: &[&str] = &[$(<$config as MethodSpec>::NAME),*];
+
+        impl MethodConfig {
+            /// The config named `name` with the loose options given: each
+            /// must apply to that method.
+            pub fn from_name(name: &str, o: &LooseOptions) -> Result<Self> {
+                let refuse = |opt: &str, applies: &str| {
+                    Error::invalid(opt, format!("applies to {applies}, not to {name:?}"))
+                };
+                $(if name == <$config as MethodSpec>::NAME {
+                    return Ok(MethodConfig::$variant(<$config>::from_loose(o, &refuse)?));
+                })*
+                Err(Error::invalid(
                     "method",
-                    format!("unknown method {other:?}; available: {METHOD_NAMES:?}"),
+                    format!("unknown method {name:?}; available: {METHOD_NAMES:?}"),
                 ))
             }
-        };
-        Ok(c)
-    }
 
+            /// The name a user passes as `method=`.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(MethodConfig::$variant(_) => <$config as MethodSpec>::NAME,)*
+                }
+            }
+
+            /// The config that runs for `ctx` (`MethodSpec::resolve`).
+            pub fn resolve(&self, ctx: &CallContext) -> Result<MethodConfig> {
+                match *self {
+                    $(MethodConfig::$variant(c) => c.resolve(ctx),)*
+                }
+            }
+
+            /// The kernel of a config; resolve it first for the backend's defaults.
+            pub fn kernel(&self) -> Method {
+                match self {
+                    $(MethodConfig::$variant(c) => c.kernel(),)*
+                }
+            }
+
+            /// Occluder layers of a resolved config (0 for methods that read none).
+            pub fn passes(&self) -> u32 {
+                match self {
+                    $(MethodConfig::$variant(c) => c.passes(),)*
+                }
+            }
+
+            /// Occluder maps' (W, H) of a resolved config (None for methods
+            /// that read no maps).
+            pub fn occluder_resolution(&self) -> Option<(usize, usize)> {
+                match self {
+                    $(MethodConfig::$variant(c) => c.occluder_resolution(),)*
+                }
+            }
+
+            /// Every method's row of `capabilities()`, in the registry's order.
+            pub fn infos() -> Vec<MethodInfo> {
+                vec![$(<$config as MethodSpec>::info()),*]
+            }
+        }
+    };
+}
+
+method_configs! {
+    Ssm(SsmConfig),
+    Bitmask(BitmaskConfig),
+    Exact(ExactConfig),
+    /// Fernando 2005's percentage-closer soft shadows (`pcss.rs`).
+    Pcss(PcssConfig),
+    /// Chan & Durand 2003's smoothies (`smoothies/`).
+    Smoothies(SmoothiesConfig),
+    /// Scherzer 2005's practical shadow mapping (hard shadows from the
+    /// light's centre or direction; `shadow_mapping/`).
+    ShadowMapping(ShadowMappingConfig),
+    Auto(AutoConfig),
+}
+
+impl MethodConfig {
     /// A typed config passed with loose options too: refused (one place says
     /// each option).
     pub fn refuse_loose(o: &LooseOptions) -> Result<()> {
@@ -591,189 +590,604 @@ impl MethodConfig {
             )),
         }
     }
+}
 
-    /// The name a user passes as `method=`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            MethodConfig::Auto(..) => "auto",
-            MethodConfig::Ssm(_) => "ssm",
-            MethodConfig::Bitmask(_) => "bitmask",
-            MethodConfig::Exact(_) => "exact",
-            MethodConfig::ShadowMapping(_) => "shadow_mapping",
-            MethodConfig::Smoothies(_) => "smoothies",
-            MethodConfig::Pcss(_) => "pcss",
+/// The option `passes` of the occluder-map methods.
+fn passes_option() -> OptionInfo {
+    OptionInfo {
+        name: "passes",
+        kind: Kind::Int {
+            min: 1,
+            max: MAX_PASSES as i64,
+        },
+        default: Value::Resolved,
+        default_doc: "2 (front and back) from meshes; the layers given from depth maps",
+        doc: "occluder depth layers: 1, the front; 2, front and back (paper §3.5); 3 to 8, \
+              front, passes - 2 layers found by depth peeling, and back",
+        restricted_on: vec![],
+    }
+}
+
+/// The option `occluder_resolution` of the map methods.
+fn occluder_resolution_option() -> OptionInfo {
+    OptionInfo {
+        name: "occluder_resolution",
+        kind: Kind::Resolution {
+            max_texels: MAX_TEXELS as i64,
+        },
+        default: Value::Resolved,
+        default_doc: "the output's resolution; from depth maps, the occluder maps' shape",
+        doc: "resolution of the occluder maps (same extent as the output): coarser maps \
+              cost less, their error is the discretization of paper §4.1.1",
+        restricted_on: vec![],
+    }
+}
+
+/// The option `hierarchy` of the occluder-map methods.
+fn hierarchy_option(default_on: bool) -> OptionInfo {
+    OptionInfo {
+        name: "hierarchy",
+        kind: Kind::Bool,
+        default: Value::Resolved,
+        default_doc: if default_on {
+            "on on the CPU; off on the GPU, which has no hierarchy"
+        } else {
+            "off (the paper's method, reproduced as published)"
+        },
+        doc: "read the occluder maps through a min/max pyramid: each 8x8 tile of receivers \
+              reads the coarsest level whose texels cover at most 3% of the light's width",
+        restricted_on: vec![(Backend::Gpu, vec![Value::Bool(false)])],
+    }
+}
+
+/// `precision` applies to the sums of `ssm` only.
+const PRECISION_SSM_ONLY: &str =
+    "\"ssm\" (sums of occlusions); the other methods count samples exactly";
+/// `samples` applies to the sampling methods only.
+const SAMPLES_ONLY: &str = "the sampling methods (\"bitmask\", \"exact\")";
+
+impl MethodSpec for SsmConfig {
+    const NAME: &'static str = "ssm";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if o.samples.is_some() {
+            return Err(refuse("samples", SAMPLES_ONLY));
+        }
+        SsmConfig::new(o.passes, o.occluder_resolution, o.hierarchy, o.precision)
+    }
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        let c = self;
+        if ctx.backend == Backend::Gpu && c.precision != Precision::F32 {
+            return Err(Error::invalid(
+                "precision",
+                format!(
+                    "the GPU backend sums in \"f32\" only, got {:?}; use backend=\"cpu\"",
+                    c.precision.name()
+                ),
+            ));
+        }
+        let (passes, occ, hierarchy) = resolve_maps(
+            c.passes,
+            c.occluder_resolution,
+            c.hierarchy,
+            HIERARCHY_DEFAULT_SSM,
+            ctx,
+        )?;
+        Ok(MethodConfig::Ssm(SsmConfig {
+            passes: Some(passes),
+            occluder_resolution: Some(occ),
+            hierarchy: Some(hierarchy),
+            precision: c.precision,
+        }))
+    }
+    fn kernel(&self) -> Method {
+        Method::Ssm {
+            hierarchy: self.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
+            precision: self.precision,
+        }
+    }
+    fn passes(&self) -> u32 {
+        self.passes.unwrap_or(DEFAULT_PASSES)
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "ssm",
+            config: "Ssm",
+            summary: "Soft shadow maps (Atty et al. 2005) as published: micro-patches of the \
+                      occluder maps back-projected onto the light, their occlusions summed",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                passes_option(),
+                occluder_resolution_option(),
+                hierarchy_option(HIERARCHY_DEFAULT_SSM),
+                OptionInfo {
+                    name: "precision",
+                    kind: Kind::Choice(Precision::ALL.iter().map(|p| p.name()).collect()),
+                    default: Value::Str(Precision::default().name()),
+                    default_doc: "f32, each occluder row summed on its own",
+                    doc: "how the occlusions are summed (paper Appendix A): f32 two-level, f64, \
+                          emulated FP16 blending, or FP16 in batches of about sqrt(M)",
+                    restricted_on: vec![(Backend::Gpu, vec![Value::Str(Precision::F32.name())])],
+                },
+            ],
+        }
+    }
+}
+
+impl MethodSpec for BitmaskConfig {
+    const NAME: &'static str = "bitmask";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if o.precision.is_some() {
+            return Err(refuse("precision", PRECISION_SSM_ONLY));
+        }
+        BitmaskConfig::new(
+            o.samples,
+            o.passes,
+            o.occluder_resolution,
+            o.hierarchy,
+            None,
+        )
+    }
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        let c = self;
+        let (passes, occ, hierarchy) = resolve_maps(
+            c.passes,
+            c.occluder_resolution,
+            c.hierarchy,
+            HIERARCHY_DEFAULT_BITMASK,
+            ctx,
+        )?;
+        Ok(MethodConfig::Bitmask(BitmaskConfig {
+            samples: c.samples,
+            gaps: c.gaps,
+            passes: Some(passes),
+            occluder_resolution: Some(occ),
+            hierarchy: Some(hierarchy),
+        }))
+    }
+    fn kernel(&self) -> Method {
+        Method::Bitmask {
+            samples: self.samples,
+            hierarchy: self.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
+            gaps: self.gaps,
+        }
+    }
+    fn passes(&self) -> u32 {
+        self.passes.unwrap_or(DEFAULT_PASSES)
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "bitmask",
+            config: "Bitmask",
+            summary: "The same micro-patches marking the light samples they hide in a bit mask \
+                      per receiver, merged by OR (Schwarz & Stamminger 2007)",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                OptionInfo {
+                    name: "samples",
+                    kind: Kind::OneOf(bitmask::SAMPLE_COUNTS.iter().map(|&n| n as i64).collect()),
+                    default: Value::Int(DEFAULT_SAMPLES as i64),
+                    default_doc: "256",
+                    doc: "light samples per receiver, a multi-jittered pattern shared by all \
+                          receivers",
+                    restricted_on: vec![],
+                },
+                passes_option(),
+                occluder_resolution_option(),
+                hierarchy_option(HIERARCHY_DEFAULT_BITMASK),
+                OptionInfo {
+                    name: "gaps",
+                    kind: Kind::Choice(bitmask::Gaps::ALL.iter().map(|g| g.name()).collect()),
+                    default: Value::Str(bitmask::Gaps::default().name()),
+                    default_doc: "closed",
+                    doc: "how neighbouring micro-patches meet: closed, connected micro-quads \
+                          (no light between neighbours on one surface; a depth step steeper \
+                          than 76° from the light's direction stays open); open, the flat \
+                          per-texel micro-patches of the paper, whose gaps leak light (§4.1.2)",
+                    restricted_on: vec![],
+                },
+            ],
+        }
+    }
+}
+
+impl MethodSpec for ExactConfig {
+    const NAME: &'static str = "exact";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        // `passes` beside "exact" is accepted and has no effect (the
+        // string form always allowed it: it reads no layers).
+        if let Some(p) = o.passes {
+            check_passes(p)?;
+        }
+        for (given, opt) in [
+            (o.occluder_resolution.is_some(), "occluder_resolution"),
+            (o.hierarchy.is_some(), "hierarchy"),
+        ] {
+            if given {
+                return Err(refuse(
+                    opt,
+                    "the occluder-map methods (\"ssm\", \"bitmask\"); \"exact\" traces the occluder triangles",
+                ));
+            }
+        }
+        if o.precision.is_some() {
+            return Err(refuse("precision", PRECISION_SSM_ONLY));
+        }
+        ExactConfig::new(o.samples)
+    }
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        if ctx.depth_layers.is_some() {
+            return Err(Error::invalid(
+                "method",
+                "\"exact\" traces the occluder triangles, which depth maps do not have; \
+                 use soft_shadow_map with meshes",
+            ));
+        }
+        Ok(MethodConfig::Exact(self))
+    }
+    fn kernel(&self) -> Method {
+        Method::Exact {
+            samples: self.samples,
         }
     }
 
-    /// The config that runs for `ctx`: "auto" replaced by its rule, every
-    /// call-dependent default filled in, backend restrictions checked.
-    pub fn resolve(&self, ctx: &CallContext) -> Result<MethodConfig> {
-        Ok(match *self {
-            MethodConfig::Auto(given, _) => {
-                let rule = match ctx.depth_layers {
-                    // From depth maps the layers and their resolution are given.
-                    Some(_) => SsmConfig::default(),
-                    None => auto_rule(ctx.resolution),
-                };
-                let ssm = SsmConfig {
-                    passes: given.passes.or(rule.passes),
-                    occluder_resolution: given.occluder_resolution.or(rule.occluder_resolution),
-                    hierarchy: given.hierarchy.or(rule.hierarchy),
-                    precision: given.precision,
-                };
-                return MethodConfig::Ssm(ssm).resolve(ctx);
-            }
-            MethodConfig::Ssm(c) => {
-                if ctx.backend == Backend::Gpu && c.precision != Precision::F32 {
-                    return Err(Error::invalid(
-                        "precision",
-                        format!(
-                            "the GPU backend sums in \"f32\" only, got {:?}; use backend=\"cpu\"",
-                            c.precision.name()
-                        ),
-                    ));
-                }
-                let (passes, occ, hierarchy) = resolve_maps(
-                    c.passes,
-                    c.occluder_resolution,
-                    c.hierarchy,
-                    HIERARCHY_DEFAULT_SSM,
-                    ctx,
-                )?;
-                MethodConfig::Ssm(SsmConfig {
-                    passes: Some(passes),
-                    occluder_resolution: Some(occ),
-                    hierarchy: Some(hierarchy),
-                    precision: c.precision,
-                })
-            }
-            MethodConfig::Bitmask(c) => {
-                let (passes, occ, hierarchy) = resolve_maps(
-                    c.passes,
-                    c.occluder_resolution,
-                    c.hierarchy,
-                    HIERARCHY_DEFAULT_BITMASK,
-                    ctx,
-                )?;
-                MethodConfig::Bitmask(BitmaskConfig {
-                    samples: c.samples,
-                    gaps: c.gaps,
-                    passes: Some(passes),
-                    occluder_resolution: Some(occ),
-                    hierarchy: Some(hierarchy),
-                })
-            }
-            MethodConfig::Exact(c) => {
-                if ctx.depth_layers.is_some() {
-                    return Err(Error::invalid(
-                        "method",
-                        "\"exact\" traces the occluder triangles, which depth maps do not have; \
-                         use soft_shadow_map with meshes",
-                    ));
-                }
-                MethodConfig::Exact(c)
-            }
-            MethodConfig::ShadowMapping(c) => {
-                if !ctx.eye {
-                    return Err(Error::invalid(
-                        "method",
-                        "ShadowMapping renders the eye view (ss.render): its map is focused, \
-                         warped and blurred for a camera; in the light view use method=\"ssm\" \
-                         or \"exact\" with a point light for hard shadows",
-                    ));
-                }
-                if ctx.depth_layers.is_some() {
-                    return Err(Error::invalid(
-                        "method",
-                        "ShadowMapping rasterizes its own map of the meshes; depth maps are not enough",
-                    ));
-                }
-                MethodConfig::ShadowMapping(c)
-            }
-            MethodConfig::Smoothies(c) => {
-                if ctx.depth_layers.is_some() {
-                    return Err(Error::invalid(
-                        "method",
-                        "Smoothies find the occluders' silhouette edges, which depth maps do not \
-                         have; use soft_shadow_map with meshes",
-                    ));
-                }
-                MethodConfig::Smoothies(SmoothiesConfig {
-                    occluder_resolution: Some(c.occluder_resolution.unwrap_or(ctx.resolution)),
-                    ..c
-                })
-            }
-            MethodConfig::Pcss(c) => {
-                // From depth maps: the front layer the user gave.
-                let (_, occ, _) = resolve_maps(
-                    Some(1),
-                    c.occluder_resolution,
-                    Some(false),
-                    false,
-                    &CallContext {
-                        depth_layers: ctx.depth_layers.map(|(_, shape)| (1, shape)),
-                        ..*ctx
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "exact",
+            config: "Exact",
+            summary: "Ray casting against the occluder triangles (a BVH) with stratified light \
+                      samples, jittered deterministically: converges to the true visibility",
+            reads: vec![Input::OccluderTriangles],
+            backends: Backend::built().to_vec(),
+            options: vec![OptionInfo {
+                name: "samples",
+                kind: Kind::Int {
+                    min: 1,
+                    max: MAX_SAMPLES as i64,
+                },
+                default: Value::Int(DEFAULT_SAMPLES as i64),
+                default_doc: "256 (a 16x16 stratification)",
+                doc: "light samples per receiver",
+                restricted_on: vec![],
+            }],
+        }
+    }
+}
+
+impl MethodSpec for PcssConfig {
+    const NAME: &'static str = "pcss";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
+            return Err(refuse(opt, "other methods; give PCSS(...) its own options"));
+        }
+        PcssConfig::new(None, o.occluder_resolution)
+    }
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        // From depth maps: the front layer the user gave.
+        let (_, occ, _) = resolve_maps(
+            Some(1),
+            self.occluder_resolution,
+            Some(false),
+            false,
+            &CallContext {
+                depth_layers: ctx.depth_layers.map(|(_, shape)| (1, shape)),
+                ..*ctx
+            },
+        )?;
+        Ok(MethodConfig::Pcss(PcssConfig {
+            occluder_resolution: Some(occ),
+            ..self
+        }))
+    }
+    fn kernel(&self) -> Method {
+        Method::Pcss {
+            max_taps: self.max_taps,
+        }
+    }
+    // The shadow map: the front layer.
+    fn passes(&self) -> u32 {
+        1
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "pcss",
+            config: "PCSS",
+            summary: "Percentage-closer soft shadows (Fernando 2005), what real-time engines \
+                      ship: a blocker search on the shadow map, the penumbra estimated from the \
+                      mean blocker depth, a box PCF of that width",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                OptionInfo {
+                    name: "max_taps",
+                    kind: Kind::Int {
+                        min: 1,
+                        max: super::pcss::MAX_TAPS as i64,
                     },
-                )?;
-                MethodConfig::Pcss(PcssConfig {
-                    occluder_resolution: Some(occ),
-                    ..c
-                })
-            }
+                    default: Value::Int(super::pcss::DEFAULT_MAX_TAPS as i64),
+                    default_doc: "16",
+                    doc: "taps per axis of the blocker search and of the filter: a box spanning \
+                          more texels is sampled by this many strata (bounded work per point)",
+                    restricted_on: vec![],
+                },
+                occluder_resolution_option(),
+            ],
+        }
+    }
+}
+
+impl MethodSpec for SmoothiesConfig {
+    const NAME: &'static str = "smoothies";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
+            return Err(refuse(
+                opt,
+                "other methods; give Smoothies(...) its own options",
+            ));
+        }
+        SmoothiesConfig::new(None, None, None, o.occluder_resolution)
+    }
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        if ctx.depth_layers.is_some() {
+            return Err(Error::invalid(
+                "method",
+                "Smoothies find the occluders' silhouette edges, which depth maps do not \
+                 have; use soft_shadow_map with meshes",
+            ));
+        }
+        Ok(MethodConfig::Smoothies(SmoothiesConfig {
+            occluder_resolution: Some(self.occluder_resolution.unwrap_or(ctx.resolution)),
+            ..self
+        }))
+    }
+    fn kernel(&self) -> Method {
+        Method::Smoothies {
+            width: self.width,
+            falloff: self.falloff,
+        }
+    }
+    // The shadow map: the front layer.
+    fn passes(&self) -> u32 {
+        1
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "smoothies",
+            config: "Smoothies",
+            summary: "Fake soft shadows (Chan & Durand 2003): the hard shadow map's umbra and an \
+                      outer penumbra from smoothies on the occluders' silhouette edges, their \
+                      alpha remapped by 1/(1 - b/r)",
+            reads: vec![Input::OccluderLayers, Input::OccluderTriangles],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                OptionInfo {
+                    name: "width",
+                    kind: Kind::Float,
+                    default: Value::Float(DEFAULT_SMOOTHIE_WIDTH),
+                    default_doc:
+                        "0.5, measured against exact on the eye scenes (1.0 is the penumbra of \
+                         the light's size for blockers at the median silhouette depth)",
+                    doc: "the smoothies' width in the light's image plane, as a factor of the \
+                          light-matched width, in (0, 16]",
+                    restricted_on: vec![],
+                },
+                OptionInfo {
+                    name: "falloff",
+                    kind: Kind::Choice(
+                        super::smoothies::Falloff::ALL
+                            .iter()
+                            .map(|f| f.name())
+                            .collect(),
+                    ),
+                    default: Value::Str("linear"),
+                    default_doc: "linear",
+                    doc:
+                        "the penumbra's profile: linear alpha, or the sinusoidal (1 - cos(pi v))/2",
+                    restricted_on: vec![],
+                },
+                OptionInfo {
+                    name: "filter",
+                    kind: Kind::Choice(SMOOTHIE_FILTERS.to_vec()),
+                    default: Value::Str("bilinear"),
+                    default_doc: "bilinear",
+                    doc: "the lookup: the paper's 2x2 tent over the shadow map and smoothie buffer",
+                    restricted_on: vec![],
+                },
+                occluder_resolution_option(),
+            ],
+        }
+    }
+}
+
+impl MethodSpec for ShadowMappingConfig {
+    const NAME: &'static str = "shadow_mapping";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if let Some(opt) = o.given().first() {
+            return Err(refuse(
+                opt,
+                "the soft shadow map methods; give ShadowMapping(...) its own options",
+            ));
+        }
+        Ok(ShadowMappingConfig::default())
+    }
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        if !ctx.eye {
+            return Err(Error::invalid(
+                "method",
+                "ShadowMapping renders the eye view (ss.render): its map is focused, \
+                 warped and blurred for a camera; in the light view use method=\"ssm\" \
+                 or \"exact\" with a point light for hard shadows",
+            ));
+        }
+        if ctx.depth_layers.is_some() {
+            return Err(Error::invalid(
+                "method",
+                "ShadowMapping rasterizes its own map of the meshes; depth maps are not enough",
+            ));
+        }
+        Ok(MethodConfig::ShadowMapping(self))
+    }
+    fn kernel(&self) -> Method {
+        Method::ShadowMapping(*self)
+    }
+    fn info() -> MethodInfo {
+        use super::shadow_mapping::config::{DEFAULT_SM_RESOLUTION, MAX_SM_SIDE};
+        let part = |name, classes: Vec<&'static str>, doc| OptionInfo {
+            name,
+            kind: Kind::Config(classes),
+            default: Value::Resolved,
+            default_doc: "None (off)",
+            doc,
+            restricted_on: vec![],
+        };
+        MethodInfo {
+            name: "shadow_mapping",
+            config: "ShadowMapping",
+            summary: "The standard shadow map from the light's centre or direction with Scherzer \
+                  2005's practical extensions: bias methods, PCF, focusing on the \
+                  intersection body, LiSPSM (directional lights), the eye-space blur; hard \
+                  shadows, the eye view only",
+            reads: vec![Input::SceneTriangles, Input::Camera],
+            backends: Backend::built().to_vec(),
+            options: vec![
+            OptionInfo {
+                name: "resolution",
+                kind: Kind::Resolution {
+                    max_texels: (MAX_SM_SIDE * MAX_SM_SIDE) as i64,
+                },
+                default: Value::Int(DEFAULT_SM_RESOLUTION as i64),
+                default_doc: "2048 x 2048 (Scherzer's)",
+                doc: "the shadow map's (W, H), each side at most 16384",
+                restricted_on: vec![],
+            },
+            OptionInfo {
+                name: "bias",
+                kind: Kind::Config(vec![
+                    "ConstantBias",
+                    "SlopeScaleBias",
+                    "LinearDepthBias",
+                    "BackFaces",
+                    "MidpointBias",
+                ]),
+                default: Value::Str("SlopeScaleBias"),
+                default_doc:
+                    "SlopeScaleBias(constant=4, slope=2): glPolygonOffset(2, 4), Scherzer's",
+                doc: "how the depth test keeps surfaces from shadowing themselves (Scherzer §4.2)",
+                restricted_on: vec![],
+            },
+            part(
+                "filter",
+                vec!["PCF"],
+                "percentage-closer filtering of the depth test",
+            ),
+            part(
+                "warp",
+                vec!["LiSPSM"],
+                "LiSPSM (directional lights only): more texels near the camera",
+            ),
+            OptionInfo {
+                name: "focus",
+                kind: Kind::Bool,
+                default: Value::Bool(true),
+                default_doc: "True",
+                doc: "fit the map to the intersection body B (view frustum and scene bounds, \
+                      extended toward the light); False: to the whole scene",
+                restricted_on: vec![],
+            },
+            part(
+                "blur",
+                vec!["EyeSpaceBlur"],
+                "the depth-dependent eye-space blur of the shadow image (Scherzer §4.3)",
+            ),
+        ],
+        }
+    }
+}
+
+impl MethodSpec for AutoConfig {
+    const NAME: &'static str = "auto";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        // The rule's choice is "ssm": its options given beside "auto"
+        // replace the rule's.
+        if o.samples.is_some() {
+            return Err(refuse("samples", SAMPLES_ONLY));
+        }
+        Ok(AutoConfig {
+            given: SsmConfig::new(o.passes, o.occluder_resolution, o.hierarchy, o.precision)?,
+            target: Default::default(),
         })
     }
-
-    /// The kernel of a config; resolve it first for the backend's defaults.
-    pub fn kernel(&self) -> Method {
-        match *self {
-            MethodConfig::Ssm(c) => Method::Ssm {
-                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
-                precision: c.precision,
-            },
-            MethodConfig::Bitmask(c) => Method::Bitmask {
-                samples: c.samples,
-                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
-                gaps: c.gaps,
-            },
-            MethodConfig::Exact(c) => Method::Exact { samples: c.samples },
-            // What "auto" always resolves to.
-            MethodConfig::Auto(c, _) => Method::Ssm {
-                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
-                precision: c.precision,
-            },
-            MethodConfig::ShadowMapping(c) => Method::ShadowMapping(c),
-            MethodConfig::Smoothies(c) => Method::Smoothies {
-                width: c.width,
-                falloff: c.falloff,
-            },
-            MethodConfig::Pcss(c) => Method::Pcss {
-                max_taps: c.max_taps,
-            },
+    fn resolve(self, ctx: &CallContext) -> Result<MethodConfig> {
+        let given = self.given;
+        let rule = match ctx.depth_layers {
+            // From depth maps the layers and their resolution are given.
+            Some(_) => SsmConfig::default(),
+            None => auto_rule(ctx.resolution),
+        };
+        let ssm = SsmConfig {
+            passes: given.passes.or(rule.passes),
+            occluder_resolution: given.occluder_resolution.or(rule.occluder_resolution),
+            hierarchy: given.hierarchy.or(rule.hierarchy),
+            precision: given.precision,
+        };
+        ssm.resolve(ctx)
+    }
+    // What "auto" always resolves to.
+    fn kernel(&self) -> Method {
+        Method::Ssm {
+            hierarchy: self.given.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
+            precision: self.given.precision,
         }
     }
 
-    /// Occluder layers of a resolved config (0 for methods that read none).
-    pub fn passes(&self) -> u32 {
-        match *self {
-            MethodConfig::Ssm(c) => c.passes.unwrap_or(DEFAULT_PASSES),
-            MethodConfig::Bitmask(c) => c.passes.unwrap_or(DEFAULT_PASSES),
-            // The shadow map: the front layer.
-            MethodConfig::Smoothies(_) | MethodConfig::Pcss(_) => 1,
-            MethodConfig::Exact(_) | MethodConfig::Auto(..) | MethodConfig::ShadowMapping(_) => 0,
-        }
-    }
-
-    /// Occluder maps' (W, H) of a resolved config (None for methods that
-    /// read no maps).
-    pub fn occluder_resolution(&self) -> Option<(usize, usize)> {
-        match *self {
-            MethodConfig::Ssm(c) => c.occluder_resolution,
-            MethodConfig::Bitmask(c) => c.occluder_resolution,
-            MethodConfig::Smoothies(c) => c.occluder_resolution,
-            MethodConfig::Pcss(c) => c.occluder_resolution,
-            MethodConfig::Exact(_) | MethodConfig::Auto(..) | MethodConfig::ShadowMapping(_) => {
-                None
-            }
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "auto",
+            config: "Auto",
+            summary: "A plan, not a method: without a target, \"ssm\" with two passes and \
+                      occluder maps at a quarter of the output's resolution (at least 64, at \
+                      most the output's), the point of the study's accuracy-time plane furthest \
+                      ahead of ray tracing; with error= or time=, the setting planned from the \
+                      scene (light-view maps from meshes; sm.plan says why)",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                OptionInfo {
+                    name: "error",
+                    kind: Kind::Float,
+                    default: Value::Resolved,
+                    default_doc: "None (no target)",
+                    doc: "the error to reach (the paper's §4.2.1 metric, mean |V - V_ref| over \
+                          the shadow), in [1e-4, 1]: the cheapest setting measured within it",
+                    restricted_on: vec![],
+                },
+                OptionInfo {
+                    name: "time",
+                    kind: Kind::Float,
+                    default: Value::Resolved,
+                    default_doc: "None (no budget)",
+                    doc: "a time budget in seconds, in [1e-6, 1e6]: a timed probe, then the most \
+                          accurate setting predicted to fit; not with error",
+                    restricted_on: vec![],
+                },
+            ],
         }
     }
 }
@@ -793,12 +1207,12 @@ mod tests {
 
     #[test]
     fn auto_is_ssm_with_quarter_occluder_maps_at_least_64() {
-        let r = MethodConfig::Auto(SsmConfig::default(), Default::default())
+        let r = MethodConfig::Auto(AutoConfig::default())
             .resolve(&cpu((512, 100)))
             .unwrap();
         assert_eq!(r.occluder_resolution(), Some((128, 64)));
         assert_eq!(r.passes(), 2);
-        let r = MethodConfig::Auto(SsmConfig::default(), Default::default())
+        let r = MethodConfig::Auto(AutoConfig::default())
             .resolve(&cpu((40, 40)))
             .unwrap();
         assert_eq!(r.occluder_resolution(), Some((40, 40)));

@@ -12,6 +12,7 @@ pub mod capabilities;
 pub mod config;
 pub mod exact;
 pub(crate) mod gather;
+pub mod info;
 pub mod inputs;
 pub(crate) mod packet;
 pub mod pcf;

@@ -6,7 +6,7 @@
 
 use super::config_class::{config_class, newargs};
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string, string};
-use crate::methods::config::{auto_rule, check_resolution, LooseOptions};
+use crate::methods::config::{auto_rule, check_resolution, AutoConfig, LooseOptions};
 use crate::methods::target::Target;
 use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 use pyo3::exceptions::PyTypeError;
@@ -156,7 +156,10 @@ fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
         return Some(MethodConfig::Exact(c.get().0));
     }
     if let Ok(a) = v.cast::<PyAuto>() {
-        return Some(MethodConfig::Auto(SsmConfig::default(), a.get().0));
+        return Some(MethodConfig::Auto(AutoConfig {
+            given: SsmConfig::default(),
+            target: a.get().0,
+        }));
     }
     if let Ok(c) = v.cast::<super::shadow_configs::PyPcss>() {
         return Some(MethodConfig::Pcss(c.get().0));
@@ -225,7 +228,7 @@ pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
         MethodConfig::Ssm(c) => Py::new(py, PySsm(c))?.into_any(),
         MethodConfig::Bitmask(c) => Py::new(py, PyBitmask(c))?.into_any(),
         MethodConfig::Exact(c) => Py::new(py, PyExact(c))?.into_any(),
-        MethodConfig::Auto(_, t) => Py::new(py, PyAuto(t))?.into_any(),
+        MethodConfig::Auto(a) => Py::new(py, PyAuto(a.target))?.into_any(),
         MethodConfig::ShadowMapping(c) => {
             Py::new(py, super::shadow_configs::PyShadowMapping(c))?.into_any()
         }
