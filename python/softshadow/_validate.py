@@ -25,12 +25,6 @@ def vector(name: str, value: Any, n: int) -> tuple[float, ...]:
     return tuple(float(x) for x in a)
 
 
-def vector3(name: str, value: Any) -> tuple[float, float, float]:
-    """A vector of 3 floats."""
-    x, y, z = vector(name, value, 3)
-    return x, y, z
-
-
 def pair(name: str, value: Any) -> tuple[float, float]:
     """A number (both components) or a pair of numbers."""
     if isinstance(value, numbers.Real) and not isinstance(value, bool):

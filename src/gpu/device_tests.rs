@@ -4,33 +4,10 @@
 
 use crate::backend::Backend;
 use crate::frame::{MapSettings, ShadowResult};
-use crate::geom::light::{MapGrid, RectLight};
+use crate::geom::light::RectLight;
 use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
 use crate::pipeline;
-
-/// `pipeline::from_depth` on `backend`, the maps given one by one.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn depth_on(
-    backend: Backend,
-    grid: &MapGrid,
-    occluder_grid: &MapGrid,
-    light_size: [f64; 2],
-    front: &[f32],
-    back: Option<&[f32]>,
-    receiver: &[f32],
-    method: Method,
-) -> crate::error::Result<(Vec<f32>, crate::timing::Timings)> {
-    let maps = pipeline::DepthMaps {
-        grid,
-        occluder_grid,
-        light_size,
-        front,
-        back,
-        receiver,
-    };
-    pipeline::from_depth(&maps, method, backend)
-}
 
 fn device_or_skip() -> bool {
     match super::info() {
@@ -352,28 +329,16 @@ fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
         for method in bitmask_kernels() {
             for back in [None, Some(&back[..])] {
                 let light = [0.8, 0.6];
-                let (c, _) = crate::gpu::device_tests::depth_on(
-                    Backend::Cpu,
-                    &grid,
-                    &og,
-                    light,
-                    &front,
+                let maps = pipeline::DepthMaps {
+                    grid: &grid,
+                    occluder_grid: &og,
+                    light_size: light,
+                    front: &front,
                     back,
-                    &receiver,
-                    method,
-                )
-                .unwrap();
-                let (g, t) = crate::gpu::device_tests::depth_on(
-                    Backend::Gpu,
-                    &grid,
-                    &og,
-                    light,
-                    &front,
-                    back,
-                    &receiver,
-                    method,
-                )
-                .unwrap();
+                    receiver: &receiver,
+                };
+                let (c, _) = pipeline::from_depth(&maps, method, Backend::Cpu).unwrap();
+                let (g, t) = pipeline::from_depth(&maps, method, Backend::Gpu).unwrap();
                 assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 50);
                 let n = same_bits(&c, &g);
                 assert_eq!(n, 0, "{method:?}, back {}, {og:?}", back.is_some());
@@ -412,28 +377,16 @@ fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
         // lie within [2^-16, 2^16]).
         let w_max = front.iter().fold(0f64, |m, &z| m.max(1.0 / z as f64));
         assert!(super::gather::chunking(&og, light, w_max, method).1 > 2);
-        let (c, _) = crate::gpu::device_tests::depth_on(
-            Backend::Cpu,
-            &grid,
-            &og,
-            light,
-            &front,
-            Some(&back),
-            &receiver,
-            method,
-        )
-        .unwrap();
-        let (g, _) = crate::gpu::device_tests::depth_on(
-            Backend::Gpu,
-            &grid,
-            &og,
-            light,
-            &front,
-            Some(&back),
-            &receiver,
-            method,
-        )
-        .unwrap();
+        let maps = pipeline::DepthMaps {
+            grid: &grid,
+            occluder_grid: &og,
+            light_size: light,
+            front: &front,
+            back: Some(&back),
+            receiver: &receiver,
+        };
+        let (c, _) = pipeline::from_depth(&maps, method, Backend::Cpu).unwrap();
+        let (g, _) = pipeline::from_depth(&maps, method, Backend::Gpu).unwrap();
         assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 100);
         assert_eq!(same_bits(&c, &g), 0, "{method:?}");
     }
@@ -458,18 +411,17 @@ fn depth_maps_cannot_be_traced() {
     // the CPU, before any GPU work.
     let z = vec![2f32; 64];
     let g = crate::geom::light::MapGrid::new(8, 8, [0.5, 0.5]).unwrap();
-    let e = crate::gpu::device_tests::depth_on(
-        Backend::Gpu,
-        &g,
-        &g,
-        [1.0, 1.0],
-        &z,
-        None,
-        &z,
-        Method::Exact { samples: 4 },
-    )
-    .unwrap_err()
-    .to_string();
+    let maps = pipeline::DepthMaps {
+        grid: &g,
+        occluder_grid: &g,
+        light_size: [1.0, 1.0],
+        front: &z,
+        back: None,
+        receiver: &z,
+    };
+    let e = pipeline::from_depth(&maps, Method::Exact { samples: 4 }, Backend::Gpu)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("method:"), "{e}");
 }
 
@@ -1506,6 +1458,7 @@ mod pcss {
     use crate::gpu::timing::StageTimer;
     use crate::methods::pcss::{Pcss, MAX_TAPS};
     use crate::methods::{LightPoint, Method, ShadowInputs, ShadowMethod};
+    use crate::pipeline;
     use crate::timing::Stopwatch;
 
     fn lcg(seed: &mut u64) -> f64 {
@@ -1604,28 +1557,16 @@ mod pcss {
             (7, [1e30, 0.5]),
         ] {
             let method = Method::Pcss { max_taps: taps };
-            let (c, _) = crate::gpu::device_tests::depth_on(
-                Backend::Cpu,
-                &grid,
-                &og,
-                light,
-                &front,
-                None,
-                &receiver,
-                method,
-            )
-            .unwrap();
-            let (g, _) = crate::gpu::device_tests::depth_on(
-                Backend::Gpu,
-                &grid,
-                &og,
-                light,
-                &front,
-                None,
-                &receiver,
-                method,
-            )
-            .unwrap();
+            let maps = pipeline::DepthMaps {
+                grid: &grid,
+                occluder_grid: &og,
+                light_size: light,
+                front: &front,
+                back: None,
+                receiver: &receiver,
+            };
+            let (c, _) = pipeline::from_depth(&maps, method, Backend::Cpu).unwrap();
+            let (g, _) = pipeline::from_depth(&maps, method, Backend::Gpu).unwrap();
             let (max, mean, flips) = compare(&c, &g);
             eprintln!("wide {taps} {light:?}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
             assert!(

@@ -101,18 +101,49 @@ fn array3<'py>(py: Python<'py>, v: glam::DVec3) -> Bound<'py, PyAny> {
     numpy::PyArray1::from_slice(py, &v.to_array()).into_any()
 }
 
-fn tuple<const N: usize>(v: [f64; N]) -> Vec<f64> {
-    v.to_vec()
-}
-
-/// A tuple of floats as Python writes it.
-fn repr(py: Python<'_>, v: &[f64]) -> PyResult<String> {
-    Ok(PyTuple::new(py, v)?.repr()?.to_string())
-}
+/// A light's values as its constructor takes them: the positional
+/// arguments, then the emission (keyword-only), each with its name.
+type Fields<'a> = [(&'static str, &'a [f64])];
 
 /// Bits that compare and hash as the values do (0.0 and -0.0 alike).
-fn key<const N: usize>(v: &[f64; N]) -> [u64; N] {
-    v.map(|x| if x == 0.0 { 0 } else { x.to_bits() })
+fn key(fields: &Fields) -> Vec<u64> {
+    fields
+        .iter()
+        .flat_map(|(_, v)| v.iter())
+        .map(|&x| if x == 0.0 { 0 } else { x.to_bits() })
+        .collect()
+}
+
+fn hash_of(fields: &Fields) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key(fields).hash(&mut h);
+    h.finish()
+}
+
+/// Pickling through the constructor: the positional fields, the last one
+/// by keyword.
+fn newargs<'py>(
+    py: Python<'py>,
+    fields: &Fields,
+) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+    let (last, positional) = fields.split_last().expect("a light has fields");
+    let args = positional
+        .iter()
+        .map(|(_, v)| PyTuple::new(py, *v))
+        .collect::<PyResult<Vec<_>>>()?;
+    let kw = PyDict::new(py);
+    kw.set_item(last.0, PyTuple::new(py, last.1)?)?;
+    Ok((PyTuple::new(py, args)?, kw))
+}
+
+/// `Class(name=(x, y, z), ...)`, each tuple as Python writes it.
+fn repr(py: Python<'_>, class: &str, fields: &Fields) -> PyResult<String> {
+    let parts = fields
+        .iter()
+        .map(|(name, v)| Ok(format!("{name}={}", PyTuple::new(py, *v)?.repr()?)))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok(format!("{class}({})", parts.join(", ")))
 }
 
 /// A rectangular area light that emits uniformly over its whole rectangle.
@@ -258,60 +289,36 @@ impl PyRectLight {
         self.radiance.into()
     }
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
-        other.cast::<PyRectLight>().is_ok_and(|o| {
-            let o = o.get();
-            key(&self.center) == key(&o.center)
-                && key(&self.normal) == key(&o.normal)
-                && key(&self.up) == key(&o.up)
-                && key(&self.size) == key(&o.size)
-                && key(&self.radiance) == key(&o.radiance)
-        })
+        other
+            .cast::<PyRectLight>()
+            .is_ok_and(|o| key(&self.fields()) == key(&o.get().fields()))
     }
     fn __hash__(&self) -> u64 {
-        use std::hash::{Hash, Hasher};
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        (
-            key(&self.center),
-            key(&self.normal),
-            key(&self.up),
-            key(&self.size),
-            key(&self.radiance),
-        )
-            .hash(&mut h);
-        h.finish()
+        hash_of(&self.fields())
     }
     fn __getnewargs_ex__<'py>(
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        let args = PyTuple::new(
-            py,
-            [
-                PyTuple::new(py, tuple(self.center))?,
-                PyTuple::new(py, tuple(self.normal))?,
-                PyTuple::new(py, tuple(self.up))?,
-                PyTuple::new(py, tuple(self.size))?,
-            ],
-        )?;
-        let kw = PyDict::new(py);
-        kw.set_item("radiance", PyTuple::new(py, tuple(self.radiance))?)?;
-        Ok((args, kw))
+        newargs(py, &self.fields())
     }
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        Ok(format!(
-            "RectLight(center={}, normal={}, up={}, size={}, radiance={})",
-            repr(py, &self.center)?,
-            repr(py, &self.normal)?,
-            repr(py, &self.up)?,
-            repr(py, &self.size)?,
-            repr(py, &self.radiance)?,
-        ))
+        repr(py, "RectLight", &self.fields())
     }
 }
 
 impl PyRectLight {
     fn core_light(&self) -> Light {
         Light::Rect(self._core_args())
+    }
+    fn fields(&self) -> [(&'static str, &[f64]); 5] {
+        [
+            ("center", &self.center),
+            ("normal", &self.normal),
+            ("up", &self.up),
+            ("size", &self.size),
+            ("radiance", &self.radiance),
+        ]
     }
 }
 
@@ -427,49 +434,31 @@ impl PyDirectionalLight {
         self.irradiance.into()
     }
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
-        other.cast::<PyDirectionalLight>().is_ok_and(|o| {
-            let o = o.get();
-            key(&self.direction) == key(&o.direction)
-                && key(&self.up) == key(&o.up)
-                && key(&self.angular_size) == key(&o.angular_size)
-                && key(&self.irradiance) == key(&o.irradiance)
-        })
+        other
+            .cast::<PyDirectionalLight>()
+            .is_ok_and(|o| key(&self.fields()) == key(&o.get().fields()))
     }
     fn __hash__(&self) -> u64 {
-        use std::hash::{Hash, Hasher};
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        (
-            key(&self.direction),
-            key(&self.up),
-            key(&self.angular_size),
-            key(&self.irradiance),
-        )
-            .hash(&mut h);
-        h.finish()
+        hash_of(&self.fields())
     }
     fn __getnewargs_ex__<'py>(
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
-        let args = PyTuple::new(
-            py,
-            [
-                PyTuple::new(py, tuple(self.direction))?,
-                PyTuple::new(py, tuple(self.up))?,
-                PyTuple::new(py, tuple(self.angular_size))?,
-            ],
-        )?;
-        let kw = PyDict::new(py);
-        kw.set_item("irradiance", PyTuple::new(py, tuple(self.irradiance))?)?;
-        Ok((args, kw))
+        newargs(py, &self.fields())
     }
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        Ok(format!(
-            "DirectionalLight(direction={}, up={}, angular_size={}, irradiance={})",
-            repr(py, &self.direction)?,
-            repr(py, &self.up)?,
-            repr(py, &self.angular_size)?,
-            repr(py, &self.irradiance)?,
-        ))
+        repr(py, "DirectionalLight", &self.fields())
+    }
+}
+
+impl PyDirectionalLight {
+    fn fields(&self) -> [(&'static str, &[f64]); 4] {
+        [
+            ("direction", &self.direction),
+            ("up", &self.up),
+            ("angular_size", &self.angular_size),
+            ("irradiance", &self.irradiance),
+        ]
     }
 }
