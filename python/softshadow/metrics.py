@@ -14,9 +14,16 @@ The map functions reject NaN and inf with a ``ValueError``.
 Eye-view images (:func:`compare_images`) are compared only where both see
 the same surface point: both hit (``mask``), the same mesh (``mesh_id``),
 at positions within ``position_tol`` times the reference's depth of each
-other. The errors ``|V - V_ref|`` over those *matched* pixels are reported
-as mean, RMSE, maximum and 99th percentile, with the fraction of the pixels
-where either image hits that are matched.
+other. The headline is the same metric as the light view's, over the
+*matched* pixels the reference shadows (``shadow_error``); the mean over
+every matched pixel (``mean_abs``), lit ones included, is kept beside it but
+hides shadow errors behind lit pixels and is not comparable between scenes.
+
+Two failure rates go with every comparison, in both views (:func:`acne_leak`):
+*acne*, the pixels (texels) the reference sees fully lit (``V_ref >= 0.99``)
+that the method darkens by more than 0.05, and *leaks*, the pixels in the
+reference umbra (``V_ref <= 0.01``) that the method lightens by more than
+0.05; each as a fraction of the pixels compared.
 """
 
 from __future__ import annotations
@@ -26,10 +33,26 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ImageComparison", "compare", "compare_images", "max_error", "rmse", "shadow_error", "shadow_mask"]
+__all__ = [
+    "ImageComparison",
+    "acne_leak",
+    "compare",
+    "compare_images",
+    "max_error",
+    "rmse",
+    "shadow_error",
+    "shadow_mask",
+]
 
 #: Default occlusion above which a reference texel counts as in shadow.
 DEFAULT_THRESHOLD = 1e-3
+#: A reference visibility at least this is fully lit (for the acne rate).
+LIT = 0.99
+#: A reference visibility at most this is umbra (for the leak rate).
+UMBRA = 0.01
+#: How far a method must darken a lit pixel (lighten an umbra one) to count
+#: as acne (a leak).
+ACNE_LEAK_MARGIN = 0.05
 
 
 def _finite_array(values: Any, name: str) -> np.ndarray:
@@ -174,6 +197,32 @@ def max_error(v: Any, v_ref: Any, *, mask: Any = None) -> float:
     return float(np.max(np.abs(a[selected] - b[selected])))
 
 
+def acne_leak(v: Any, v_ref: Any, *, mask: Any = None) -> tuple[float, float]:
+    """Acne and leak rates over all texels (or those in ``mask``).
+
+    *Acne*: the reference sees the texel fully lit (``v_ref >= 0.99``) and
+    ``v`` is darker by more than 0.05 (a surface shadowing itself, a false
+    shadow). *Leak*: the reference has it in umbra (``v_ref <= 0.01``) and
+    ``v`` is lighter by more than 0.05 (light through a closed mesh, a
+    lost occluder). Each count is divided by the texels selected, so the two
+    rates and the shadow error describe the same set.
+
+    Returns
+    -------
+    (float, float)
+        ``(acne, leak)``, each in [0, 1]; ``(0.0, 0.0)`` when no texel is
+        selected.
+    """
+    a, b = _pair(v, v_ref)
+    selected = _mask(mask, a.shape)
+    n = int(np.count_nonzero(selected))
+    if n == 0:
+        return 0.0, 0.0
+    acne = selected & (b >= LIT) & (a < b - ACNE_LEAK_MARGIN)
+    leak = selected & (b <= UMBRA) & (a > b + ACNE_LEAK_MARGIN)
+    return int(np.count_nonzero(acne)) / n, int(np.count_nonzero(leak)) / n
+
+
 def compare(v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD) -> dict[str, float | int]:
     """All metrics at once.
 
@@ -188,14 +237,18 @@ def compare(v: Any, v_ref: Any, *, threshold: float = DEFAULT_THRESHOLD) -> dict
     -------
     dict
         ``error`` (:func:`shadow_error`), ``rmse`` and ``max`` (over all
+        texels), ``acne`` and ``leak`` (:func:`acne_leak`, fractions of all
         texels) as floats, and ``shadow_texels``, the number of texels in the
         reference shadow, as an int.
     """
     a, b = _pair(v, v_ref)
+    acne, leak = acne_leak(a, b)
     return {
         "error": shadow_error(a, b, threshold=threshold),
         "rmse": rmse(a, b),
         "max": max_error(a, b),
+        "acne": acne,
+        "leak": leak,
         "shadow_texels": int(np.count_nonzero(shadow_mask(b, threshold=threshold))),
     }
 
@@ -220,9 +273,20 @@ class ImageComparison:
     matched_fraction : float
         ``matched`` over the pixels where either image hits a surface (1.0
         when neither hits anything).
+    shadow_error : float
+        Mean ``|V - V_ref|`` over the matched pixels the reference shadows
+        (occlusion ``1 - V_ref`` above ``threshold``: umbra and penumbra),
+        the light view's metric; 0.0 when the reference shadows none.
+    shadowed : int
+        Those pixels.
+    acne, leak : float
+        :func:`acne_leak` over the matched pixels: the fractions of them the
+        method darkens where the reference is fully lit, and lightens where
+        it is umbra, by more than 0.05.
     mean_abs, rmse, max_abs, p99_abs : float
         Mean, root-mean-square, largest and 99th-percentile ``|V - V_ref|``
-        over the matched pixels (0.0 when none is matched).
+        over all matched pixels, lit ones included (0.0 when none is
+        matched).
     mismatched : int
         Pixels where either image hits a surface but they are not matched.
     mask : numpy.ndarray, (H, W) bool
@@ -231,6 +295,10 @@ class ImageComparison:
 
     matched: int
     matched_fraction: float
+    shadow_error: float
+    shadowed: int
+    acne: float
+    leak: float
     mean_abs: float
     rmse: float
     max_abs: float
@@ -241,7 +309,8 @@ class ImageComparison:
     def __repr__(self) -> str:
         return (
             f"ImageComparison(matched={self.matched} ({self.matched_fraction:.1%}), "
-            f"mean_abs={self.mean_abs:.4g}, rmse={self.rmse:.4g}, max_abs={self.max_abs:.4g}, "
+            f"shadow_error={self.shadow_error:.4g} over {self.shadowed}, acne={self.acne:.2%}, "
+            f"leak={self.leak:.2%}, mean_abs={self.mean_abs:.4g}, rmse={self.rmse:.4g}, max_abs={self.max_abs:.4g}, "
             f"p99_abs={self.p99_abs:.4g}, mismatched={self.mismatched})"
         )
 
@@ -264,7 +333,9 @@ def _image_fields(image: Any, name: str) -> dict[str, np.ndarray]:
     return fields
 
 
-def compare_images(image: Any, reference: Any, *, position_tol: float = 1e-4) -> ImageComparison:
+def compare_images(
+    image: Any, reference: Any, *, position_tol: float = 1e-4, threshold: float = DEFAULT_THRESHOLD
+) -> ImageComparison:
     """Visibility errors of an eye-view image over the pixels that see the same point.
 
     A pixel is *matched* when both images hit a surface there (``mask``),
@@ -282,6 +353,9 @@ def compare_images(image: Any, reference: Any, *, position_tol: float = 1e-4) ->
         :class:`softshadow.reference.ReferenceImage`.
     position_tol : float, optional
         Tolerance on the positions, relative to the reference depth.
+    threshold : float, optional
+        Occlusion above which a reference pixel is in shadow (as
+        :func:`shadow_mask`).
 
     Returns
     -------
@@ -291,8 +365,10 @@ def compare_images(image: Any, reference: Any, *, position_tol: float = 1e-4) ->
     ------
     ValueError
         On a shape mismatch (naming the argument and field), a negative or
-        non-finite ``position_tol``, or a NaN or inf visibility at a matched pixel.
+        non-finite ``position_tol``, a ``threshold`` outside [0, 1), or a NaN
+        or inf visibility at a matched pixel.
     """
+    threshold = _threshold(threshold)
     tol = float(position_tol)
     if not (np.isfinite(tol) and tol >= 0.0):
         raise ValueError(f"position_tol must be finite and non-negative, got {position_tol}")
@@ -312,9 +388,14 @@ def compare_images(image: Any, reference: Any, *, position_tol: float = 1e-4) ->
         matched = both & (distance <= tol * b["depth"].astype(np.float64))
     either = int(np.count_nonzero(a["mask"] | b["mask"]))
     count = int(np.count_nonzero(matched))
-    errors = np.abs(a["visibility"][matched].astype(np.float64) - b["visibility"][matched].astype(np.float64))
+    va = a["visibility"][matched].astype(np.float64)
+    vb = b["visibility"][matched].astype(np.float64)
+    errors = np.abs(va - vb)
     if not np.all(np.isfinite(errors)):
         raise ValueError("image.visibility or reference.visibility is NaN or inf at a matched pixel")
+    in_shadow = (1.0 - vb) > threshold
+    shadowed = int(np.count_nonzero(in_shadow))
+    acne, leak = acne_leak(va, vb)
     if count:
         mean_abs = float(errors.mean())
         rmse_value = float(np.sqrt(np.mean(errors**2)))
@@ -325,6 +406,10 @@ def compare_images(image: Any, reference: Any, *, position_tol: float = 1e-4) ->
     return ImageComparison(
         matched=count,
         matched_fraction=count / either if either else 1.0,
+        shadow_error=float(errors[in_shadow].mean()) if shadowed else 0.0,
+        shadowed=shadowed,
+        acne=acne,
+        leak=leak,
         mean_abs=mean_abs,
         rmse=rmse_value,
         max_abs=max_abs,

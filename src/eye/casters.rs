@@ -1,83 +1,95 @@
-//! Which meshes can shadow a visible point (Scherzer et al. 2005, §4.1:
+//! Which triangles can shadow a visible point (Scherzer et al. 2005, §4.1:
 //! focusing; the light-view maps hold texels only where a pixel needs them).
 //!
-//! A planar mesh with the whole light strictly on one side of its plane
+//! A triangle with the whole light strictly on one side of its plane
 //! shadows nothing on that side: a segment from a point p with
 //! n·(p − p0) ≥ 0 to a light point y with n·(y − p0) > 0 stays in the
 //! closed half-space and meets the plane at most at p itself. So where
-//! every visible point off the mesh lies on the light's side (a ground or
-//! a wall lit on its visible side), the mesh neither takes texels in the
-//! occluder maps nor widens their extent. The sun is a cone of directions:
-//! its whole disc must lie on the plane's lit side.
+//! every visible point lies on the light's side of a triangle's plane, the
+//! triangle neither takes texels in the occluder maps nor widens their
+//! extent. The sun is a cone of directions: its whole disc must lie on the
+//! plane's lit side.
 //!
-//! Without this, visible ground reaching toward the light's plane widened
-//! the maps' extent to tangents of 40-56 and left the occluders a few
-//! percent of the texels (docs/eye_view.md).
+//! The rule is per triangle, whatever mesh it belongs to and however it is
+//! wound: a floor, a wall or a ceiling built as a closed box (its faces all
+//! have every visible point on their lit side) casts nothing, exactly like
+//! a one-sided quad, and neither do the bottoms of objects resting on it.
+//! Without it, visible ground reaching toward the light's plane widened the
+//! maps' extent to tangents of 40-56 and left the occluders a few percent
+//! of the texels (docs/eye_view.md); a box floor kept that, and its bottom
+//! face became every texel's back layer (docs/accuracy.md).
+//!
+//! Cost: each triangle's plane against the points, in chunks of
+//! consecutive pixels with their bounding boxes: a chunk whose box lies on
+//! the lit side is passed over whole, and a triangle stops at the first
+//! point on its dark side (most casters find one in the first chunks).
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::gbuffer::SceneTriangles;
 use crate::geom::light_space::Light;
 
-/// A plane's thickness, relative to its mesh's size, within which its
-/// vertices count as coplanar (f64 world coordinates).
+/// Thickness of a plane, relative to the scene's size, within which a
+/// point counts as on it (f64 world coordinates: a visible point on a
+/// floor lies on the floor's plane to about 1e-16 of the scene's size).
 const PLANE_TOLERANCE: f64 = 1e-9;
 
-/// Per mesh, whether it can shadow one of `points` (world positions of the
-/// visible pixels, `point_mesh` their meshes) under `light`.
-pub(crate) fn casters(
+/// Consecutive visible points per bounding box.
+const CHUNK: usize = 64;
+
+/// Per triangle of `scene`, whether it can shadow one of `points` (world
+/// positions of the visible pixels) under `light`.
+pub(crate) fn casting_triangles(
     scene: &SceneTriangles,
     light: &Light,
     points: &[[f64; 3]],
-    point_mesh: &[i32],
 ) -> Vec<bool> {
-    let meshes = scene
-        .mesh_of
+    let chunks: Vec<(DVec3, DVec3, &[[f64; 3]])> = points
+        .par_chunks(CHUNK)
+        .map(|c| {
+            let (lo, hi) = c.iter().fold(
+                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+                |(lo, hi), p| {
+                    let p = DVec3::from_array(*p);
+                    (lo.min(p), hi.max(p))
+                },
+            );
+            (lo, hi, c)
+        })
+        .collect();
+    let (lo, hi) = scene
+        .vertices
         .iter()
-        .map(|&m| m as usize + 1)
-        .max()
-        .unwrap_or(0);
-    let mut planes: Vec<Option<(DVec3, DVec3, f64)>> = vec![None; meshes];
-    // The plane of each mesh's largest face.
-    let mut area = vec![0f64; meshes];
-    for (t, &m) in scene.corners.iter().zip(&scene.mesh_of) {
-        let m = m as usize;
-        let c = (t[1] - t[0]).cross(t[2] - t[0]);
-        let a = c.length();
-        if a > area[m] {
-            area[m] = a;
-            planes[m] = Some((t[0], c / a, 0.0));
-        }
-    }
-    // Planar: every corner within the tolerance of that plane (and the
-    // mesh's size, which scales the tolerance).
-    let mut size = vec![0f64; meshes];
-    for (t, &m) in scene.corners.iter().zip(&scene.mesh_of) {
-        let m = m as usize;
-        if let Some((p0, n, off)) = planes[m] {
-            let d = t.iter().map(|c| n.dot(*c - p0).abs()).fold(off, f64::max);
-            size[m] = t.iter().map(|c| (*c - p0).length()).fold(size[m], f64::max);
-            planes[m] = Some((p0, n, d));
-        }
-    }
-    (0..meshes)
-        .map(|m| {
-            let Some((p0, n, off)) = planes[m] else {
-                return true; // no area: nothing to rasterize anyway
-            };
-            let tol = PLANE_TOLERANCE * size[m].max(1e-300);
-            if off > tol {
-                return true; // not planar
+        .copied()
+        .chain(chunks.iter().flat_map(|c| [c.0, c.1]))
+        .fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        );
+    let tol = PLANE_TOLERANCE * (hi - lo).max_element().max(1e-300);
+    scene
+        .corners
+        .par_iter()
+        .with_min_len(256)
+        .map(|t| {
+            let c = (t[1] - t[0]).cross(t[2] - t[0]);
+            let a = c.length();
+            if !(a > 0.0) {
+                return false; // no area: nothing to rasterize
             }
-            // Orient n toward the light; the light must be strictly on that side.
-            let n = match lit_side(light, p0, n, tol) {
-                Some(n) => n,
-                None => return true,
+            // Orient the normal toward the light; the light must be strictly on that side.
+            let Some(n) = lit_side(light, t[0], c / a, tol) else {
+                return true;
             };
-            points
-                .iter()
-                .zip(point_mesh)
-                .any(|(p, &pm)| pm as usize != m && n.dot(DVec3::from_array(*p) - p0) < -tol)
+            let floor = n.dot(t[0]) - tol;
+            chunks.iter().any(|(lo, hi, pts)| {
+                // The box's lowest n·p: each axis at its low or high end.
+                let least = n.x * if n.x >= 0.0 { lo.x } else { hi.x }
+                    + n.y * if n.y >= 0.0 { lo.y } else { hi.y }
+                    + n.z * if n.z >= 0.0 { lo.z } else { hi.z };
+                least < floor && pts.iter().any(|p| n.dot(DVec3::from_array(*p)) < floor)
+            })
         })
         .collect()
 }
@@ -170,10 +182,17 @@ mod tests {
         ];
         let scene = SceneTriangles::new(&meshes).unwrap();
         let pts = [[1.0, 0.0, 1.0], [0.0, 1.2, 0.05]];
-        assert_eq!(casters(&scene, &light(), &pts, &[0, 1]), vec![false, true]);
+        // The ground's two triangles cast nothing; the tetrahedron's top
+        // face (y = 1.5) has the ground point below it, on its dark side.
+        let casts = casting_triangles(&scene, &light(), &pts);
+        assert_eq!(&casts[..2], &[false, false]);
+        assert!(casts[5]);
+        assert_eq!(casts, brute_force(&scene, &pts));
         // A point below the ground (seen from underneath) can be shadowed by it.
         let below = [[1.0, -0.5, 1.0]];
-        assert_eq!(casters(&scene, &light(), &below, &[1]), vec![true, true]);
+        let casts = casting_triangles(&scene, &light(), &below);
+        assert_eq!(&casts[..2], &[true, true]);
+        assert_eq!(casts, brute_force(&scene, &below));
     }
 
     #[test]
@@ -184,6 +203,134 @@ mod tests {
             faces: &gf,
         }];
         let scene = SceneTriangles::new(&meshes).unwrap();
-        assert_eq!(casters(&scene, &light(), &[], &[]), vec![true]);
+        assert_eq!(casting_triangles(&scene, &light(), &[]), vec![true, true]);
+    }
+
+    /// A floor built as a closed box casts nothing on what stands on it,
+    /// however the box is wound and placed, and a box resting on it keeps
+    /// the faces that can shadow the floor (its top and sides) but not its
+    /// bottom.
+    #[test]
+    fn a_box_floor_casts_nothing_and_a_resting_box_drops_its_bottom() {
+        let floor = boxed([-5.0, -0.1, -5.0], [5.0, 0.0, 5.0]);
+        let block = boxed([-0.2, 0.0, -0.2], [0.2, 0.4, 0.2]);
+        // The floor wound inside out: the rule does not read the winding.
+        let flipped: Vec<[u32; 3]> = floor.1.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        for floor_faces in [&floor.1, &flipped] {
+            let meshes = [
+                MeshRef {
+                    vertices: &floor.0,
+                    faces: floor_faces,
+                },
+                MeshRef {
+                    vertices: &block.0,
+                    faces: &block.1,
+                },
+            ];
+            let scene = SceneTriangles::new(&meshes).unwrap();
+            // Floor points around the block (one in its shadow) and on its top.
+            let mut pts: Vec<[f64; 3]> = (0..200)
+                .map(|k| {
+                    let a = k as f64 * 0.1;
+                    [0.3 + 2.0 * a.cos().abs(), 0.0, 2.0 * a.sin()]
+                })
+                .collect();
+            pts.push([0.0, 0.4, 0.0]);
+            let casts = casting_triangles(&scene, &light(), &pts);
+            assert!(
+                casts[..12].iter().all(|&c| !c),
+                "the floor casts: {casts:?}"
+            );
+            let block_casts: Vec<bool> = casts[12..].to_vec();
+            for (t, c) in scene.corners[12..].iter().zip(&block_casts) {
+                let bottom = t.iter().all(|p| p.y == 0.0);
+                assert_eq!(*c, !bottom, "{t:?}");
+            }
+        }
+    }
+
+    /// The rule point by point, without the chunks' boxes: a triangle
+    /// casts when the light is not strictly on one side of its plane, or a
+    /// point lies strictly on the other side.
+    fn brute_force(scene: &SceneTriangles, pts: &[[f64; 3]]) -> Vec<bool> {
+        scene
+            .corners
+            .iter()
+            .map(|t| {
+                let c = (t[1] - t[0]).cross(t[2] - t[0]);
+                match lit_side(&light(), t[0], c.normalize(), 1e-12) {
+                    None => true,
+                    Some(n) => pts
+                        .iter()
+                        .any(|p| n.dot(DVec3::from_array(*p) - t[0]) < -1e-9),
+                }
+            })
+            .collect()
+    }
+
+    /// Many points in many chunks: the boxes pass over nothing the points
+    /// would catch.
+    #[test]
+    fn the_chunks_boxes_agree_with_every_point() {
+        let (tv, tf) = tetra();
+        let (gv, gf) = quad(0.0);
+        let meshes = [
+            MeshRef {
+                vertices: &tv,
+                faces: &tf,
+            },
+            MeshRef {
+                vertices: &gv,
+                faces: &gf,
+            },
+        ];
+        let scene = SceneTriangles::new(&meshes).unwrap();
+        // Points on a spiral around the tetrahedron and on the ground.
+        let pts: Vec<[f64; 3]> = (0..1000)
+            .map(|k| {
+                let a = k as f64 * 0.37;
+                let r = 0.05 + 0.002 * k as f64;
+                [
+                    r * a.cos(),
+                    1.0 + 0.4 * (a * 0.5).sin() * (k % 3) as f64 * 0.5,
+                    r * a.sin(),
+                ]
+            })
+            .collect();
+        for n in [1, 10, 63, 64, 65, 1000] {
+            assert_eq!(
+                casting_triangles(&scene, &light(), &pts[..n]),
+                brute_force(&scene, &pts[..n]),
+                "{n} points"
+            );
+        }
+    }
+
+    /// An axis-aligned closed box from `lo` to `hi`, 12 triangles.
+    fn boxed(lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let v = (0..8)
+            .map(|k| {
+                [
+                    if k & 4 != 0 { hi[0] } else { lo[0] },
+                    if k & 2 != 0 { hi[1] } else { lo[1] },
+                    if k & 1 != 0 { hi[2] } else { lo[2] },
+                ]
+            })
+            .collect();
+        let f = vec![
+            [0, 1, 3],
+            [0, 3, 2],
+            [4, 6, 7],
+            [4, 7, 5],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 3, 7],
+            [2, 7, 6],
+            [0, 2, 6],
+            [0, 6, 4],
+            [1, 5, 7],
+            [1, 7, 3],
+        ];
+        (v, f)
     }
 }

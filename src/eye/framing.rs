@@ -6,7 +6,7 @@
 
 use super::call::EyeCall;
 use super::gbuffer::{GBuffer, SceneTriangles};
-use super::{casters, focus, maps};
+use super::{casters, focus, maps, tangent_plane};
 use crate::backend::Backend;
 use crate::error::Result;
 use crate::geom::light::MapGrid;
@@ -118,16 +118,18 @@ pub fn traced_triangles(f: &Framed, scene: &SceneTriangles) -> Vec<[Vec3; 3]> {
         .collect()
 }
 
-/// The faces of the meshes that can shadow a visible point (`casters.rs`):
-/// the map methods' occluders. Smoothies keep every mesh: their falloff
-/// reads the depth of the receiver behind each silhouette from the map
-/// (without the floor there, its error on contact_boxes went from under
-/// 0.1 to 0.26).
+/// The faces that can shadow a visible point (`casters.rs`): the map
+/// methods' occluders. Points facing away from the whole light are not
+/// asked about: their visibility is 0 whatever shadows them
+/// (`maps::shading_points`, the tangent-plane bound), and a box floor's
+/// sides facing away from the light would otherwise keep its top face a
+/// caster. Smoothies keep every face: their falloff reads the depth of the
+/// receiver behind each silhouette from the map (without the floor there,
+/// its error on contact_boxes went from under 0.1 to 0.26).
 pub fn casting_faces<'s>(
     call: &EyeCall,
     scene: &'s SceneTriangles,
     f: &Framed,
-    g: &GBuffer,
 ) -> Cow<'s, [[u32; 3]]> {
     if matches!(
         call.method.kernel(),
@@ -135,13 +137,23 @@ pub fn casting_faces<'s>(
     ) {
         return Cow::Borrowed(&scene.faces);
     }
-    let point_mesh: Vec<i32> = f.hits.iter().map(|&k| g.mesh_id[k]).collect();
-    let casts = casters::casters(scene, call.light, &f.points, &point_mesh);
+    let half = f.light_size.map(|s| 0.5 * s);
+    let facing: Vec<[f64; 3]> = f
+        .points
+        .par_iter()
+        .zip(&f.normals)
+        .filter(|(p, n)| {
+            let n = glam::Vec3::from_array(**n).as_dvec3();
+            tangent_plane::front_of(&f.space, f.unit, half, DVec3::from_array(**p), n) > 0.0
+        })
+        .map(|(p, _)| *p)
+        .collect();
+    let casts = casters::casting_triangles(scene, call.light, &facing);
     scene
         .faces
         .iter()
-        .zip(&scene.mesh_of)
-        .filter(|(_, &m)| casts[m as usize])
+        .zip(&casts)
+        .filter(|(_, &c)| c)
         .map(|(t, _)| *t)
         .collect::<Vec<_>>()
         .into()

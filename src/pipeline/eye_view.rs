@@ -70,7 +70,7 @@ pub fn render_with<S: EyeStages>(
         }
         sw.lap("shadow");
     } else if !f.points.is_empty() {
-        let casting = casting_faces(call, &scene, &f, &g);
+        let casting = casting_faces(call, &scene, &f);
         let (grid, m) = map_grid(call, &g, &f, &casting, S::BACKEND)?;
         method = m;
         sw.lap("extent");

@@ -470,14 +470,31 @@ def test_rmse_max_and_masks():
 
 def test_compare():
     result = metrics.compare(V_EST, V_REF)
-    assert set(result) == {"error", "rmse", "max", "shadow_texels"}
+    assert set(result) == {"error", "rmse", "max", "acne", "leak", "shadow_texels"}
+    assert result["acne"] == pytest.approx(2 / 6) and result["leak"] == pytest.approx(1 / 6)
     assert result["error"] == pytest.approx(0.2 / 3)
     assert result["rmse"] == pytest.approx(metrics.rmse(V_EST, V_REF))
     assert result["max"] == pytest.approx(0.4995)
     assert result["shadow_texels"] == 3 and isinstance(result["shadow_texels"], int)
 
 
-@pytest.mark.parametrize("function", [metrics.shadow_error, metrics.rmse, metrics.max_error, metrics.compare])
+def test_acne_and_leak_rates_hand_computed():
+    # Lit in the reference: (0, 0) and (0, 1) darkened by 0.3 and 0.4995
+    # (acne), (1, 1) not; umbra: (1, 0) lightened by 0.1 (a leak).
+    assert metrics.acne_leak(V_EST, V_REF) == pytest.approx((2 / 6, 1 / 6))
+    # A margin of exactly 0.05 is not acne, a hair more is.
+    ref = np.ones((1, 2))
+    assert metrics.acne_leak(np.array([[0.95, 0.9499]]), ref) == (0.5, 0.0)
+    # Over a mask: the rate is of the texels selected.
+    mask = np.array([[False, False, False], [True, True, False]])
+    assert metrics.acne_leak(V_EST, V_REF, mask=mask) == (0.0, 0.5)
+    assert metrics.acne_leak(V_EST, V_REF, mask=np.zeros((2, 3), dtype=bool)) == (0.0, 0.0)
+    assert metrics.acne_leak(V_REF, V_REF) == (0.0, 0.0)
+
+
+@pytest.mark.parametrize(
+    "function", [metrics.shadow_error, metrics.rmse, metrics.max_error, metrics.compare, metrics.acne_leak]
+)
 def test_metrics_reject_bad_input(function):
     with_nan = V_EST.copy()
     with_nan[0, 1] = np.nan

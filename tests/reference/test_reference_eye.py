@@ -466,8 +466,9 @@ def test_compare_identical_images():
     result = metrics.compare_images(image, synthetic_image())
     assert result.matched == 32 and result.matched_fraction == 1.0 and result.mismatched == 0
     assert result.mean_abs == result.rmse == result.max_abs == result.p99_abs == 0.0
+    assert result.shadow_error == result.acne == result.leak == 0.0 and result.shadowed == 31
     np.testing.assert_array_equal(result.mask, image.mask)
-    assert repr(result).startswith("ImageComparison(matched=32") and len(repr(result)) < 200
+    assert repr(result).startswith("ImageComparison(matched=32") and len(repr(result)) < 250
 
 
 def test_compare_errors_and_matching():
@@ -499,6 +500,32 @@ def test_compare_errors_and_matching():
     assert result.p99_abs == pytest.approx(0.25, abs=1e-7)
     # A looser tolerance matches the moved pixel too.
     assert metrics.compare_images(image, reference_image, position_tol=1e-3).matched == 31
+
+
+def test_compare_images_reports_the_shadowed_pixels_acne_and_leaks():
+    # The reference: 32 floor pixels with V_ref from 0 to 1; 0 is umbra, the
+    # last one (1.0) fully lit.
+    reference_image, image = synthetic_image(), synthetic_image()
+    v_ref = reference_image.visibility[reference_image.mask].astype(np.float64)
+    image.visibility = image.visibility.copy()
+    # Lighten the umbra pixel by 0.2 (a leak), darken the lit one by 0.1
+    # (acne) and one penumbra pixel by 0.04 (neither).
+    rows, cols = np.nonzero(reference_image.mask)
+    image.visibility[rows[0], cols[0]] += 0.2
+    image.visibility[rows[-1], cols[-1]] -= 0.1
+    image.visibility[rows[10], cols[10]] -= 0.04
+    result = metrics.compare_images(image, reference_image)
+    shadowed = (1.0 - v_ref) > 1e-3
+    assert result.shadowed == int(shadowed.sum()) == 31
+    assert result.shadow_error == pytest.approx((0.2 + 0.04) / 31, abs=1e-7)
+    # The mean over every matched pixel is lower: the lit one counts too.
+    assert result.mean_abs == pytest.approx(0.34 / 32, abs=1e-7)
+    assert result.acne == pytest.approx(1 / 32) and result.leak == pytest.approx(1 / 32)
+    assert "shadow_error=" in repr(result) and "acne=3.12%" in repr(result)
+    # A stricter threshold leaves the shadow error over fewer pixels.
+    assert metrics.compare_images(image, reference_image, threshold=0.5).shadowed == int(((1 - v_ref) > 0.5).sum())
+    with pytest.raises(ValueError, match="threshold"):
+        metrics.compare_images(image, reference_image, threshold=1.0)
 
 
 def test_compare_shape_mismatch_names_the_argument():

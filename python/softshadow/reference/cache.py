@@ -49,3 +49,35 @@ def cached_reference_map(
     np.save(tmp, ref)
     tmp.replace(path)
     return ref
+
+
+def cached_reference_image(
+    name: str, scene: Any, light: Any, camera: Any, *, samples: int, cache: Path, seed: int = 0
+) -> Any:
+    """``render_visibility(scene, light, camera, samples, seed=seed)`` (a
+    :class:`softshadow.reference.ReferenceImage`), from ``cache`` when it
+    holds one for the same meshes, light, camera, samples and seed; ``name``
+    labels the file. The cached image keeps the timings of the run that
+    made it."""
+    from .eye import ReferenceImage, _scene_meshes, render_visibility
+
+    meshes = [part for _, v, f in _scene_meshes(scene) for part in (v, f)]
+    parts: list[object] = [name, repr(light), repr(camera), samples, seed, *meshes]
+    path = cache / f"eye-{name}-{key(*parts)}.npz"
+    fields = ("visibility", "mask", "depth", "position", "normal", "mesh_id")
+    scalars = ("samples", "time_first_hits", "time_shadow", "rays")
+    if path.exists():
+        with np.load(path) as data:
+            return ReferenceImage(
+                **{f: data[f] for f in fields},
+                samples=int(data["samples"]),
+                time_first_hits=float(data["time_first_hits"]),
+                time_shadow=float(data["time_shadow"]),
+                rays=int(data["rays"]),
+            )
+    ref = render_visibility(scene, light, camera, samples, seed=seed)
+    cache.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(f".{os.getpid()}.tmp.npz")
+    np.savez_compressed(tmp, **{f: getattr(ref, f) for f in fields + scalars})
+    tmp.replace(path)
+    return ref

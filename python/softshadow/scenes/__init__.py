@@ -8,6 +8,10 @@
   light at height 4 (``SCENES``, ``HARD_SURFACES``).
 * :mod:`.eye_view`: scenes that shadow themselves, seen through a camera,
   each builder returning ``(Scene, light, Camera)`` (``EYE_SCENES``).
+* :mod:`.as_built`: eye-view scenes built the way users build them (closed
+  box floors and walls, thin panels, open and damaged meshes, files through
+  ``trimesh.load``, 100 000+ triangles), in a calibration set and a
+  held-out set (``CALIBRATION``, ``HELD_OUT``; docs/accuracy.md).
 
 The primitives and the light-view builders are re-exported here
 (``softshadow.scenes.bunny_floating()``, ``softshadow.scenes.quad(...)``);
@@ -19,7 +23,7 @@ view's.
 
 from __future__ import annotations
 
-from . import eye_view, light_view, primitives
+from . import as_built, eye_view, light_view, primitives
 from .light_view import (
     HARD_SURFACES,
     LIGHT_HEIGHT,
@@ -42,6 +46,7 @@ __all__ = [
     "HARD_SURFACES",
     "LIGHT_HEIGHT",
     "SCENES",
+    "as_built",
     "box",
     "bunny_floating",
     "bunny_mesh",
