@@ -110,7 +110,8 @@ impl ExactShading {
             ax_rec_y: grid.width as u32,
             ..Default::default()
         };
-        light::set_samples(&mut params, light_shape, samples);
+        let r = light::ray_fields(light_shape, samples);
+        (params.na, params.nb, params.size_x, params.size_y) = (r.na, r.nb, r.size_x, r.size_y);
         ExactShading {
             params,
             samples: params.na * params.nb,

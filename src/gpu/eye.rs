@@ -437,7 +437,8 @@ fn exact_visibility(
         t1: 1.0 - RAY_EPS,
         ..Default::default()
     };
-    light::set_samples(&mut params, light_shape, samples);
+    let r = light::ray_fields(light_shape, samples);
+    (params.na, params.nb, params.size_x, params.size_y) = (r.na, r.nb, r.size_x, r.size_y);
     let (na, nb) = (params.na, params.nb);
     let bytes = n as u64 * 4;
     let out = with_error_scopes(g, || {

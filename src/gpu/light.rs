@@ -7,16 +7,27 @@
 //! edges scaled by 2/sx. Each value is the f32 the CPU kernels hold (one
 //! rounding from f64), so both backends start from the same bits.
 
-use super::exact::ExactParams;
 use super::gather::GatherParams;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 
-/// Sets the ray casters' sample pattern: `samples` strata over `light`.
-pub(super) fn set_samples(p: &mut ExactParams, light: LightShape, samples: u32) {
+/// The ray casters' fields (`ExactParams`' na, nb, size_x, size_y).
+pub(super) struct RayFields {
+    pub na: u32,
+    pub nb: u32,
+    pub size_x: f32,
+    pub size_y: f32,
+}
+
+/// The ray casters' sample pattern: `samples` strata over `light`.
+pub(super) fn ray_fields(light: LightShape, samples: u32) -> RayFields {
     let s = light.samples(samples);
-    (p.na, p.nb) = s.grid;
-    [p.size_x, p.size_y] = s.size;
+    RayFields {
+        na: s.grid.0,
+        nb: s.grid.1,
+        size_x: s.size[0],
+        size_y: s.size[1],
+    }
 }
 
 /// Sets the map kernels' half-light scales, and `wx`, the occluder
