@@ -210,7 +210,7 @@ fn bench_kernels(c: &mut Criterion) {
     let inputs = ShadowInputs {
         grid: maps.grid,
         occluder_grid: maps.occluder_grid,
-        light_size: s.rect.size,
+        light_shape: s.rect.shape(),
         receiver: &maps.receiver,
         occluder_layers: vec![front, back],
         occluder_triangles: Some(&triangles),

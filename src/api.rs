@@ -13,7 +13,8 @@ use crate::backend::{Backend, BackendChoice};
 use crate::error::{Error, Result};
 use crate::eye::{EyeCall, EyeImage, Lighting, Shaded};
 use crate::frame::{orthographic_maps, MapSettings, ShadowResult};
-use crate::geom::light::{check_light_size, is_point, MapGrid};
+use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::mesh::MeshRef;
 use crate::methods::config::{check_resolution, AutoConfig, CallContext};
@@ -97,7 +98,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         call.backend,
         &call.method,
         gpu,
-        !is_point(call.light.kernel_size()),
+        !call.light.kernel_shape().is_point(),
     );
     let ctx = CallContext { backend, ..ctx };
     let target = match call.method {
@@ -213,9 +214,9 @@ pub struct DepthCall<'a> {
     pub grid: MapGrid,
     /// The occluder maps' grid (same extent, their own resolution).
     pub occluder_grid: MapGrid,
-    /// A rectangle's (width, height) in the depths' unit; ignored for
+    /// The light's shape (a rectangle's) in the depths' unit; ignored for
     /// orthographic maps.
-    pub light_size: [f64; 2],
+    pub light_shape: LightShape,
     /// `Some(angular_size)`: orthographic maps of a directional light of
     /// that angular size (degrees): depths from the depth origin, extents
     /// in world units (see `geom/sun.rs`).
@@ -254,12 +255,12 @@ pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
             )
         })
         .transpose()?;
-    let (grid, occluder_grid, light_size) = match &ortho {
+    let (grid, occluder_grid, light_shape) = match &ortho {
         Some((_, g, og, size, _)) => (*g, *og, *size),
         None => (
             call.grid,
             call.occluder_grid,
-            check_light_size("light_size", call.light_size)?,
+            call.light_shape.check("light_size")?,
         ),
     };
     let (front, receiver, back) = match &ortho {
@@ -278,13 +279,13 @@ pub fn shadow_map_from_depth(call: &DepthCall) -> Result<Run<DepthOutput>> {
         backend: Backend::Gpu,
         ..ctx
     };
-    let backend = pick(call.backend, &call.method, gpu, !is_point(light_size));
+    let backend = pick(call.backend, &call.method, gpu, !light_shape.is_point());
     let method = call.method.resolve(&CallContext { backend, ..ctx })?;
     let kernel = method.kernel();
     let maps = pipeline::DepthMaps {
         grid: &grid,
         occluder_grid: og,
-        light_size,
+        light_shape,
         front,
         back,
         receiver,

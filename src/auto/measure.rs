@@ -91,7 +91,7 @@ pub(crate) fn layer_tries(
             &ShadowInputs {
                 grid,
                 occluder_grid,
-                light_size: f.light_size,
+                light_shape: f.light_shape,
                 receiver: &receiver,
                 occluder_layers: layers,
                 occluder_triangles: None,
@@ -193,7 +193,7 @@ pub(crate) fn scene_stats(f: &FramedScene, resolution: (usize, usize)) -> SceneS
     SceneStats {
         resolution,
         extent: [f.grid.tx, f.grid.ty],
-        light_size: f.light_size,
+        light_shape: f.light_shape,
         occ_w_near: w(oz0),
         occ_w_far: w(oz1),
         rec_w_near: w(rz0.max(0.0)),

@@ -27,6 +27,7 @@
 //! is kept when nothing better fits), and each more accurate setting's time
 //! is predicted from it by the largest ratio measured on the study's scenes.
 
+use crate::geom::light_shape::LightShape;
 use crate::methods::config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 use crate::methods::shadow_mapping::config::Real;
 use crate::methods::target::Target;
@@ -37,7 +38,7 @@ pub struct SceneStats {
     /// Output (W, H) and tangent half-extents.
     pub resolution: (usize, usize),
     pub extent: [f64; 2],
-    pub light_size: [f64; 2],
+    pub light_shape: LightShape,
     /// 1/depth of the nearest and farthest occluder vertex.
     pub occ_w_near: f64,
     pub occ_w_far: f64,
@@ -61,7 +62,7 @@ impl SceneStats {
     }
 
     fn light(&self) -> f64 {
-        self.light_size[0].max(self.light_size[1])
+        self.light_shape.largest_width()
     }
 
     /// The widest penumbra, in output texels.
@@ -637,7 +638,7 @@ mod tests {
         SceneStats {
             resolution: (256, 256),
             extent: [0.35, 0.35],
-            light_size: [1.0, 1.0],
+            light_shape: LightShape::rect([1.0, 1.0]),
             occ_w_near: 1.0 / 2.0,
             occ_w_far: 1.0 / 2.9,
             rec_w_near: 0.25,
@@ -652,7 +653,7 @@ mod tests {
     fn a_tiny_light_is_a_point_and_a_big_one_is_not() {
         let mut s = stats();
         assert!(!plan(&s, &Target::default(), None).hard);
-        s.light_size = [1e-4, 1e-4];
+        s.light_shape = LightShape::rect([1e-4, 1e-4]);
         assert!(plan(&s, &Target::default(), None).hard);
     }
 
@@ -676,7 +677,7 @@ mod tests {
         let mut s = stats();
         // (1/2 - 1/4) / (0.7 / 256) = 91 texels.
         assert_eq!(hierarchy(&s), Some(true));
-        s.light_size = [0.5, 0.5];
+        s.light_shape = LightShape::rect([0.5, 0.5]);
         assert_eq!(hierarchy(&s), Some(false));
     }
 

@@ -27,6 +27,7 @@
 use crate::error::Result;
 use crate::geom::extent::{fit_extent_within, ReceiverBounds};
 use crate::geom::light::MAX_EXTENT;
+use crate::geom::light_shape::LightShape;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -67,7 +68,7 @@ impl VisibleBounds {
 pub fn focused_extent(
     occluders: &[DVec3],
     points: &VisibleBounds,
-    light_size: [f64; 2],
+    light_shape: LightShape,
 ) -> Result<[f64; 2]> {
     let cut = points.z_min * NEAREST_OCCLUDER;
     let occ: Vec<DVec3> = occluders
@@ -92,7 +93,7 @@ pub fn focused_extent(
     // occluder's reach finds no texel near it and is lit, so points need no
     // texels of their own (visible ground reaching toward the light's plane
     // once widened the maps to tangents of 40-56, docs/eye_view.md).
-    let e = fit_extent_within(&occ, &points.bounds, light_size)?;
+    let e = fit_extent_within(&occ, &points.bounds, light_shape)?;
     Ok(e.map(|t| (t * 1.01).min(MAX_EXTENT)))
 }
 
@@ -169,7 +170,7 @@ mod tests {
         // An occluder touching the light's plane would need an unbounded map.
         let occ = [DVec3::new(0.0, 0.0, 1e-12), DVec3::new(0.05, 0.05, 0.5)];
         let vis = VisibleBounds::of(&pts, 1.0).unwrap();
-        let e = focused_extent(&occ, &vis, [0.5, 0.5]).unwrap();
+        let e = focused_extent(&occ, &vis, LightShape::rect([0.5, 0.5])).unwrap();
         assert!(e[0] >= 0.1 && e[1] >= 0.05, "{e:?}");
         assert!(e[0] < 0.25 * 16.0 + 0.2, "{e:?}");
     }

@@ -10,9 +10,10 @@ use super::{casters, focus, maps, tangent_plane};
 use crate::backend::Backend;
 use crate::error::Result;
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::sun::SunSpace;
-use crate::geom::units::{check_unit, depth_unit, light_size_in};
+use crate::geom::units::{check_unit, depth_unit};
 use crate::methods::config::CallContext;
 use crate::methods::MethodConfig;
 use glam::{DVec3, Vec3};
@@ -31,9 +32,9 @@ pub struct Framed {
     pub space: LightSpace,
     /// The visible points in light space (not unit-scaled).
     pub pts_ls: Vec<DVec3>,
-    /// The kernels' depth unit, and the light's size in it.
+    /// The kernels' depth unit, and the light's shape in it.
     pub unit: f64,
-    pub light_size: [f64; 2],
+    pub light_shape: LightShape,
     /// Every vertex in kernel light space, unit-scaled (the faces into them
     /// are `SceneTriangles::faces`).
     pub verts: Vec<DVec3>,
@@ -68,7 +69,7 @@ pub fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Fram
         .collect();
     let unit = depth_unit(pts_ls.par_iter().map(|q| q.z).reduce(|| 0.0, f64::max));
     check_unit("meshes", unit)?;
-    let light_size = light_size_in("size", space.size(), unit)?;
+    let light_shape = space.shape().in_unit("size", unit)?;
     let verts: Vec<DVec3> = scene
         .vertices
         .par_iter()
@@ -81,7 +82,7 @@ pub fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Fram
         space,
         pts_ls,
         unit,
-        light_size,
+        light_shape,
         verts,
     })
 }
@@ -190,7 +191,7 @@ pub fn map_grid(
     };
     let extent = match &visible {
         None => [1.0, 1.0],
-        Some(v) => focus::focused_extent(&occluders, v, f.light_size)?,
+        Some(v) => focus::focused_extent(&occluders, v, f.light_shape)?,
     };
     // The median over a regular subsample of at most FOOTPRINT_SAMPLES
     // points: the resolution is a rule of thumb, not worth a full select.

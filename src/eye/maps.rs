@@ -26,6 +26,7 @@
 use super::tangent_plane;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::methods::{Input, LightPoint, Method, ShadowInputs};
 use crate::raster::Prepared;
@@ -159,14 +160,13 @@ pub(crate) const EMPTY_POINT: LightPoint = LightPoint {
 pub fn shading_points(
     space: &LightSpace,
     unit: f64,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     grid: &MapGrid,
     points: &[[f64; 3]],
     pts_ls: &[DVec3],
     normals: &[[f32; 3]],
     bias: &Bias,
 ) -> ShadingPoints {
-    let half = light_size.map(|s| 0.5 * s);
     let inv_unit = 1.0 / unit;
     let mut out = ShadingPoints {
         points: vec![EMPTY_POINT; points.len()],
@@ -180,7 +180,7 @@ pub fn shading_points(
         .for_each(|((lp, b), ((p, q), n))| {
             let p = DVec3::from_array(*p);
             let n = glam::Vec3::from_array(*n).as_dvec3();
-            let front = tangent_plane::front_of(space, unit, half, p, n);
+            let front = tangent_plane::front_of(space, unit, light_shape, p, n);
             if front <= 0.0 {
                 return;
             }
@@ -206,7 +206,7 @@ pub fn shading_points(
 pub(crate) fn shade(
     space: &LightSpace,
     unit: f64,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     tris: &LightTriangles,
     grid: MapGrid,
     passes: u32,
@@ -220,13 +220,20 @@ pub(crate) fn shade(
     let mut layers = occluder_layers(&grid, tris, passes);
     sw.lap("raster_occluders");
     let sp = shading_points(
-        space, unit, light_size, &grid, points, pts_ls, normals, bias,
+        space,
+        unit,
+        light_shape,
+        &grid,
+        points,
+        pts_ls,
+        normals,
+        bias,
     );
     sw.lap("bias");
     let inputs = ShadowInputs {
         grid,
         occluder_grid: grid,
-        light_size,
+        light_shape,
         receiver: &[],
         occluder_layers: layers.iter().map(|l| l.as_slice()).collect(),
         occluder_triangles: None,

@@ -11,8 +11,9 @@
 //! moved to the kernels' light space (`geom/light_space.rs`), where the rays
 //! are traced exactly as the light-view `exact` traces them.
 
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
-use crate::methods::exact::{sample_grid, Bvh};
+use crate::methods::exact::Bvh;
 use crate::methods::shadow_rays::{tile_order, visibilities, RayOrigin, Sampling};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -102,7 +103,7 @@ impl RayOrigin for RayStart {
 /// indices of `starts`) is the order to trace them in: neighbours next to
 /// each other (`tiled`), so that packets are coherent.
 pub fn visibility(
-    light_size: [f64; 2],
+    light_shape: LightShape,
     triangles: Vec<[Vec3; 3]>,
     starts: &[Option<RayStart>],
     order: &[usize],
@@ -110,8 +111,7 @@ pub fn visibility(
 ) -> Vec<f32> {
     let bvh = Bvh::build(triangles);
     let s = Sampling {
-        grid: sample_grid(samples, light_size),
-        size: light_size.map(|s| s as f32),
+        light: light_shape.samples(samples),
         t0: 0.0,
     };
     visibilities(&bvh, starts, order, &s, 0.0)

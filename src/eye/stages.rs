@@ -105,7 +105,7 @@ impl EyeStages for CpuEye {
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
         let order = rays::tiled(&f.hits, camera.width, camera.height);
         Ok(rays::visibility(
-            f.light_size,
+            f.light_shape,
             tris,
             &starts,
             &order,
@@ -125,7 +125,7 @@ impl EyeStages for CpuEye {
         maps::shade(
             &f.space,
             f.unit,
-            f.light_size,
+            f.light_shape,
             tris,
             grid,
             method.passes(),

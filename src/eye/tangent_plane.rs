@@ -18,15 +18,19 @@
 //! a clamped linear function, in closed form.
 
 use super::rays::plane_side;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use glam::DVec3;
 
 /// The fraction of the light in front of the tangent plane at `p` (normal
-/// `n`, world; `half` the light's half-size in kernel units, unit-scaled):
-/// 0 at or behind a rectangle's plane.
+/// `n`, world; `light` in kernel units, unit-scaled): 0 at or behind a
+/// rectangle's plane. The clipping of the light by a plane: each shape its
+/// own closed form.
 #[inline]
-pub fn front_of(space: &LightSpace, unit: f64, half: [f64; 2], p: DVec3, n: DVec3) -> f64 {
-    plane_side(space, unit, p, n).map_or(0.0, |s| front_fraction(s, half))
+pub fn front_of(space: &LightSpace, unit: f64, light: LightShape, p: DVec3, n: DVec3) -> f64 {
+    plane_side(space, unit, p, n).map_or(0.0, |s| match light {
+        LightShape::Rect { .. } => front_fraction(s, light.half_extent()),
+    })
 }
 
 /// ∫_0^t clamp(s, 0, h) ds for any t (the antiderivative of the clamp).

@@ -3,10 +3,11 @@
 //! sun's) as the kernels read them. Both backends start from these.
 
 use crate::error::{Error, Result};
-use crate::geom::light::{check_light_size, MapGrid};
+use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::geom::sun::{DirectionalLight, SunSpace};
-use crate::geom::units::{farthest, light_size_in, scaled_map};
+use crate::geom::units::{farthest, scaled_map};
 use crate::methods::{Input, Method};
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -27,17 +28,17 @@ pub fn check_depth(arg: &str, depth: &[f32]) -> Result<()> {
 }
 
 /// Checks the inputs of `from_depth` (both backends): the light size, a
-/// method that reads maps, each map's size and depths. Returns the light size.
+/// method that reads maps, each map's size and depths. Returns the light's shape.
 pub(crate) fn check_depth_inputs(
     grid: &MapGrid,
     occluder_grid: &MapGrid,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     front: &[f32],
     back: Option<&[f32]>,
     receiver: &[f32],
     method: Method,
-) -> Result<[f64; 2]> {
-    let light_size = check_light_size("light_size", light_size)?;
+) -> Result<LightShape> {
+    let light_shape = light_shape.check("light_size")?;
     if !method.reads_input(Input::OccluderLayers) {
         return Err(Error::invalid(
             "method",
@@ -59,14 +60,14 @@ pub(crate) fn check_depth_inputs(
             check_depth(arg, d)?;
         }
     }
-    Ok(light_size)
+    Ok(light_shape)
 }
 
 /// The user's depth maps and light size in the kernels' depth unit (see
 /// units.rs), shared by both backends; the maps are copied only when the unit
 /// is not 1.
 pub struct DepthInUnit<'a> {
-    pub light_size: [f64; 2],
+    pub light_shape: LightShape,
     pub front: Cow<'a, [f32]>,
     pub back: Option<Cow<'a, [f32]>>,
     pub receiver: Cow<'a, [f32]>,
@@ -75,13 +76,13 @@ pub struct DepthInUnit<'a> {
 impl<'a> DepthInUnit<'a> {
     pub fn new(
         unit: f64,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         front: &'a [f32],
         back: Option<&'a [f32]>,
         receiver: &'a [f32],
     ) -> Result<DepthInUnit<'a>> {
         Ok(DepthInUnit {
-            light_size: light_size_in("light_size", light_size, unit)?,
+            light_shape: light_shape.in_unit("light_size", unit)?,
             front: scaled_map(front, unit),
             back: back.map(|b| scaled_map(b, unit)),
             receiver: scaled_map(receiver, unit),
@@ -100,7 +101,7 @@ pub fn orthographic_maps(
     back: Option<&[f32]>,
     receiver: &[f32],
     angular_size: [f64; 2],
-) -> Result<(SunSpace, MapGrid, MapGrid, [f64; 2], Vec<Vec<f32>>)> {
+) -> Result<(SunSpace, MapGrid, MapGrid, LightShape, Vec<Vec<f32>>)> {
     let sun = DirectionalLight::new([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], angular_size)?;
     let maps: Vec<(&str, &[f32])> = [("occluder_depth", front), ("receiver_depth", receiver)]
         .into_iter()
@@ -135,7 +136,7 @@ pub fn orthographic_maps(
         space,
         grid(grids.0)?,
         grid(grids.1)?,
-        sun.kernel_size(),
+        sun.kernel_shape(),
         kernel,
     ))
 }

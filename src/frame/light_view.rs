@@ -5,9 +5,10 @@
 use crate::error::{Error, Result};
 use crate::geom::extent::fit_extent;
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
-use crate::geom::units::{check_lateral, check_unit, depth_unit, light_size_in};
+use crate::geom::units::{check_lateral, check_unit, depth_unit};
 use crate::memory::{check_fits, map_bytes};
 use crate::methods::{Input, Method, MethodConfig};
 use crate::raster::near_plane;
@@ -28,8 +29,8 @@ pub struct FramedScene {
     /// The depth unit (a power of two): maps go back to the user's units
     /// by multiplying with it.
     pub unit: f64,
-    /// The light's size in that unit.
-    pub light_size: [f64; 2],
+    /// The light's shape in that unit.
+    pub light_shape: LightShape,
 }
 
 /// Checks the input, moves the meshes to light space and fits the grids
@@ -84,7 +85,7 @@ pub(crate) fn frame_scene(
     // the user's units at the end.
     let unit = depth_unit(rec_ls.iter().fold(0f64, |m, q| m.max(q.z)));
     check_unit("receivers", unit)?;
-    let light_size = light_size_in("size", light.size(), unit)?;
+    let light_shape = light.shape().in_unit("size", unit)?;
     if unit != 1.0 {
         for q in occ_ls.iter_mut().chain(rec_ls.iter_mut()) {
             *q /= unit;
@@ -95,7 +96,7 @@ pub(crate) fn frame_scene(
     sw.lap("transform");
     let extent = match s.extent {
         Some(e) => e,
-        None => fit_extent(&occ_ls, &rec_ls, light_size)?,
+        None => fit_extent(&occ_ls, &rec_ls, light_shape)?,
     };
     let grid = MapGrid::new(s.width, s.height, extent)?;
     let occluder_grid = MapGrid::new(ow, oh, extent)?;
@@ -108,7 +109,7 @@ pub(crate) fn frame_scene(
         occluder_grid,
         near,
         unit,
-        light_size,
+        light_shape,
     })
 }
 

@@ -1,9 +1,9 @@
 //! Fitting the light-view map to where shadows can fall (`extent=None`).
 //!
-//! A light point at tangent offset X_L (|X_L| <= Lx/2, on the light's plane)
+//! A light point at tangent offset X_L (|X_L| <= hx, the half-extent of the light's shape, light_shape.rs)
 //! and an occluder point at tangent x_O, depth Z_O cast a shadow on depth z_R
 //! at tangent  x_O + X_L (1/z_R - 1/Z_O)  (seen from the light's center). So
-//! every shadow point lies within  |x| <= |x_O| + Lx/2 (1/Z_O - 1/z_far)  where
+//! every shadow point lies within  |x| <= |x_O| + hx (1/Z_O - 1/z_far)  where
 //! z_far is the farthest receiver depth. Over a triangle |x| is convex and 1/Z
 //! is linear in the map's plane, so the bound's maximum is at a vertex: the
 //! extent is the largest bound over occluder vertices (and likewise in y). It
@@ -12,10 +12,11 @@
 //! the occluders' own (their vertices' largest |x|) where that is wider: the
 //! map methods see only occluders inside the map, and one just outside the
 //! receivers can shadow them. Never wider than the receivers' extent plus
-//! the largest penumbra reach Lx/2 (1/Z_O - 1/z_far): occluder points farther
+//! the largest penumbra reach hx (1/Z_O - 1/z_far): occluder points farther
 //! out cannot shadow a receiver.
 
 use crate::error::{Error, Result};
+use crate::geom::light_shape::LightShape;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -83,19 +84,15 @@ impl ReceiverBounds {
 
 /// Tangent half-extents (tx, ty) that contain every umbra and penumbra the
 /// occluders can cast on the receivers.
-pub fn fit_extent(
-    occluders: &[DVec3],
-    receivers: &[DVec3],
-    light_size: [f64; 2],
-) -> Result<[f64; 2]> {
-    fit_extent_within(occluders, &ReceiverBounds::of(receivers), light_size)
+pub fn fit_extent(occluders: &[DVec3], receivers: &[DVec3], light: LightShape) -> Result<[f64; 2]> {
+    fit_extent_within(occluders, &ReceiverBounds::of(receivers), light)
 }
 
 /// `fit_extent` for receivers known by their bounds.
 pub fn fit_extent_within(
     occluders: &[DVec3],
     receivers: &ReceiverBounds,
-    light_size: [f64; 2],
+    light: LightShape,
 ) -> Result<[f64; 2]> {
     if let Some(q) = occluders.iter().find(|q| !(q.z > 0.0)) {
         return Err(Error::invalid(
@@ -119,9 +116,11 @@ pub fn fit_extent_within(
     // The occluders' own tangent extent, and their largest penumbra reach.
     let mut own = [0f64; 2];
     let mut reach = [0f64; 2];
+    // The light's half-extents h: a penumbra reaches h (1/z - 1/z_far).
+    let h = light.half_extent();
     for q in occluders {
         let pen = (1.0 / q.z - inv_far).max(0.0);
-        let r = [0.5 * light_size[0] * pen, 0.5 * light_size[1] * pen];
+        let r = [h[0] * pen, h[1] * pen];
         let t = [(q.x / q.z).abs(), (q.y / q.z).abs()];
         for a in 0..2 {
             ext[a] = ext[a].max(t[a] + r[a]);
@@ -146,19 +145,19 @@ mod tests {
         // Plate of half-size 0.25 at depth 2, receivers at depth 4 reaching far.
         let occ = [DVec3::new(0.25, -0.25, 2.0), DVec3::new(-0.25, 0.25, 2.0)];
         let rec = [DVec3::new(-40.0, -40.0, 4.0), DVec3::new(40.0, 40.0, 4.0)];
-        let e = fit_extent(&occ, &rec, [1.0, 0.5]).unwrap();
+        let e = fit_extent(&occ, &rec, LightShape::rect([1.0, 0.5])).unwrap();
         // |x| = 0.125; penumbra 0.5 * (1/2 - 1/4) = 0.125 -> 0.25; y: 0.125 + 0.0625.
         assert!((e[0] - 0.25).abs() < 1e-15 && (e[1] - 0.1875).abs() < 1e-15);
         // Small receivers cut it, but not below the occluders' own extent
         // (0.125: the map methods see only occluders inside the map, and
         // this one's penumbra reaches the receivers).
         let rec = [DVec3::new(-0.4, -0.4, 4.0), DVec3::new(0.4, 0.4, 4.0)];
-        let e = fit_extent(&occ, &rec, [1.0, 0.5]).unwrap();
+        let e = fit_extent(&occ, &rec, LightShape::rect([1.0, 0.5])).unwrap();
         assert!((e[0] - 0.125).abs() < 1e-15, "{e:?}");
         // Smaller receivers still: no wider than them plus the reach (an
         // occluder point farther out cannot shadow them).
         let rec = [DVec3::new(-0.1, -0.1, 4.0), DVec3::new(0.1, 0.1, 4.0)];
-        let e = fit_extent(&occ, &rec, [0.2, 0.2]).unwrap();
+        let e = fit_extent(&occ, &rec, LightShape::rect([0.2, 0.2])).unwrap();
         assert!((e[0] - (0.025 + 0.025)).abs() < 1e-15, "{e:?}");
     }
 
@@ -166,11 +165,11 @@ mod tests {
     fn occluders_behind_the_light_need_an_explicit_extent() {
         let occ = [DVec3::new(0.0, 0.0, -1.0)];
         let rec = [DVec3::new(0.0, 0.0, 4.0)];
-        assert!(fit_extent(&occ, &rec, [1.0, 1.0]).is_err());
+        assert!(fit_extent(&occ, &rec, LightShape::rect([1.0, 1.0])).is_err());
         assert!(fit_extent(
             &[DVec3::new(0.0, 0.0, 1.0)],
             &[DVec3::new(0.0, 0.0, -4.0)],
-            [1.0, 1.0]
+            LightShape::rect([1.0, 1.0])
         )
         .is_err());
     }

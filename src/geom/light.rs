@@ -15,6 +15,7 @@
 //! shape in f32); maps and kernels work in f32 once coordinates are light-relative.
 
 use crate::error::{Error, Result};
+use crate::geom::light_shape::LightShape;
 use glam::DVec3;
 
 /// A rectangular area light with its orthonormal frame.
@@ -35,27 +36,6 @@ pub(crate) fn finite3(arg: &str, a: [f64; 3]) -> Result<DVec3> {
     } else {
         Err(Error::invalid(arg, format!("must be finite, got {a:?}")))
     }
-}
-
-/// Checks a light size: both components finite and > 0, or both 0 (a point
-/// light: hard shadows, see point_light.rs).
-pub fn check_light_size(arg: &str, size: [f64; 2]) -> Result<[f64; 2]> {
-    if size.iter().all(|s| s.is_finite() && *s > 0.0) || size == [0.0, 0.0] {
-        Ok(size)
-    } else {
-        Err(Error::invalid(
-            arg,
-            format!(
-                "must be two finite sizes > 0 (full width, full height), or (0, 0) for a point \
-                 light, got {size:?}"
-            ),
-        ))
-    }
-}
-
-/// Whether a (checked) light size is a point light's.
-pub fn is_point(size: [f64; 2]) -> bool {
-    size == [0.0, 0.0]
 }
 
 /// A light's frame (u, v, n) from its axis `axis` (named `axis_arg`: the
@@ -106,11 +86,17 @@ impl RectLight {
         ]
     }
 
+    /// The light's shape: the rectangle `size`.
+    pub fn shape(&self) -> LightShape {
+        LightShape::rect(self.size)
+    }
+
     /// Builds the light frame, refusing degenerate input.
     pub fn new(center: [f64; 3], normal: [f64; 3], up: [f64; 3], size: [f64; 2]) -> Result<Self> {
         let c = finite3("center", center)?;
         let (u, v, n) = light_frame("normal", normal, up)?;
-        let size = check_light_size("size", size)?;
+        // Both sides > 0, or both 0: a point light (hard shadows).
+        LightShape::rect(size).check("size")?;
         Ok(RectLight {
             center: c,
             u,

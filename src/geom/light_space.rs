@@ -4,7 +4,8 @@
 //! backends move geometry with this, never with a light directly.
 
 use crate::error::Result;
-use crate::geom::light::{is_point, RectLight};
+use crate::geom::light::RectLight;
+use crate::geom::light_shape::LightShape;
 use crate::geom::sun::{DirectionalLight, SunSpace};
 use glam::DVec3;
 
@@ -28,17 +29,17 @@ impl From<DirectionalLight> for Light {
 }
 
 impl Light {
-    /// The light's size in its kernel space (both 0: a hard light).
-    pub fn kernel_size(&self) -> [f64; 2] {
+    /// The light's shape in its kernel space (a point: a hard light).
+    pub fn kernel_shape(&self) -> LightShape {
         match self {
-            Light::Rect(l) => l.size,
-            Light::Sun(s) => s.kernel_size(),
+            Light::Rect(l) => l.shape(),
+            Light::Sun(s) => s.kernel_shape(),
         }
     }
 
     /// Whether it casts hard shadows (a point light, a sun of size 0).
     pub fn is_hard(&self) -> bool {
-        is_point(self.kernel_size())
+        self.kernel_shape().is_point()
     }
 
     /// Its light space for a scene made of `points` (the sun's depth origin
@@ -52,7 +53,7 @@ impl Light {
 }
 
 /// The kernels' light space: perspective, relative to the light's centre,
-/// the light the rectangle `size` at depth 0.
+/// the light its `shape` at depth 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LightSpace {
     Rect(RectLight),
@@ -84,11 +85,11 @@ impl LightSpace {
         }
     }
 
-    /// The light's size in kernel units.
-    pub fn size(&self) -> [f64; 2] {
+    /// The light's shape in kernel units.
+    pub fn shape(&self) -> LightShape {
         match self {
-            LightSpace::Rect(l) => l.size,
-            LightSpace::Sun(s) => s.light.kernel_size(),
+            LightSpace::Rect(l) => l.shape(),
+            LightSpace::Sun(s) => s.light.kernel_shape(),
         }
     }
 

@@ -1,4 +1,4 @@
-//! Geometry: the light and its map grid, the camera, meshes, the depth unit the kernels
+//! Geometry: the light, its shape and its map grid, the camera, meshes, the depth unit the kernels
 //! compute in, and the fitted extent of a light-view map.
 
 pub mod body;
@@ -6,6 +6,7 @@ pub mod camera;
 pub(crate) mod clip;
 pub mod extent;
 pub mod light;
+pub mod light_shape;
 pub mod light_space;
 pub mod mesh;
 pub mod shadow_projection;

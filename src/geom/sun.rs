@@ -30,6 +30,7 @@
 
 use crate::error::{Error, Result};
 use crate::geom::light::light_frame;
+use crate::geom::light_shape::LightShape;
 use glam::DVec3;
 
 /// A directional light with its orthonormal frame.
@@ -73,9 +74,10 @@ impl DirectionalLight {
             .map(|a| (0.5 * a).to_radians().tan().max(0.0))
     }
 
-    /// The light's size in the kernels' perspective space (see the module doc).
-    pub fn kernel_size(&self) -> [f64; 2] {
-        self.half_tangents().map(|t| 2.0 * t)
+    /// The light's shape in the kernels' perspective space (see the module
+    /// doc): the rectangle of full tangent sides 2 tan(a/2).
+    pub fn kernel_shape(&self) -> LightShape {
+        LightShape::rect(self.half_tangents().map(|t| 2.0 * t))
     }
 
     /// The unit direction toward the light's point (x, y) (tangent units).

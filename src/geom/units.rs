@@ -98,28 +98,6 @@ pub fn scaled_map(depth: &[f32], unit: f64) -> std::borrow::Cow<'_, [f32]> {
     }
 }
 
-/// The light's size in unit `unit`, refused when the kernels cannot resolve it.
-pub fn light_size_in(arg: &str, size: [f64; 2], unit: f64) -> Result<[f64; 2]> {
-    let s = [size[0] / unit, size[1] / unit];
-    if crate::geom::light::is_point(size) {
-        return Ok([0.0, 0.0]);
-    }
-    if s.iter()
-        .all(|x| (MIN_RELATIVE_SIZE..=MAX_RELATIVE_SIZE).contains(x))
-    {
-        return Ok(s);
-    }
-    Err(Error::invalid(
-        arg,
-        format!(
-            "{size:?} is {:?} times the receivers' depth ({unit:e}); the kernels compute in f32 \
-             and resolve ratios in [{MIN_RELATIVE_SIZE:e}, {MAX_RELATIVE_SIZE:e}] (a smaller \
-             light casts the hard shadow: pass (0, 0) for a point light)",
-            s
-        ),
-    ))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,13 +114,10 @@ mod tests {
     }
 
     #[test]
-    fn scaling_is_exact_and_light_sizes_are_checked_relative_to_depth() {
+    fn scaling_is_exact() {
         let m = [3.0f32, f32::INFINITY, 1e-3];
         let s = scaled_map(&m, 1024.0);
         assert_eq!(&s[..], &[3.0 / 1024.0, f32::INFINITY, 1e-3 / 1024.0]);
-        assert!(light_size_in("size", [1.0, 1.0], 2f64.powi(51)).is_ok());
-        assert!(light_size_in("size", [1e-40, 1.0], 1.0).is_err());
-        assert!(light_size_in("size", [1e-40, 1e-40], 2f64.powi(-100)).is_ok());
         // The deepest f32 depth and the shallowest normal one keep their unit.
         assert!(check_unit("points", depth_unit(f32::MAX as f64)).is_ok());
         assert!(check_unit("points", depth_unit(1e-45f32 as f64)).is_ok());

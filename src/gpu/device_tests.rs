@@ -5,6 +5,7 @@
 use crate::backend::Backend;
 use crate::frame::{MapSettings, ShadowResult};
 use crate::geom::light::RectLight;
+use crate::geom::light_shape::LightShape;
 use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
 use crate::pipeline;
@@ -328,11 +329,11 @@ fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
             .collect();
         for method in bitmask_kernels() {
             for back in [None, Some(&back[..])] {
-                let light = [0.8, 0.6];
+                let light = LightShape::rect([0.8, 0.6]);
                 let maps = pipeline::DepthMaps {
                     grid: &grid,
                     occluder_grid: &og,
-                    light_size: light,
+                    light_shape: light,
                     front: &front,
                     back,
                     receiver: &receiver,
@@ -368,7 +369,7 @@ fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
     let og = MapGrid::new(320, 320, [0.6, 0.5]).unwrap();
     let (front, back) = tilted_depth_maps(&og);
     let receiver = vec![2.8f32; grid.len()];
-    let light = [2.5, 2.0];
+    let light = LightShape::rect([2.5, 2.0]);
     for method in bitmask_kernels()
         .into_iter()
         .filter(|m| matches!(m, Method::Bitmask { samples: 1024, .. }))
@@ -380,7 +381,7 @@ fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
         let maps = pipeline::DepthMaps {
             grid: &grid,
             occluder_grid: &og,
-            light_size: light,
+            light_shape: light,
             front: &front,
             back: Some(&back),
             receiver: &receiver,
@@ -414,7 +415,7 @@ fn depth_maps_cannot_be_traced() {
     let maps = pipeline::DepthMaps {
         grid: &g,
         occluder_grid: &g,
-        light_size: [1.0, 1.0],
+        light_shape: LightShape::rect([1.0, 1.0]),
         front: &z,
         back: None,
         receiver: &z,
@@ -1304,7 +1305,7 @@ mod eye {
 // the CPU (methods/smoothies/).
 
 mod smoothies {
-    use super::{device_or_skip, run, sphere};
+    use super::{device_or_skip, run, sphere, LightShape};
     use crate::geom::light::MapGrid;
     use crate::methods::shadow_mapping::config::Real;
     use crate::methods::smoothies::{shadow_map, Falloff, SmoothieBuffer, Smoothies};
@@ -1353,7 +1354,7 @@ mod smoothies {
             return;
         }
         let (verts, faces) = scene();
-        let light = [0.8, 0.5];
+        let light = LightShape::rect([0.8, 0.5]);
         for (w, h) in [(96, 80), (257, 131)] {
             let grid = MapGrid::new(w, h, [0.45, 0.4]).unwrap();
             let front = crate::raster::rasterize(&grid, &verts, &faces, 1e-3, false).nearest;
@@ -1448,7 +1449,7 @@ mod smoothies {
 // PCSS (pcss.wgsl) against methods/pcss.rs: maps and points.
 
 mod pcss {
-    use super::{device_or_skip, run_at, same_bits};
+    use super::{device_or_skip, run_at, same_bits, LightShape};
     use crate::backend::Backend;
     use crate::geom::light::MapGrid;
     use crate::gpu::context::gpu;
@@ -1556,11 +1557,12 @@ mod pcss {
             (32, [1e4, 1e4]),
             (7, [1e30, 0.5]),
         ] {
+            let light = LightShape::rect(light);
             let method = Method::Pcss { max_taps: taps };
             let maps = pipeline::DepthMaps {
                 grid: &grid,
                 occluder_grid: &og,
-                light_size: light,
+                light_shape: light,
                 front: &front,
                 back: None,
                 receiver: &receiver,
@@ -1582,7 +1584,7 @@ mod pcss {
     /// `points` shaded by the GPU's points mode from `front` on `og`.
     fn gpu_points(
         og: &MapGrid,
-        light: [f64; 2],
+        light: LightShape,
         taps: u32,
         front: &[f32],
         points: &[LightPoint],
@@ -1649,10 +1651,11 @@ mod pcss {
             (MAX_TAPS, [2.0, 2.0]),
             (32, [1.0, 0.0]),
         ] {
+            let light = LightShape::rect(light);
             let inputs = ShadowInputs {
                 grid: og,
                 occluder_grid: og,
-                light_size: light,
+                light_shape: light,
                 receiver: &[],
                 occluder_layers: vec![&front],
                 occluder_triangles: None,
@@ -1688,13 +1691,13 @@ mod pcss {
         let inputs = ShadowInputs {
             grid: fine,
             occluder_grid: fine,
-            light_size: [1.5, 1.2],
+            light_shape: LightShape::rect([1.5, 1.2]),
             receiver: &[],
             occluder_layers: vec![&front],
             occluder_triangles: None,
         };
         let c = Pcss { max_taps: MAX_TAPS }.visibility_points(&inputs, &pts);
-        let g = gpu_points(&fine, [1.5, 1.2], MAX_TAPS, &front, &pts);
+        let g = gpu_points(&fine, LightShape::rect([1.5, 1.2]), MAX_TAPS, &front, &pts);
         let (max, mean, flips) = compare(&c, &g);
         eprintln!("points fine {MAX_TAPS}: max {max:.2e}, mean {mean:.2e}, {flips} > 1e-3");
         assert!(max <= 2e-3 && mean <= 1e-4, "fine: max {max}, mean {mean}");

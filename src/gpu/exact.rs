@@ -5,15 +5,25 @@
 
 use super::context::Gpu;
 use super::dispatch::{bind, module, pipeline, storage, uniform, upload};
+use super::light;
 use super::timing::StageTimer;
 use crate::geom::light::MapGrid;
-use crate::methods::exact::{sample_grid, Bvh, RAY_EPS};
+use crate::geom::light_shape::LightShape;
+use crate::methods::exact::{Bvh, RAY_EPS};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use std::sync::OnceLock;
 
 /// The module: the 64-bit helpers it calls (u64.wgsl), then exact.wgsl.
-pub const SOURCE: &str = concat!(include_str!("u64.wgsl"), "\n", include_str!("exact.wgsl"));
+/// The ray caster's module: the 64-bit helpers, the light's sampling
+/// (`light.rs`), then exact.wgsl.
+pub const SOURCE: &str = concat!(
+    include_str!("u64.wgsl"),
+    "\n",
+    include_str!("light_shape.wgsl"),
+    "\n",
+    include_str!("exact.wgsl")
+);
 
 /// Loop iterations (BVH nodes visited and triangles tested) one invocation
 /// may run per dispatch; lavapipe stops an invocation after 65535.
@@ -79,34 +89,32 @@ impl ExactShading {
         grid: &MapGrid,
         tris: Vec<[Vec3; 3]>,
         samples: u32,
-        light_size: [f64; 2],
+        light_shape: LightShape,
     ) -> ExactShading {
         let device = &g.device;
         let has_tris = !tris.is_empty();
         let bvh = Bvh::build(tris);
-        let (na, nb) = sample_grid(samples, light_size);
         let axes: Vec<f32> = (0..grid.width)
             .map(|i| grid.x_of(i) as f32)
             .chain((0..grid.height).map(|j| grid.y_of(j) as f32))
             .collect();
         let vis_bytes = grid.len() as u64 * 4;
+        let mut params = ExactParams {
+            rec_w: grid.width as u32,
+            rec_h: grid.height as u32,
+            budget: BUDGET,
+            has_tris: has_tris as u32,
+            t0: RAY_EPS,
+            t1: 1.0 - RAY_EPS,
+            ax_rec_x: 0,
+            ax_rec_y: grid.width as u32,
+            ..Default::default()
+        };
+        let r = light::ray_fields(light_shape, samples);
+        (params.na, params.nb, params.size_x, params.size_y) = (r.na, r.nb, r.size_x, r.size_y);
         ExactShading {
-            params: ExactParams {
-                rec_w: grid.width as u32,
-                rec_h: grid.height as u32,
-                na,
-                nb,
-                budget: BUDGET,
-                has_tris: has_tris as u32,
-                size_x: light_size[0] as f32,
-                size_y: light_size[1] as f32,
-                t0: RAY_EPS,
-                t1: 1.0 - RAY_EPS,
-                ax_rec_x: 0,
-                ax_rec_y: grid.width as u32,
-                ..Default::default()
-            },
-            samples: na * nb,
+            params,
+            samples: params.na * params.nb,
             nodes: upload(device, "bvh nodes", &bvh.node_words()),
             tris: upload(device, "bvh triangles", &bvh.triangle_floats()),
             axes: upload(device, "axes", &axes),

@@ -20,6 +20,7 @@ struct ExactParams {
     // `status` (lavapipe stops an invocation after 65535).
     budget: u32,
     has_tris: u32,
+    // The light's rectangle (light_shape.wgsl's `size`).
     size_x: f32,
     size_y: f32,
     t0: f32,
@@ -227,9 +228,8 @@ fn exact(@builtin(global_invocation_id) gid: vec3<u32>) {
         let sb = s / ep.na;
         // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
         let h = hash(key ^ hash(vec2<u32>(s << 1u, 0u)));
-        let x = ((f32(sa) + unit(h)) / f32(ep.na) - 0.5) * ep.size_x;
-        let y = ((f32(sb) + unit(hash(h))) / f32(ep.nb) - 0.5) * ep.size_y;
-        let d = vec3<f32>(x, y, 0.0) - p;
+        let l = light_sample(sa, sb, ep.na, ep.nb, unit(h), unit(hash(h)), vec2<f32>(ep.size_x, ep.size_y));
+        let d = vec3<f32>(l.x, l.y, 0.0) - p;
         if !occluded(p, d) {
             count += 1u;
         }

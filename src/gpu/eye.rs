@@ -47,6 +47,7 @@ use super::exact::{ExactParams, BUDGET, SAMPLES_PER_CHUNK};
 use super::gather::{
     self, GatherBuffers, GpuGroup, GpuPoint, PointsBuffers, PointsParams, POINT_GROUP,
 };
+use super::light;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::refusals::{check_method, check_side, point_light_on_gpu};
@@ -61,7 +62,8 @@ use crate::eye::rays::{self, RayStart};
 use crate::eye::{Bias, EyeCall, EyeMaps, EyeStages, Framed};
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
-use crate::methods::exact::{sample_grid, Bvh, RAY_EPS};
+use crate::geom::light_shape::LightShape;
+use crate::methods::exact::{Bvh, RAY_EPS};
 use crate::methods::gather::{point_group, point_order, POINTS_PER_GROUP};
 use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::{Input, LightPoint, Method, MethodConfig};
@@ -72,18 +74,24 @@ use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-/// The first-hit module: the 64-bit helpers, exact.wgsl (BVH access,
-/// Möller-Trumbore), then eye_hits.wgsl.
+/// The first-hit module: the 64-bit helpers, the light's sampling (which
+/// exact.wgsl's ray caster calls), exact.wgsl (BVH access, Möller-Trumbore),
+/// then eye_hits.wgsl.
 pub const HITS_SOURCE: &str = concat!(
     include_str!("u64.wgsl"),
+    "\n",
+    include_str!("light_shape.wgsl"),
     "\n",
     include_str!("exact.wgsl"),
     "\n",
     include_str!("eye_hits.wgsl")
 );
-/// The shadow-ray module: exact.wgsl's traversal and jitter, then eye_rays.wgsl.
+/// The shadow-ray module: the light's sampling, exact.wgsl's traversal and
+/// jitter, then eye_rays.wgsl.
 pub const RAYS_SOURCE: &str = concat!(
     include_str!("u64.wgsl"),
+    "\n",
+    include_str!("light_shape.wgsl"),
     "\n",
     include_str!("exact.wgsl"),
     "\n",
@@ -227,7 +235,7 @@ impl EyeStages for GpuEye {
             .iter()
             .map(GpuRayStart::new)
             .collect();
-        let (v, t) = exact_visibility(gpu()?, tris, &starts, samples, f.light_size, sw)?;
+        let (v, t) = exact_visibility(gpu()?, tris, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
         Ok(v)
     }
@@ -409,7 +417,7 @@ fn exact_visibility(
     tris: Vec<[Vec3; 3]>,
     starts: &[GpuRayStart],
     samples: u32,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, Timings)> {
     let n = starts.len();
@@ -419,21 +427,19 @@ fn exact_visibility(
     fits(g, "resolution", n as u64 * size_of::<GpuRayStart>() as u64)?;
     let has_tris = !tris.is_empty();
     let bvh = Bvh::build(tris);
-    let (na, nb) = sample_grid(samples, light_size);
-    let params = ExactParams {
+    let mut params = ExactParams {
         rec_w: n as u32,
         rec_h: 1,
-        na,
-        nb,
         budget: BUDGET,
         has_tris: has_tris as u32,
-        size_x: light_size[0] as f32,
-        size_y: light_size[1] as f32,
         // rays.rs's segments: t in (0, 1 - RAY_EPS).
         t0: 0.0,
         t1: 1.0 - RAY_EPS,
         ..Default::default()
     };
+    let r = light::ray_fields(light_shape, samples);
+    (params.na, params.nb, params.size_x, params.size_y) = (r.na, r.nb, r.size_x, r.size_y);
+    let (na, nb) = (params.na, params.nb);
     let bytes = n as u64 * 4;
     let out = with_error_scopes(g, || {
         let device = &g.device;
@@ -560,11 +566,13 @@ fn point_lanes(sorted: &[LightPoint]) -> (Vec<GpuPoint>, Vec<GpuGroup>) {
 /// the f32 rounding of the device's coordinates.
 fn window_bounds(
     grid: &MapGrid,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     w_bound: f64,
     groups: &[GpuGroup],
 ) -> (usize, usize) {
     let (hw, hh) = grid.half_texel();
+    // A micro-patch reaches the light's half-extent times dw further.
+    let [hx, hy] = light_shape.half_extent();
     let (w, h) = (grid.width as f64, grid.height as f64);
     let row = |y: f64| (1.0 - y / grid.ty) * 0.5 * h - 0.5;
     let col = |x: f64| (x / grid.tx + 1.0) * 0.5 * w - 0.5;
@@ -576,8 +584,8 @@ fn window_bounds(
         .filter(|b| b.live != 0 && w_bound > b.wr_min as f64)
         .fold((1, 1), |(c, s), b| {
             let dw = w_bound - b.wr_min as f64;
-            let reach_y = hh + 0.5 * light_size[1] * dw;
-            let reach_x = hw + 0.5 * light_size[0] * dw;
+            let reach_y = hh + hy * dw;
+            let reach_x = hw + hx * dw;
             let rows = row(b.y_lo as f64 - reach_y).ceil() - row(b.y_hi as f64 + reach_y).floor();
             let cols = col(b.x_hi as f64 + reach_x).ceil() - col(b.x_lo as f64 - reach_x).floor();
             (
@@ -590,16 +598,12 @@ fn window_bounds(
 /// The occluder grid's tables as the CPU kernel holds them at level 0
 /// (`gather/hierarchy.rs`): column left edges in half-light units (from the
 /// f32 edge, as `col_x0_scaled`), row centres; their offsets in `p`.
-fn point_axes(og: &MapGrid, light_size: [f64; 2], p: &mut gather::GatherParams) -> Vec<f32> {
-    let (hw, _) = og.half_texel();
+fn point_axes(og: &MapGrid, light_shape: LightShape, p: &mut gather::GatherParams) -> Vec<f32> {
     let mut data = Vec::with_capacity(og.width + og.height);
     p.ax_rec_x = 0;
     p.ax_rec_y = 0;
     p.ax_col_x0s = 0;
-    data.extend((0..og.width).map(|i| {
-        let x0 = (og.x_of(i) - hw) as f32;
-        (x0 as f64 * 2.0 / light_size[0]) as f32
-    }));
+    data.extend(light::column_edges(og, light_shape));
     p.ax_row_y = data.len() as u32;
     data.extend((0..og.height).map(|j| og.y_of(j) as f32));
     data
@@ -644,7 +648,7 @@ fn shade_maps(
     let sp = maps::shading_points(
         &f.space,
         f.unit,
-        f.light_size,
+        f.light_shape,
         &grid,
         &f.points,
         &f.pts_ls,
@@ -662,11 +666,11 @@ fn shade_maps(
     if quads {
         fits(g, "map_resolution", texels * 16)?;
     }
-    let mut params = gather_params(&grid, &grid, f.light_size, passes, method);
+    let mut params = gather_params(&grid, &grid, f.light_shape, passes, method);
     params.rec_w = 0;
     params.rec_h = 0;
     params.layer0_offset = 0;
-    let axes = point_axes(&grid, f.light_size, &mut params);
+    let axes = point_axes(&grid, f.light_shape, &mut params);
     sw.lap("setup");
     let maps_bytes = texels * 4;
     let vis_bytes = n_points as u64 * 4;
@@ -742,7 +746,7 @@ fn shade_maps(
         } else {
             None
         };
-        let (cols, steps) = window_bounds(&grid, f.light_size, w_bound, &groups);
+        let (cols, steps) = window_bounds(&grid, f.light_shape, w_bound, &groups);
         let (steps_per_chunk, chunks) = gather::points_chunking(cols, steps, method);
         let b = GatherBuffers {
             maps: &maps_buf,

@@ -62,8 +62,9 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
         let sb = k / ep.na;
         // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
         let h = hash(key ^ hash(vec2<u32>(k << 1u, 0u)));
-        let x = ((f32(sa) + unit(h)) / f32(ep.na) - 0.5) * ep.size_x;
-        let y = ((f32(sb) + unit(hash(h))) / f32(ep.nb) - 0.5) * ep.size_y;
+        let l = light_sample(sa, sb, ep.na, ep.nb, unit(h), unit(hash(h)), vec2<f32>(ep.size_x, ep.size_y));
+        let x = l.x;
+        let y = l.y;
         var o = below;
         if s.a0 + x * s.au + y * s.av >= 0.0 {
             o = above;

@@ -13,7 +13,7 @@ use super::shading::{check_size, Shading};
 use super::timing::StageTimer;
 use crate::error::Result;
 use crate::frame::DepthInUnit;
-use crate::geom::light::{is_point, MapGrid};
+use crate::geom::light::MapGrid;
 use crate::methods::Method;
 use crate::timing::{Stopwatch, Timings};
 
@@ -45,11 +45,11 @@ pub(crate) fn shade(
     method: Method,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, Timings)> {
-    if is_point(d.light_size) {
+    if d.light_shape.is_point() {
         return Err(point_light_on_gpu("light_size"));
     }
-    let (light_size, front, back, receiver) = (
-        d.light_size,
+    let (light_shape, front, back, receiver) = (
+        d.light_shape,
         &d.front[..],
         d.back.as_deref(),
         &d.receiver[..],
@@ -79,7 +79,7 @@ pub(crate) fn shade(
         if let Method::Pcss { max_taps } = method {
             // The front layer follows the receiver map.
             let off = grid.len() as u32;
-            let sh = PcssShading::maps(g, grid, occluder_grid, light_size, max_taps, off)?;
+            let sh = PcssShading::maps(g, grid, occluder_grid, light_shape, max_taps, off)?;
             sw.lap("upload");
             let timer = StageTimer::new(g, 1);
             let mut enc = g
@@ -95,7 +95,7 @@ pub(crate) fn shade(
             method,
             grid,
             occluder_grid,
-            light_size,
+            light_shape,
             n_layers,
             w_max,
             corners.as_ref(),

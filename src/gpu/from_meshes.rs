@@ -66,10 +66,10 @@ pub(crate) fn maps(
         grid,
         occluder_grid,
         near,
-        light_size,
+        light_shape,
         ..
     } = f;
-    let (grid, occluder_grid, near, light_size) = (*grid, *occluder_grid, *near, *light_size);
+    let (grid, occluder_grid, near, light_shape) = (*grid, *occluder_grid, *near, *light_shape);
     let g = gpu()?;
     // Occluder depth layers in `maps` after the receiver's (none when traced).
     let layers = if traced { 0 } else { s.passes };
@@ -90,7 +90,14 @@ pub(crate) fn maps(
     // Smoothies: steps 2-3 on the CPU (smoothies.rs).
     let smoothies = smoothies::options(s.method)
         .map(|m| {
-            smoothies::prepare_light_view(g, &m, &occluder_grid, light_size, occ_ls, occluder_faces)
+            smoothies::prepare_light_view(
+                g,
+                &m,
+                &occluder_grid,
+                light_shape,
+                occ_ls,
+                occluder_faces,
+            )
         })
         .transpose()?;
     sw.lap("setup");
@@ -110,13 +117,13 @@ pub(crate) fn maps(
             )),
             (Method::Exact { samples }, _) => {
                 let t = light_space_triangles(occ_ls, occluder_faces);
-                Stage::Rays(ExactShading::new(g, &grid, t, samples, light_size))
+                Stage::Rays(ExactShading::new(g, &grid, t, samples, light_shape))
             }
             (Method::Pcss { max_taps }, _) => Stage::Pcss(PcssShading::maps(
                 g,
                 &grid,
                 &occluder_grid,
-                light_size,
+                light_shape,
                 max_taps,
                 grid.len() as u32,
             )?),
@@ -126,7 +133,7 @@ pub(crate) fn maps(
                 s.method,
                 &grid,
                 &occluder_grid,
-                light_size,
+                light_shape,
                 layers,
                 w_max,
                 None,
@@ -181,7 +188,7 @@ pub(crate) fn maps(
                 s.method,
                 &grid,
                 &occluder_grid,
-                light_size,
+                light_shape,
                 layers,
                 w_max,
                 Some(&corners),

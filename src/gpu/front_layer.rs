@@ -73,7 +73,7 @@ impl FrontLayer {
         let points = maps::shading_points(
             &f.space,
             f.unit,
-            f.light_size,
+            f.light_shape,
             &grid,
             &f.points,
             &f.pts_ls,

@@ -16,6 +16,7 @@
 use super::dispatch::{bind, groups_1d, module, pipeline, uniform};
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::methods::bitmask::Gaps;
 use crate::methods::ssm::Precision;
 use crate::methods::Method;
@@ -218,21 +219,22 @@ const ITERATION_BUDGET: usize = 32768;
 /// of chunks that covers any receiver's rows. `w_max` bounds the occluders'
 /// 1/depth (from their vertices: 1/Z is linear over a triangle, so its
 /// largest value is at a vertex), which bounds how far a micro-patch reaches.
-pub fn chunking(og: &MapGrid, light_size: [f64; 2], w_max: f64, method: Method) -> (u32, u32) {
+pub fn chunking(og: &MapGrid, light_shape: LightShape, w_max: f64, method: Method) -> (u32, u32) {
     let (hw, hh) = og.half_texel();
     // Texels in reach along a row (rows in reach along a column): a patch
     // reaches half_texel + (L/2) w_max in tangent units, and the rounding of
     // both ends adds up to 3 texels.
-    let reach = |half_texel: f64, light: f64, n: usize| -> usize {
-        let t = (1.0 + 0.5 * light * w_max / half_texel).ceil() + 3.0;
+    let reach = |half_texel: f64, half_light: f64, n: usize| -> usize {
+        let t = (1.0 + half_light * w_max / half_texel).ceil() + 3.0;
         if t.is_finite() {
             (t as usize).min(n)
         } else {
             n
         }
     };
-    let cols = reach(hw, light_size[0], og.width);
-    let rows = reach(hh, light_size[1], og.height);
+    let [hx, hy] = light_shape.half_extent();
+    let cols = reach(hw, hx, og.width);
+    let rows = reach(hh, hy, og.height);
     let per_texel = texel_cost(method);
     let rows_per_chunk = (ITERATION_BUDGET / (cols * per_texel + 2)).max(1);
     (rows_per_chunk as u32, rows.div_ceil(rows_per_chunk) as u32)

@@ -7,7 +7,7 @@ use super::timing::merged;
 use crate::backend::Backend;
 use crate::error::Result;
 use crate::frame::{DepthInUnit, FramedScene, MapSettings};
-use crate::geom::light::{is_point, MapGrid};
+use crate::geom::light::MapGrid;
 use crate::light_view::{LightMaps, LightViewStages};
 use crate::methods::Method;
 use crate::timing::{Stopwatch, Timings};
@@ -32,7 +32,7 @@ impl LightViewStages for GpuLightView {
         s: &MapSettings,
         sw: &mut Stopwatch,
     ) -> Result<LightMaps> {
-        if is_point(f.light_size) {
+        if f.light_shape.is_point() {
             return Err(super::refusals::point_light_on_gpu("size"));
         }
         let (maps, t) = super::from_meshes::maps(f, faces, s, sw)?;

@@ -47,6 +47,7 @@ mod from_depth;
 mod from_meshes;
 mod front_layer;
 mod gather;
+mod light;
 mod light_view;
 mod pcss;
 mod raster;

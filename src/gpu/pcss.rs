@@ -23,6 +23,7 @@ use crate::error::{Error, Result};
 use crate::eye::maps::LightTriangles;
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::methods::pcss::{half_per_w, MAX_TAPS};
 use crate::methods::LightPoint;
 use crate::timing::{Stopwatch, Timings};
@@ -190,7 +191,7 @@ impl PcssShading {
     fn new(
         g: &Gpu,
         og: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         max_taps: u32,
         front_offset: u32,
         mut params: PcssParams,
@@ -200,7 +201,7 @@ impl PcssShading {
         let device = &g.device;
         let taps = max_taps.clamp(1, MAX_TAPS);
         let (rows_per_chunk, chunks) = chunking(taps);
-        let [hx, hy] = half_per_w(og, light_size);
+        let [hx, hy] = half_per_w(og, light_shape);
         params.occ_w = og.width as u32;
         params.occ_h = og.height as u32;
         params.front_offset = front_offset;
@@ -238,7 +239,7 @@ impl PcssShading {
         g: &Gpu,
         grid: &MapGrid,
         og: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         max_taps: u32,
         front_offset: u32,
     ) -> Result<PcssShading> {
@@ -261,7 +262,7 @@ impl PcssShading {
         Ok(PcssShading::new(
             g,
             og,
-            light_size,
+            light_shape,
             max_taps,
             front_offset,
             params,
@@ -275,7 +276,7 @@ impl PcssShading {
     pub fn points(
         g: &Gpu,
         og: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         max_taps: u32,
         front_offset: u32,
         points: &[LightPoint],
@@ -294,7 +295,7 @@ impl PcssShading {
         Ok(PcssShading::new(
             g,
             og,
-            light_size,
+            light_shape,
             max_taps,
             front_offset,
             params,
@@ -400,7 +401,7 @@ pub(crate) fn shade_points(
         f,
         "softshadow eye pcss",
         2,
-        || PcssShading::points(g, &grid, f.light_size, max_taps, 0, &points),
+        || PcssShading::points(g, &grid, f.light_shape, max_taps, 0, &points),
         sw,
     )
 }

@@ -7,9 +7,11 @@
 use super::context::Gpu;
 use super::dispatch::{storage, upload};
 use super::gather::{self, GatherBuffers, GatherParams};
+use super::light;
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::methods::Method;
 
 /// Refuses maps (and accumulators, and the corners) that do not fit one
@@ -46,8 +48,7 @@ pub fn check_size(
 /// Tangent coordinates the shaders read, computed in f64 like the CPU
 /// kernels' tables (so both sides start from the same f32 values), and
 /// their offsets.
-fn axes(grid: &MapGrid, og: &MapGrid, light_size: [f64; 2], p: &mut GatherParams) -> Vec<f32> {
-    let (hw, _) = og.half_texel();
+fn axes(grid: &MapGrid, og: &MapGrid, light_shape: LightShape, p: &mut GatherParams) -> Vec<f32> {
     let mut data = Vec::new();
     p.ax_rec_x = data.len() as u32;
     data.extend((0..grid.width).map(|i| grid.x_of(i) as f32));
@@ -57,10 +58,7 @@ fn axes(grid: &MapGrid, og: &MapGrid, light_size: [f64; 2], p: &mut GatherParams
     // As the CPU's `col_x0_scaled`: the f32 left edge, scaled in f64 (one
     // rounding from f64 differs from these two in the last bit now and then,
     // which moved a rank: a sample of one texel in 2000 on a 61-wide grid).
-    data.extend((0..og.width).map(|i| {
-        let x0 = (og.x_of(i) - hw) as f32;
-        (x0 as f64 * 2.0 / light_size[0]) as f32
-    }));
+    data.extend(light::column_edges(og, light_shape));
     p.ax_row_y = data.len() as u32;
     data.extend((0..og.height).map(|j| og.y_of(j) as f32));
     data
@@ -69,14 +67,13 @@ fn axes(grid: &MapGrid, og: &MapGrid, light_size: [f64; 2], p: &mut GatherParams
 pub(super) fn gather_params(
     grid: &MapGrid,
     og: &MapGrid,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     n_layers: u32,
     method: Method,
 ) -> GatherParams {
     let (hw, hh) = og.half_texel();
     // The same f32 values as methods/gather.rs's Kernel::new.
-    let inv_half_lx = (2.0 / light_size[0]) as f32;
-    GatherParams {
+    let mut p = GatherParams {
         rec_w: grid.width as u32,
         rec_h: grid.height as u32,
         occ_w: og.width as u32,
@@ -92,13 +89,10 @@ pub(super) fn gather_params(
         ty: og.ty as f32,
         hw: hw as f32,
         hh: hh as f32,
-        inv_half_lx,
-        inv_half_ly: (2.0 / light_size[1]) as f32,
-        half_lx: (0.5 * light_size[0]) as f32,
-        half_ly: (0.5 * light_size[1]) as f32,
-        wx: 2.0 * hw as f32 * inv_half_lx,
         ..Default::default()
-    }
+    };
+    light::set_half_light(&mut p, light_shape, hw);
+    p
 }
 
 /// The buffers and parameters of the shading stage.
@@ -126,17 +120,17 @@ impl Shading {
         method: Method,
         grid: &MapGrid,
         og: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         n_layers: u32,
         w_max: f64,
         corners: Option<&gather::LayerCorners>,
     ) -> Shading {
         let device = &g.device;
         debug_assert_eq!(corners.is_some(), gather::needs_corners(method));
-        let mut params = gather_params(grid, og, light_size, n_layers, method);
-        let ax = axes(grid, og, light_size, &mut params);
+        let mut params = gather_params(grid, og, light_shape, n_layers, method);
+        let ax = axes(grid, og, light_shape, &mut params);
         let w_max = corners.map_or(w_max, |c| w_max.max(c.w_max as f64));
-        let (rows_per_chunk, chunks) = gather::chunking(og, light_size, w_max, method);
+        let (rows_per_chunk, chunks) = gather::chunking(og, light_shape, w_max, method);
         params.rows_per_chunk = rows_per_chunk;
         let acc_words = gather::accumulator_words(method, n_layers) as u64 * grid.len() as u64;
         let vis_bytes = grid.len() as u64 * 4;

@@ -36,6 +36,7 @@ use crate::eye::maps::LightTriangles;
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::methods::smoothies::method::soup;
 use crate::methods::smoothies::{Falloff, Shape, Smoothies};
 use crate::methods::{LightPoint, Method};
@@ -217,12 +218,14 @@ impl Prepared {
     pub fn new(
         s: &Smoothies,
         og: &MapGrid,
-        light: [f64; 2],
+        light: LightShape,
         verts: &[DVec3],
         faces: &[[u32; 3]],
         per_chunk: u32,
     ) -> Prepared {
         let built = s.smoothies(og, light, verts, faces);
+        // q units scale tangents by the light's box (smoothies/construct.rs).
+        let light = light.extent();
         let t = built.t;
         let (w, h) = (og.width, og.height);
         let (tiles_x, tiles_y) = (w.div_ceil(TILE), h.div_ceil(TILE));
@@ -591,13 +594,13 @@ pub fn prepare_light_view(
     g: &Gpu,
     s: &Smoothies,
     og: &MapGrid,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     occ_ls: &[DVec3],
     faces: &[[u32; 3]],
 ) -> Result<Prepared> {
     let tris = light_space_triangles(occ_ls, faces);
     let (verts, faces) = soup(&tris);
-    let p = Prepared::new(s, og, light_size, &verts, &faces, PER_CHUNK);
+    let p = Prepared::new(s, og, light_shape, &verts, &faces, PER_CHUNK);
     p.check_fits(g)?;
     Ok(p)
 }
@@ -617,7 +620,7 @@ pub(super) fn shade_eye(
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
     let front = FrontLayer::new(g, f, tris, grid, bias)?;
     // Every mesh is an occluder: the silhouette straight from the mesh.
-    let prepared = Prepared::new(s, &grid, f.light_size, &tris.verts, tris.faces, PER_CHUNK);
+    let prepared = Prepared::new(s, &grid, f.light_shape, &tris.verts, tris.faces, PER_CHUNK);
     prepared.check_fits(g)?;
     let tents = point_tents(&grid, &front.points.points);
     sw.lap("setup");
@@ -659,14 +662,14 @@ impl AfterFront for SmoothieShading {
 pub fn buffer_on_device(
     s: &Smoothies,
     grid: &MapGrid,
-    light_size: [f64; 2],
+    light_shape: LightShape,
     front: &[f32],
     verts: &[DVec3],
     faces: &[[u32; 3]],
     per_chunk: u32,
 ) -> Result<(crate::methods::smoothies::SmoothieBuffer, u32)> {
     let g = super::context::gpu()?;
-    let p = Prepared::new(s, grid, light_size, verts, faces, per_chunk);
+    let p = Prepared::new(s, grid, light_shape, verts, faces, per_chunk);
     let words: Vec<u32> = front.iter().map(|z| z.to_bits()).collect();
     let mut sw = Stopwatch::new();
     let map_bytes = grid.len() as u64 * 4;

@@ -7,6 +7,7 @@ use crate::backend::Backend;
 use crate::error::Result;
 use crate::frame::{light_space_triangles, DepthInUnit, FramedScene, MapSettings};
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::memory::{check_fits, map_bytes};
 use crate::methods::{shade_map, Input, Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared};
@@ -64,7 +65,11 @@ impl LightViewStages for CpuLightView {
             occluder_grid: f.occluder_grid,
             // The hard shadow map where a plan says every penumbra is under
             // half a texel (the point-light path of shade_map).
-            light_size: if s.hard { [0.0; 2] } else { f.light_size },
+            light_shape: if s.hard {
+                LightShape::POINT
+            } else {
+                f.light_shape
+            },
             receiver: &receiver,
             occluder_layers: layers,
             occluder_triangles: triangles.as_deref(),
@@ -120,7 +125,7 @@ impl LightViewStages for CpuLightView {
         let inputs = ShadowInputs {
             grid: *grid,
             occluder_grid: *occluder_grid,
-            light_size: d.light_size,
+            light_shape: d.light_shape,
             receiver: &d.receiver,
             occluder_layers: layers,
             occluder_triangles: None,

@@ -632,6 +632,7 @@ impl ShadowMethod for Bitmask {
 mod tests {
     use super::*;
     use crate::geom::light::MapGrid;
+    use crate::geom::light_shape::LightShape;
 
     #[test]
     fn pattern_is_multi_jittered() {
@@ -702,7 +703,7 @@ mod tests {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1.0, 0.7],
+            light_shape: LightShape::rect([1.0, 0.7]),
             receiver: &receiver,
             occluder_layers: vec![&front],
             occluder_triangles: None,
@@ -735,7 +736,7 @@ mod tests {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [0.1, 0.1],
+            light_shape: LightShape::rect([0.1, 0.1]),
             receiver: &receiver,
             occluder_layers: vec![&front, &front],
             occluder_triangles: None,

@@ -11,12 +11,14 @@
 //!
 //! Geometry is in light space (relative to the light's center, computed in
 //! f64 and then stored in f32), so a scene far from the world origin keeps its
-//! precision. The light is the rectangle [-Lx/2, Lx/2] x [-Ly/2, Ly/2] at Z = 0.
+//! precision. The light is its shape at Z = 0 (geom/light_shape.rs: where the
+//! samples lie).
 
 pub use super::bvh::Bvh;
 pub(crate) use super::shadow_rays::RAY_EPS;
 use super::shadow_rays::{tile_order, visibilities, Sampling};
 use super::{LightPoint, ShadowInputs, ShadowMethod};
+use crate::geom::light_shape::{LightSamples, LightShape};
 use glam::Vec3;
 
 /// The exact method with `samples` light samples per receiver.
@@ -30,27 +32,15 @@ pub struct Exact {
 /// (benchmarks/bvh_crates compares BVH crates on them).
 pub fn light_sample(key: u64, sa: u32, sb: u32, grid: (u32, u32), size: [f32; 2]) -> (f32, f32) {
     Sampling {
-        grid,
-        size,
+        light: LightSamples { grid, size },
         t0: RAY_EPS,
     }
     .sample(key, sa, sb)
 }
 
-/// The stratification grid a x b = samples, a the largest divisor <= sqrt,
-/// the longer side of the light getting the larger count.
-pub fn sample_grid(samples: u32, light_size: [f64; 2]) -> (u32, u32) {
-    let mut a = (samples as f64).sqrt() as u32;
-    while a > 1 && !samples.is_multiple_of(a) {
-        a -= 1;
-    }
-    let a = a.max(1);
-    let b = samples / a;
-    if light_size[0] >= light_size[1] {
-        (b, a)
-    } else {
-        (a, b)
-    }
+/// The stratification of a rectangle of full `size` (`LightShape::sample_grid`).
+pub fn sample_grid(samples: u32, size: [f64; 2]) -> (u32, u32) {
+    LightShape::rect(size).sample_grid(samples)
 }
 
 impl Exact {
@@ -64,8 +54,7 @@ impl Exact {
         };
         let bvh = Bvh::build(tris.to_vec());
         let s = Sampling {
-            grid: sample_grid(self.samples, inputs.light_size),
-            size: [inputs.light_size[0] as f32, inputs.light_size[1] as f32],
+            light: inputs.light_shape.samples(self.samples),
             t0: RAY_EPS,
         };
         visibilities(&bvh, pts, order, &s, 1.0)
@@ -128,7 +117,7 @@ mod tests {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1.0, 1.0],
+            light_shape: LightShape::rect([1.0, 1.0]),
             receiver: &receiver,
             occluder_layers: vec![],
             occluder_triangles: Some(&tris),
@@ -171,7 +160,7 @@ mod tests {
         let mk = |t| ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1.0, 1.0],
+            light_shape: LightShape::rect([1.0, 1.0]),
             receiver: &[],
             occluder_layers: vec![],
             occluder_triangles: t,

@@ -3,6 +3,7 @@
 //! reads the methods.
 
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use glam::Vec3;
 
 /// What every method reads: the light-view maps and the light's size.
@@ -13,8 +14,8 @@ pub struct ShadowInputs<'a> {
     /// The occluder maps' grid: the same extent, its own resolution (coarser
     /// occluder maps cost less; the paper notes large lights need fewer texels).
     pub occluder_grid: MapGrid,
-    /// Full light width along u and height along v (world units).
-    pub light_size: [f64; 2],
+    /// The light's shape in its plane (geom/light_shape.rs), in depth units.
+    pub light_shape: LightShape,
     /// Receiver planar depth per texel, `inf` where there is no receiver.
     pub receiver: &'a [f32],
     /// Occluder depth layers: the front (nearest) map, then the back (farthest) one.

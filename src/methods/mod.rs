@@ -37,6 +37,7 @@ pub use registry::{
 pub(crate) mod plate_case {
     use super::{ShadowInputs, ShadowMethod};
     use crate::geom::light::MapGrid;
+    use crate::geom::light_shape::LightShape;
 
     /// Largest |V - V_exact| of `method` on an n x n map of a plate covering
     /// tangent [-1/4, 1/4]^2 at depth 2 over a floor at depth 4 (light 1 x 1).
@@ -59,7 +60,7 @@ pub(crate) mod plate_case {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1.0, 1.0],
+            light_shape: LightShape::rect([1.0, 1.0]),
             receiver: &receiver,
             occluder_layers: vec![&front],
             occluder_triangles: None,

@@ -69,7 +69,8 @@
 
 use super::pcf::{self, occludes, Axis, Border};
 use super::{point_light, LightPoint, ShadowInputs, ShadowMethod};
-use crate::geom::light::{is_point, MapGrid};
+use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use rayon::prelude::*;
 
 /// The default taps per axis per stage (at most 16 x 16 taps per stage per
@@ -121,9 +122,9 @@ fn size_component(l: f64) -> f64 {
 /// L/2 per axis divided by the texel's tangent width on `grid`, light sizes
 /// as the kernel reads them (`size_component`): (1/z - 1/z_r) times this is
 /// a box's half-width in texels. The GPU twin (src/gpu/pcss.rs) reads the same.
-pub(crate) fn half_per_w(grid: &MapGrid, light_size: [f64; 2]) -> [f64; 2] {
+pub(crate) fn half_per_w(grid: &MapGrid, light_shape: LightShape) -> [f64; 2] {
     let (hx, hy) = grid.half_texel();
-    let [lu, lv] = light_size.map(size_component);
+    let [lu, lv] = light_shape.extent().map(size_component);
     // (L/2) / (2 half-texel)
     [0.25 * lu / hx, 0.25 * lv / hy]
 }
@@ -151,7 +152,7 @@ impl<'a> Kernel<'a> {
             grid,
             front,
             z_near,
-            half_per_w: half_per_w(&grid, inputs.light_size),
+            half_per_w: half_per_w(&grid, inputs.light_shape),
             max_taps,
         })
     }
@@ -207,7 +208,7 @@ impl<'a> Kernel<'a> {
 
 impl ShadowMethod for Pcss {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
-        if is_point(inputs.light_size) {
+        if inputs.light_shape.is_point() {
             return point_light::visibility_map(inputs);
         }
         let g = inputs.grid;
@@ -225,7 +226,7 @@ impl ShadowMethod for Pcss {
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        if is_point(inputs.light_size) {
+        if inputs.light_shape.is_point() {
             return point_light::visibility_points(inputs, points);
         }
         let Some(kernel) = Kernel::new(inputs, self.max_taps) else {
@@ -259,7 +260,7 @@ mod tests {
         ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: light,
+            light_shape: LightShape::rect(light),
             receiver,
             occluder_layers: vec![front],
             occluder_triangles: None,

@@ -61,6 +61,7 @@ pub fn visibility_points(inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f3
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::light_shape::LightShape;
     use crate::methods::ssm::Ssm;
     use crate::methods::ShadowMethod;
 
@@ -88,13 +89,13 @@ mod tests {
         let mut inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1e-6, 1e-6],
+            light_shape: LightShape::rect([1e-6, 1e-6]),
             receiver: &receiver,
             occluder_layers: vec![&front],
             occluder_triangles: None,
         };
         let soft = Ssm::default().visibility_map(&inputs);
-        inputs.light_size = [0.0, 0.0];
+        inputs.light_shape = LightShape::rect([0.0, 0.0]);
         let hard = visibility_map(&inputs);
         for (k, (s, h)) in soft.iter().zip(&hard).enumerate() {
             // Pairs within 1e-5 in depth are too close for a 1e-6 light to

@@ -152,8 +152,7 @@ impl Method {
 /// Visibility of every receiver texel: the method's, or for a point light
 /// (size 0) on the map methods the hard shadow they converge to.
 pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
-    if crate::geom::light::is_point(inputs.light_size) && method.reads_input(Input::OccluderLayers)
-    {
+    if inputs.light_shape.is_point() && method.reads_input(Input::OccluderLayers) {
         point_light::visibility_map(inputs)
     } else {
         method.implementation().visibility_map(inputs)
@@ -162,8 +161,7 @@ pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
 
 /// Visibility at receiver points, as `shade_map`.
 pub fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
-    if crate::geom::light::is_point(inputs.light_size) && method.reads_input(Input::OccluderLayers)
-    {
+    if inputs.light_shape.is_point() && method.reads_input(Input::OccluderLayers) {
         point_light::visibility_points(inputs, pts)
     } else {
         method.implementation().visibility_points(inputs, pts)

@@ -2,7 +2,7 @@
 //! light: which are traced, in what groups, and what each receiver sees.
 //!
 //! Each receiver sends one ray to a jittered point in each stratum of an
-//! a x b grid over the light (`exact::sample_grid`); the jitter is a hash
+//! a x b grid over the light (`LightShape::sample_grid`); the jitter is a hash
 //! of the receiver's key and the stratum, so results are deterministic and
 //! the same on the GPU (`gpu/exact.wgsl`, which traces every ray). What
 //! the CPU skips or groups never changes a ray's answer:
@@ -27,6 +27,7 @@
 use super::bvh::Bvh;
 use super::packet::{Mask, Rays, ALL, LANES};
 use super::shaft::is_clear;
+use crate::geom::light_shape::LightSamples;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -72,27 +73,22 @@ impl RayOrigin for Vec3 {
 /// The light samples every receiver's rays go to, and where rays start.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Sampling {
-    /// The stratification (`sample_grid`).
-    pub grid: (u32, u32),
-    /// The light's size.
-    pub size: [f32; 2],
+    /// The strata and where their samples lie (`LightShape::samples`).
+    pub light: LightSamples,
     /// Segments are t in (t0, 1 - RAY_EPS) of origin to light point.
     pub t0: f32,
 }
 
 impl Sampling {
-    /// The light rectangle of strata [a0, a1) x [b0, b1).
+    /// The box of the light holding strata [a0, a1) x [b0, b1).
     fn rect(&self, a0: u32, a1: u32, b0: u32, b1: u32) -> [[f32; 2]; 2] {
-        let (na, nb) = self.grid;
-        let x = |a: u32| (a as f32 / na as f32 - 0.5) * self.size[0];
-        let y = |b: u32| (b as f32 / nb as f32 - 0.5) * self.size[1];
-        [[x(a0), x(a1)], [y(b0), y(b1)]]
+        self.light.region(a0, a1, b0, b1)
     }
 
     /// The light point of sample (sa, sb) for the receiver whose jitter
     /// key is `key`.
     pub(crate) fn sample(&self, key: u64, sa: u32, sb: u32) -> (f32, f32) {
-        let na = self.grid.0;
+        let na = self.light.grid.0;
         self.point(key, hash(((sb * na + sa) as u64) << 1), sa, sb)
     }
 
@@ -100,11 +96,8 @@ impl Sampling {
     /// every receiver shares.
     #[inline(always)]
     fn point(&self, key: u64, hs: u64, sa: u32, sb: u32) -> (f32, f32) {
-        let (na, nb) = self.grid;
         let h = hash(key ^ hs);
-        let x = ((sa as f32 + unit(h)) / na as f32 - 0.5) * self.size[0];
-        let y = ((sb as f32 + unit(hash(h))) / nb as f32 - 0.5) * self.size[1];
-        (x, y)
+        self.light.point(sa, sb, unit(h), unit(hash(h)))
     }
 }
 
@@ -133,7 +126,7 @@ pub(crate) fn visibilities<R: RayOrigin>(
     absent: f32,
 ) -> Vec<f32> {
     debug_assert_eq!(order.len(), receivers.len());
-    let light = s.rect(0, s.grid.0, 0, s.grid.1);
+    let light = s.rect(0, s.light.grid.0, 0, s.light.grid.1);
     let traced: Vec<Vec<(usize, f32)>> = order
         .par_chunks(CHUNK)
         .map(|chunk| {
@@ -173,7 +166,7 @@ fn trace_packet<R: RayOrigin>(bvh: &Bvh, group: &[(u64, &R)], s: &Sampling) -> [
     let valid: Mask = if m == LANES { ALL } else { (1 << m) - 1 };
     // Unused lanes repeat the last receiver (masked off).
     let lane = |i: usize| group[i.min(m - 1)];
-    let (na, nb) = s.grid;
+    let (na, nb) = s.light.grid;
     let t1 = 1.0 - RAY_EPS;
 
     // The packet's origins, and which regions of strata their shaft

@@ -331,6 +331,7 @@ impl ShadowMethod for Ssm {
 mod tests {
     use super::*;
     use crate::geom::light::MapGrid;
+    use crate::geom::light_shape::LightShape;
 
     /// The published method written as plainly as possible, in f64: every
     /// occluder texel against every receiver texel, no bounds, no early exit.
@@ -338,7 +339,7 @@ mod tests {
         let g = &inputs.grid;
         let og = &inputs.occluder_grid;
         let (hw, hh) = og.half_texel();
-        let [lx, ly] = inputs.light_size;
+        let LightShape::Rect { size: [lx, ly] } = inputs.light_shape;
         let overlap = |a: f64, b: f64| (b.clamp(0.0, 1.0) - a.clamp(0.0, 1.0)).max(0.0);
         let mut out = vec![1f32; g.len()];
         for jr in 0..g.height {
@@ -427,7 +428,7 @@ mod tests {
                 let inputs = ShadowInputs {
                     grid,
                     occluder_grid: grid,
-                    light_size: [1.0, 0.7],
+                    light_shape: LightShape::rect([1.0, 0.7]),
                     receiver: &receiver,
                     occluder_layers: layers,
                     occluder_triangles: None,
@@ -482,7 +483,7 @@ mod tests {
             let inputs = ShadowInputs {
                 grid,
                 occluder_grid: og,
-                light_size: [0.8, 1.1],
+                light_shape: LightShape::rect([0.8, 1.1]),
                 receiver: &receiver,
                 occluder_layers: vec![&front],
                 occluder_triangles: None,
@@ -522,7 +523,7 @@ mod tests {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1.0, 0.7],
+            light_shape: LightShape::rect([1.0, 0.7]),
             receiver: &receiver,
             occluder_layers: vec![&front],
             occluder_triangles: None,
@@ -572,7 +573,7 @@ mod tests {
             let with_levels = ShadowInputs {
                 grid,
                 occluder_grid: og,
-                light_size: [1.0, 0.8],
+                light_shape: LightShape::rect([1.0, 0.8]),
                 receiver: &receiver,
                 occluder_layers: vec![&front],
                 occluder_triangles: None,

@@ -6,6 +6,7 @@ use crate::backend::Backend;
 use crate::error::Result;
 use crate::frame::{check_depth_inputs, DepthInUnit};
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::units::{depth_unit, farthest};
 use crate::light_view::{CpuLightView, LightViewStages};
 use crate::methods::Method;
@@ -17,7 +18,7 @@ use crate::timing::{Stopwatch, Timings};
 pub struct DepthMaps<'a> {
     pub grid: &'a MapGrid,
     pub occluder_grid: &'a MapGrid,
-    pub light_size: [f64; 2],
+    pub light_shape: LightShape,
     pub front: &'a [f32],
     pub back: Option<&'a [f32]>,
     pub receiver: &'a [f32],
@@ -44,10 +45,10 @@ pub fn from_depth_with<S: LightViewStages>(
     m: &DepthMaps,
     method: Method,
 ) -> Result<(Vec<f32>, Timings)> {
-    let light_size = check_depth_inputs(
+    let light_shape = check_depth_inputs(
         m.grid,
         m.occluder_grid,
-        m.light_size,
+        m.light_shape,
         m.front,
         m.back,
         m.receiver,
@@ -59,7 +60,7 @@ pub fn from_depth_with<S: LightViewStages>(
     let unit = depth_unit(farthest(m.receiver));
     let layers = 1 + m.back.is_some() as usize;
     stages.reserve_depth(method, (m.grid, m.occluder_grid), layers, unit)?;
-    let d = DepthInUnit::new(unit, light_size, m.front, m.back, m.receiver)?;
+    let d = DepthInUnit::new(unit, light_shape, m.front, m.back, m.receiver)?;
     let v = stages.depth((m.grid, m.occluder_grid), &d, method, &mut sw)?;
     Ok((v, stages.timings(sw.timings)))
 }
@@ -73,7 +74,7 @@ mod tests {
     fn cpu(
         grid: &MapGrid,
         og: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         front: &[f32],
         back: Option<&[f32]>,
         receiver: &[f32],
@@ -82,7 +83,7 @@ mod tests {
         let maps = DepthMaps {
             grid,
             occluder_grid: og,
-            light_size,
+            light_shape,
             front,
             back,
             receiver,
@@ -123,13 +124,23 @@ mod tests {
         };
         for method in [ssm, bitmask] {
             let (f, r) = plate_maps(n, 1.0);
-            let (base, _) = cpu(&grid, &grid, [1.0, 0.6], &f, None, &r, method).unwrap();
+            let (base, _) = cpu(
+                &grid,
+                &grid,
+                LightShape::rect([1.0, 0.6]),
+                &f,
+                None,
+                &r,
+                method,
+            )
+            .unwrap();
             assert!(base.iter().any(|&v| v < 1e-6));
             for k in [-90, -70, 50, 60, 90] {
                 let s = 2f32.powi(k);
                 let (f, r) = plate_maps(n, s);
                 let size = [s as f64, 0.6 * s as f64];
-                let (v, _) = cpu(&grid, &grid, size, &f, None, &r, method).unwrap();
+                let (v, _) =
+                    cpu(&grid, &grid, LightShape::rect(size), &f, None, &r, method).unwrap();
                 assert_eq!(v, base, "{method:?} at 2^{k}");
             }
         }
@@ -143,7 +154,7 @@ mod tests {
         let err = cpu(
             &grid,
             &grid,
-            [1e-35, 1.0],
+            LightShape::rect([1e-35, 1.0]),
             &f,
             None,
             &r,

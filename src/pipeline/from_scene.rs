@@ -35,7 +35,7 @@ pub fn from_scene(
         occluder_grid,
         near,
         unit,
-        light_size,
+        light_shape,
     } = frame_scene(&scene, &scene, light, s, &mut sw)?;
     let prepared = Prepared::with_faces(&grid, &occ_ls, scene.faces, near);
     let (receiver, faces) = prepared.nearest_faces();
@@ -65,11 +65,7 @@ pub fn from_scene(
         sw.lap("triangles");
         let starts = rays::ray_starts(light, unit, &points, &normals);
         let samples = match s.method {
-            crate::methods::Method::Exact { samples }
-                if !crate::geom::light::is_point(light_size) =>
-            {
-                samples
-            }
+            crate::methods::Method::Exact { samples } if !light_shape.is_point() => samples,
             _ => 1,
         };
         // Keys are texel indices, as the light-view exact's.
@@ -81,7 +77,7 @@ pub fn from_scene(
             all
         };
         let order = crate::methods::shadow_rays::tile_order(grid.width, grid.height);
-        let v = rays::visibility(light_size, tris, &keyed, &order, samples);
+        let v = rays::visibility(light_shape, tris, &keyed, &order, samples);
         for &k in &texels {
             visibility[k] = v[k];
         }
@@ -99,7 +95,7 @@ pub fn from_scene(
         let (v, m) = maps::shade(
             light,
             unit,
-            light_size,
+            light_shape,
             &tris,
             occluder_grid,
             s.passes,

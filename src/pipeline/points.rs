@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
-use crate::geom::units::{check_lateral, check_unit, depth_unit, light_size_in, scaled_map};
+use crate::geom::units::{check_lateral, check_unit, depth_unit, scaled_map};
 use crate::methods::{Input, LightPoint, Method, ShadowInputs};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -57,7 +57,7 @@ pub fn sample_points(
             .fold(0f64, |m, q| m.max(q.z)),
     );
     check_unit("points", unit)?;
-    let light_size = light_size_in("size", light.size(), unit)?;
+    let light_shape = light.shape().in_unit("size", unit)?;
     let (ls, inside): (Vec<LightPoint>, Vec<bool>) = ls_points
         .par_iter()
         .map(|q| {
@@ -143,7 +143,7 @@ pub fn sample_points(
     let inputs = ShadowInputs {
         grid: *grid,
         occluder_grid,
-        light_size,
+        light_shape,
         receiver: &[],
         occluder_layers: layers.iter().map(|l| &l[..]).collect(),
         occluder_triangles: triangles.as_deref(),

@@ -8,6 +8,7 @@ use super::results::{DepthShadowResult, MeshShadowResult};
 use crate::api::{self, DepthCall, MeshCall, SceneCall};
 use crate::backend::BackendChoice;
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::Light as CoreLight;
 use crate::methods::MethodConfig;
 use crate::pipeline::{self, OccluderSource};
@@ -182,7 +183,7 @@ pub fn shadow_map_from_depth<'py>(
         let call = DepthCall {
             grid,
             occluder_grid,
-            light_size,
+            light_shape: LightShape::rect(light_size),
             sun: angular_size,
             front: slice("occluder_depth", &occluder_depth)?,
             back: match &occluder_depth_back {

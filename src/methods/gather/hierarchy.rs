@@ -5,6 +5,7 @@
 //! the penumbra is wide. Built once per call in `Kernel::new`.
 
 use super::kernel::{Group, Kernel, Layer, Level, RowSpan, BLOCK};
+use crate::geom::light_shape::LightShape;
 use crate::methods::ShadowInputs;
 use rayon::prelude::*;
 
@@ -175,7 +176,10 @@ impl Kernel {
         let g = &inputs.occluder_grid;
         let r = &inputs.grid;
         let (hw, hh) = g.half_texel();
-        let [lx, ly] = inputs.light_size;
+        // The rectangle's clipping: half-light units (light_shape.rs).
+        let light = inputs.light_shape;
+        let LightShape::Rect { size: [lx, ly] } = light;
+        let half_light = light.half_light();
         // A layer equal to one already kept changes nothing (sums merge by
         // max, masks by OR), so it is not shaded: single-sided or flat
         // occluders make the back map equal the front one, and such a scene
@@ -232,10 +236,7 @@ impl Kernel {
                 height,
                 blocks_per_row: width.div_ceil(BLOCK),
                 scale: f as f32,
-                col_x0_scaled: col_x0
-                    .iter()
-                    .map(|&x| (x as f64 * 2.0 / lx) as f32)
-                    .collect(),
+                col_x0_scaled: col_x0.iter().map(|&x| light.x_in_half_light(x)).collect(),
                 col_x0,
                 row_y,
                 hw: (hw * f) as f32,
@@ -256,10 +257,10 @@ impl Kernel {
             ty: g.ty as f32,
             width: g.width as f32,
             height: g.height as f32,
-            inv_half_lx: (2.0 / lx) as f32,
-            inv_half_ly: (2.0 / ly) as f32,
-            half_lx: (0.5 * lx) as f32,
-            half_ly: (0.5 * ly) as f32,
+            inv_half_lx: half_light.inv_half[0],
+            inv_half_ly: half_light.inv_half[1],
+            half_lx: half_light.half[0],
+            half_ly: half_light.half[1],
             levels,
             texel_per_d: (4.0 * (hw / lx).max(hh / ly)) as f32,
             max_on_light: 2.0 * hierarchy.map_or(0.0, |h| h.max_texel_on_light),
@@ -388,6 +389,7 @@ impl Kernel {
 mod tests {
     use super::*;
     use crate::geom::light::MapGrid;
+    use crate::geom::light_shape::LightShape;
 
     /// Layers the kernel keeps for the occluder maps `layers`.
     fn kept(layers: Vec<&[f32]>) -> usize {
@@ -396,7 +398,7 @@ mod tests {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_size: [1.0, 1.0],
+            light_shape: LightShape::rect([1.0, 1.0]),
             receiver: &receiver,
             occluder_layers: layers,
             occluder_triangles: None,

@@ -45,7 +45,7 @@ impl Smoothies {
         } else {
             front
         };
-        let buffer = self.buffer(og, inputs.light_size, map, verts, faces);
+        let buffer = self.buffer(og, inputs.light_shape, map, verts, faces);
         self.visibility_points(og, map, &buffer, points)
     }
 
@@ -77,6 +77,7 @@ impl ShadowMethod for Smoothies {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::light_shape::LightShape;
 
     #[test]
     fn a_soup_has_the_silhouette_of_its_indexed_mesh() {
@@ -102,12 +103,12 @@ mod tests {
         };
         let a = s.buffer(
             &grid,
-            [0.2, 0.2],
+            LightShape::rect([0.2, 0.2]),
             &front,
             &v.map(|p| p.as_vec3().as_dvec3()),
             &faces,
         );
-        let b = s.buffer(&grid, [0.2, 0.2], &front, &sv, &sf);
+        let b = s.buffer(&grid, LightShape::rect([0.2, 0.2]), &front, &sv, &sf);
         // Four boundary edges either way (the shared diagonal is no silhouette).
         assert_eq!(a.stats.silhouette_edges, 4);
         assert_eq!(a, b);

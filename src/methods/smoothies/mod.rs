@@ -29,6 +29,7 @@ mod silhouette;
 mod tests;
 
 use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
 use crate::methods::LightPoint;
 pub(crate) use construct::Shape;
 use glam::DVec3;
@@ -131,17 +132,19 @@ impl Smoothies {
     /// light, or a positive width.
     pub fn tangent_width(
         &self,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         verts: &[DVec3],
         faces: &[[u32; 3]],
     ) -> Option<[f64; 2]> {
         let sil = silhouette::silhouette(verts, faces);
-        let t = self.q_width(&sil, light_size)?;
-        Some([t * light_size[0], t * light_size[1]])
+        let t = self.q_width(&sil, light_shape)?;
+        let [lx, ly] = light_shape.extent();
+        Some([t * lx, t * ly])
     }
 
     /// t in the image plane scaled by the light's size (construct.rs).
-    fn q_width(&self, sil: &silhouette::Silhouette, light: [f64; 2]) -> Option<f64> {
+    fn q_width(&self, sil: &silhouette::Silhouette, light: LightShape) -> Option<f64> {
+        let light = light.extent();
         let light_ok = light.iter().all(|l| l.is_finite() && *l > 0.0);
         if !(light_ok && self.width.is_finite() && self.width > 0.0) {
             return None;
@@ -157,7 +160,7 @@ impl Smoothies {
     pub(crate) fn smoothies(
         &self,
         grid: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         verts: &[DVec3],
         faces: &[[u32; 3]],
     ) -> Built {
@@ -166,14 +169,14 @@ impl Smoothies {
             silhouette_edges: sil.edges.len(),
             ..Default::default()
         };
-        let Some(t) = self.q_width(&sil, light_size) else {
+        let Some(t) = self.q_width(&sil, light_shape) else {
             return Built {
                 shapes: vec![],
                 t: 0.0,
                 stats,
             };
         };
-        let smoothies = construct::build(&sil, grid, light_size, t);
+        let smoothies = construct::build(&sil, grid, light_shape.extent(), t);
         stats.corners = smoothies.corners;
         Built {
             shapes: smoothies.shapes,
@@ -187,13 +190,13 @@ impl Smoothies {
     pub fn buffer(
         &self,
         grid: &MapGrid,
-        light_size: [f64; 2],
+        light_shape: LightShape,
         front: &[f32],
         verts: &[DVec3],
         faces: &[[u32; 3]],
     ) -> SmoothieBuffer {
         assert_eq!(front.len(), grid.len(), "front must be H x W on the grid");
-        let built = self.smoothies(grid, light_size, verts, faces);
+        let built = self.smoothies(grid, light_shape, verts, faces);
         let mut buf = SmoothieBuffer {
             depth: vec![f32::INFINITY; grid.len()],
             alpha: vec![1.0; grid.len()],
@@ -204,7 +207,7 @@ impl Smoothies {
         }
         buf.stats.texels = buffer::rasterize(
             grid,
-            light_size,
+            light_shape.extent(),
             front,
             &built.shapes,
             built.t,

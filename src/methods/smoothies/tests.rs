@@ -50,7 +50,7 @@ fn plate_case(zr: f64, falloff: Falloff) -> (Vec<f32>, Vec<f32>, SmoothieBuffer)
     let receiver = vec![zr as f32; g.len()];
     let front = shadow_map(&plate_front(&g), &receiver);
     let s = sm(falloff);
-    let buf = s.buffer(&g, [1.0, 1.0], &front, &v, &f);
+    let buf = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, &v, &f);
     let vis = s.visibility_map(&g, &front, &buf, &receiver);
     (vis, front, buf)
 }
@@ -168,7 +168,7 @@ fn the_penumbra_widens_with_the_receiver_distance_as_t_times_1_minus_b_over_r() 
     let (v, f) = plate(A, ZO, [0.0, 0.0]);
     let front = plate_front(&g);
     let s = sm(Falloff::Linear);
-    let buf = s.buffer(&g, [1.0, 1.0], &front, &v, &f);
+    let buf = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, &v, &f);
     let vis = s.visibility_map(&g, &front, &buf, &vec![4.0; g.len()]);
     let (n, _) = penumbra_row(&vis);
     assert!((n as f64 * TEXEL - 0.25).abs() <= 2.0 * TEXEL, "{n}");
@@ -297,8 +297,11 @@ fn the_light_size_sets_the_width_per_axis() {
     let (v, f) = plate(A, ZO, [0.0, 0.0]);
     let front = plate_front(&g);
     let s = sm(Falloff::Linear);
-    assert_eq!(s.tangent_width([0.5, 1.0], &v, &f), Some([0.125, 0.25]));
-    let buf = s.buffer(&g, [0.5, 1.0], &front, &v, &f);
+    assert_eq!(
+        s.tangent_width(LightShape::rect([0.5, 1.0]), &v, &f),
+        Some([0.125, 0.25])
+    );
+    let buf = s.buffer(&g, LightShape::rect([0.5, 1.0]), &front, &v, &f);
     let vis = s.visibility_map(&g, &front, &buf, &vec![4.0; g.len()]);
     let across_u = (N / 2..N).filter(|i| vis[(N / 2) * N + i] < 1.0 && vis[(N / 2) * N + i] > 0.0);
     let across_v = (0..N / 2).filter(|j| vis[j * N + N / 2] < 1.0 && vis[j * N + N / 2] > 0.0);
@@ -320,8 +323,10 @@ fn minimum_blending_keeps_the_winners_depth() {
     v.extend(v2);
     let front = vec![f32::INFINITY; g.len()];
     let s = sm(Falloff::Linear);
-    let buf = s.buffer(&g, [1.0, 1.0], &front, &v, &f);
-    let t = s.tangent_width([1.0, 1.0], &v, &f).unwrap()[0];
+    let buf = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, &v, &f);
+    let t = s
+        .tangent_width(LightShape::rect([1.0, 1.0]), &v, &f)
+        .unwrap()[0];
     let j = N / 2;
     let mut both = 0;
     for i in 0..N {
@@ -351,7 +356,7 @@ fn smoothies_behind_a_blocker_are_discarded() {
     v.extend(v2);
     let front = crate::raster::rasterize(&g, &v, &f, 1e-9, false).nearest;
     let s = sm(Falloff::Linear);
-    let buf = s.buffer(&g, [1.0, 1.0], &front, &v, &f);
+    let buf = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, &v, &f);
     assert_eq!(buf.stats.silhouette_edges, 8);
     // Only the large plate's smoothies (whose width is set by b_ref = 3 here).
     assert!(buf.stats.texels > 0);
@@ -383,7 +388,7 @@ fn run(v: &[DVec3], f: &[[u32; 3]]) -> (SmoothieBuffer, Vec<f32>) {
     let receiver = vec![4.0f32; g.len()];
     let front = shadow_map(&front, &receiver);
     let s = sm(Falloff::Sine);
-    let buf = s.buffer(&g, [1.0, 1.0], &front, v, f);
+    let buf = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, v, f);
     let vis = s.visibility_map(&g, &front, &buf, &receiver);
     assert!(finite_unit(&vis));
     assert!(buf
@@ -466,7 +471,7 @@ fn odd_meshes_neither_panic_nor_give_nan() {
         falloff: Falloff::Linear,
     };
     let front = vec![4.0f32; g.len()];
-    let b = s.buffer(&g, [1.0, 1.0], &front, &tri, &[[0, 1, 2]]);
+    let b = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, &tri, &[[0, 1, 2]]);
     assert!(b.stats.texels <= 6 * g.len());
     assert!(finite_unit(&s.visibility_map(
         &g,
@@ -481,7 +486,7 @@ fn no_occluders_and_no_receivers_are_lit() {
     let g = grid();
     let front = vec![f32::INFINITY; g.len()];
     for s in [sm(Falloff::Linear), sm(Falloff::Sine)] {
-        let buf = s.buffer(&g, [1.0, 1.0], &front, &[], &[]);
+        let buf = s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, &[], &[]);
         assert_eq!(buf.stats, SmoothieStats::default());
         assert!(s
             .visibility_map(&g, &front, &buf, &vec![3.0; g.len()])
@@ -517,7 +522,7 @@ fn no_occluders_and_no_receivers_are_lit() {
             [1.0, 1.0],
         ),
     ] {
-        let buf = s.buffer(&g, size, &front, &v, &f);
+        let buf = s.buffer(&g, LightShape::rect(size), &front, &v, &f);
         assert_eq!(buf.stats.texels, 0);
         let vis = s.visibility_map(&g, &front, &buf, &vec![4.0; g.len()]);
         assert!(vis.iter().all(|v| *v == 0.0 || *v == 1.0));
@@ -554,7 +559,10 @@ fn a_cube_has_a_silhouette_of_four_or_six_edges() {
     let g = grid();
     let front = vec![f32::INFINITY; g.len()];
     let s = sm(Falloff::Linear);
-    let count = |v: &[DVec3], f: &[[u32; 3]]| s.buffer(&g, [1.0, 1.0], &front, v, f).stats;
+    let count = |v: &[DVec3], f: &[[u32; 3]]| {
+        s.buffer(&g, LightShape::rect([1.0, 1.0]), &front, v, f)
+            .stats
+    };
     // Check the winding: every face's normal points away from the centre.
     let (v, f) = cube(DVec3::new(0.0, 0.0, 3.0), 0.3);
     for t in &f {

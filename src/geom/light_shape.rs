@@ -1,0 +1,241 @@
+//! The light's shape in its own plane: the one type every stage asks about
+//! the light, so that a new shape (a disk, a sphere's silhouette) is this
+//! file plus the kernels' sampling and clipping.
+//!
+//! The light lies in the plane Z = 0 of light space (light.rs), centred on
+//! the origin; its points are (x, y, 0) in the same units as depths (the
+//! user's, or the depth unit's once `in_unit` has scaled it).
+//!
+//! * **Rect** `{ size: [sx, sy] }`: the rectangle [-sx/2, sx/2] x
+//!   [-sy/2, sy/2]. `size = [0, 0]` is a point light (hard shadows,
+//!   methods/point_light.rs); otherwise both sides are finite and > 0.
+//! * **Bounds.** Every point of the light lies within the half-extents
+//!   (hx, hy) = (sx/2, sy/2). An occluder point at tangent t and depth z
+//!   shadows a receiver at depth z_r only within t ± h (1/z - 1/z_r) (the
+//!   light seen through it, scaled onto the receiver's tangent plane): the
+//!   reach that framing (extent.rs, eye focus), the gather kernels' windows
+//!   and chunks, PCSS's search box and the smoothies' width all bound.
+//! * **Sampling** (exact, the eye view's rays): a x b strata, a x b =
+//!   samples, the longer side taking the larger count (`sample_grid`); the
+//!   jittered sample (ja, jb) in [0, 1)^2 of stratum (sa, sb) is the point
+//!   (((sa + ja)/a - 1/2) sx, ((sb + jb)/b - 1/2) sy) (`LightSamples`).
+//! * **Clipping** (the map kernels: ssm's overlap, gather/hierarchy.rs,
+//!   the bitmask's ranks): light coordinates in half-light units
+//!   s = x / (sx/2), t = y / (sy/2), where the light is [-1, 1]^2 and a
+//!   micro-patch's coverage is the product of two interval overlaps
+//!   (`HalfLight`).
+//!
+//! Each quantity is computed here in the order the kernels always did (in
+//! f64, rounded once to f32), so moving it here changed no bit.
+
+use crate::error::{Error, Result};
+use crate::geom::units::{MAX_RELATIVE_SIZE, MIN_RELATIVE_SIZE};
+
+/// The shape of a light in its plane (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightShape {
+    /// Full width along u and full height along v; [0, 0]: a point light.
+    Rect { size: [f64; 2] },
+}
+
+impl LightShape {
+    /// A point light: the rectangle of size 0.
+    pub const POINT: LightShape = LightShape::Rect { size: [0.0, 0.0] };
+
+    /// The rectangle of full width and height `size`, unchecked (`check`).
+    pub const fn rect(size: [f64; 2]) -> LightShape {
+        LightShape::Rect { size }
+    }
+
+    /// The shape, or an error naming `arg`: a rectangle's sides both finite
+    /// and > 0, or both 0 (a point light).
+    pub fn check(self, arg: &str) -> Result<LightShape> {
+        let LightShape::Rect { size } = self;
+        if size.iter().all(|s| s.is_finite() && *s > 0.0) || size == [0.0, 0.0] {
+            Ok(self)
+        } else {
+            Err(Error::invalid(
+                arg,
+                format!(
+                    "must be two finite sizes > 0 (full width, full height), or (0, 0) for a \
+                     point light, got {size:?}"
+                ),
+            ))
+        }
+    }
+
+    /// Whether a (checked) shape is a point light's.
+    pub fn is_point(&self) -> bool {
+        let LightShape::Rect { size } = self;
+        *size == [0.0, 0.0]
+    }
+
+    /// The shape with every length divided by `unit` (a power of two:
+    /// exact, units.rs), refused when the kernels cannot resolve it: a
+    /// ratio to the receivers' depth outside [MIN_RELATIVE_SIZE,
+    /// MAX_RELATIVE_SIZE] makes 2/L or L/2 leave the f32 range.
+    pub fn in_unit(&self, arg: &str, unit: f64) -> Result<LightShape> {
+        let LightShape::Rect { size } = *self;
+        let s = [size[0] / unit, size[1] / unit];
+        if self.is_point() {
+            return Ok(LightShape::POINT);
+        }
+        if s.iter()
+            .all(|x| (MIN_RELATIVE_SIZE..=MAX_RELATIVE_SIZE).contains(x))
+        {
+            return Ok(LightShape::rect(s));
+        }
+        Err(Error::invalid(
+            arg,
+            format!(
+                "{size:?} is {:?} times the receivers' depth ({unit:e}); the kernels compute in \
+                 f32 and resolve ratios in [{MIN_RELATIVE_SIZE:e}, {MAX_RELATIVE_SIZE:e}] (a \
+                 smaller light casts the hard shadow: pass (0, 0) for a point light)",
+                s
+            ),
+        ))
+    }
+
+    /// The full width and height (2 hx, 2 hy) of the light's bounding box.
+    pub fn extent(&self) -> [f64; 2] {
+        let LightShape::Rect { size } = *self;
+        size
+    }
+
+    /// The half-extents (hx, hy) = (sx/2, sy/2): every light point has
+    /// |x| <= hx, |y| <= hy; the penumbra reach is h (1/z - 1/z_r).
+    pub fn half_extent(&self) -> [f64; 2] {
+        let LightShape::Rect { size } = *self;
+        [0.5 * size[0], 0.5 * size[1]]
+    }
+
+    /// The larger full side of the bounding box, max(2 hx, 2 hy): the
+    /// widest penumbra is this times (1/z_near - 1/z_r,far).
+    pub fn largest_width(&self) -> f64 {
+        let [sx, sy] = self.extent();
+        sx.max(sy)
+    }
+
+    /// The stratification a x b = samples, a the largest divisor <= sqrt,
+    /// the longer side of the light getting the larger count.
+    pub fn sample_grid(&self, samples: u32) -> (u32, u32) {
+        let LightShape::Rect { size } = *self;
+        let mut a = (samples as f64).sqrt() as u32;
+        while a > 1 && !samples.is_multiple_of(a) {
+            a -= 1;
+        }
+        let a = a.max(1);
+        let b = samples / a;
+        if size[0] >= size[1] {
+            (b, a)
+        } else {
+            (a, b)
+        }
+    }
+
+    /// The f32 sample pattern of `samples` rays per receiver.
+    pub fn samples(&self, samples: u32) -> LightSamples {
+        let LightShape::Rect { size } = *self;
+        LightSamples {
+            grid: self.sample_grid(samples),
+            size: size.map(|s| s as f32),
+        }
+    }
+
+    /// The map kernels' half-light units, in f32.
+    pub fn half_light(&self) -> HalfLight {
+        let LightShape::Rect { size } = *self;
+        HalfLight {
+            inv_half: [(2.0 / size[0]) as f32, (2.0 / size[1]) as f32],
+            half: [(0.5 * size[0]) as f32, (0.5 * size[1]) as f32],
+        }
+    }
+
+    /// An f32 tangent x in half-light units, scaled in f64 and rounded once
+    /// (`x * 2 / sx`; the kernels' column edges, CPU and GPU alike).
+    pub fn x_in_half_light(&self, x: f32) -> f32 {
+        let LightShape::Rect { size } = *self;
+        (x as f64 * 2.0 / size[0]) as f32
+    }
+}
+
+/// Where the rays of a receiver go on the light, in f32 (the ray casters'
+/// inner loops; `gpu/light_shape.wgsl` is the device's twin).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSamples {
+    /// The strata a x b (`LightShape::sample_grid`).
+    pub grid: (u32, u32),
+    /// The rectangle's full width and height.
+    pub size: [f32; 2],
+}
+
+impl LightSamples {
+    /// The light point of stratum (sa, sb) jittered by (ja, jb) in [0, 1)^2:
+    /// (((sa + ja)/a - 1/2) sx, ((sb + jb)/b - 1/2) sy).
+    #[inline(always)]
+    pub fn point(&self, sa: u32, sb: u32, ja: f32, jb: f32) -> (f32, f32) {
+        let (na, nb) = self.grid;
+        let x = ((sa as f32 + ja) / na as f32 - 0.5) * self.size[0];
+        let y = ((sb as f32 + jb) / nb as f32 - 0.5) * self.size[1];
+        (x, y)
+    }
+
+    /// The box [[x0, x1], [y0, y1]] holding every sample of strata
+    /// [a0, a1) x [b0, b1) (the shaft culling's target).
+    pub fn region(&self, a0: u32, a1: u32, b0: u32, b1: u32) -> [[f32; 2]; 2] {
+        let (na, nb) = self.grid;
+        let x = |a: u32| (a as f32 / na as f32 - 0.5) * self.size[0];
+        let y = |b: u32| (b as f32 / nb as f32 - 0.5) * self.size[1];
+        [[x(a0), x(a1)], [y(b0), y(b1)]]
+    }
+}
+
+/// The map kernels' clipping scales: light coordinates (x, y) become
+/// (x * inv_half[0], y * inv_half[1]), in which the light is [-1, 1]^2;
+/// `half` turns 1/depth differences back into tangent reach.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfLight {
+    /// (2/sx, 2/sy), rounded once from f64.
+    pub inv_half: [f32; 2],
+    /// (sx/2, sy/2), rounded once from f64.
+    pub half: [f32; 2],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shapes_are_checked_and_scaled() {
+        assert!(LightShape::rect([0.0, 1.0]).check("size").is_err());
+        assert!(LightShape::rect([-0.0, 0.0]).check("size").is_ok());
+        assert!(LightShape::rect([1.0, f64::NAN]).check("size").is_err());
+        assert!(LightShape::rect([-0.0, 0.0]).is_point());
+        let one = LightShape::rect([1.0, 1.0]);
+        assert!(one.in_unit("size", 2f64.powi(51)).is_ok());
+        assert!(LightShape::rect([1e-40, 1.0]).in_unit("size", 1.0).is_err());
+        assert!(LightShape::rect([1e-40, 1e-40])
+            .in_unit("size", 2f64.powi(-100))
+            .is_ok());
+        assert_eq!(
+            LightShape::POINT.in_unit("size", 4.0).unwrap(),
+            LightShape::POINT
+        );
+    }
+
+    #[test]
+    fn sample_grids_are_near_square_and_samples_cover_the_light() {
+        assert_eq!(LightShape::rect([1.0, 1.0]).sample_grid(256), (16, 16));
+        assert_eq!(LightShape::rect([2.0, 1.0]).sample_grid(12), (4, 3));
+        assert_eq!(LightShape::rect([1.0, 2.0]).sample_grid(12), (3, 4));
+        assert_eq!(LightShape::rect([1.0, 1.0]).sample_grid(7), (7, 1));
+        let s = LightShape::rect([2.0, 1.0]).samples(12);
+        assert_eq!(s.point(0, 0, 0.0, 0.0), (-1.0, -0.5));
+        assert_eq!(s.region(0, 4, 0, 3), [[-1.0, 1.0], [-0.5, 0.5]]);
+        assert_eq!(LightShape::rect([2.0, 1.0]).half_extent(), [1.0, 0.5]);
+        assert_eq!(
+            LightShape::rect([2.0, 1.0]).half_light().inv_half,
+            [1.0, 2.0]
+        );
+    }
+}
