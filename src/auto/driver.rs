@@ -82,7 +82,7 @@ pub(crate) fn planned(
         let coarse = MapGrid::new(eighth(w), eighth(h), fitted)?;
         let coarse_occ = MapGrid::new(quarter(occ.0), quarter(occ.1), fitted)?;
         let kernel = |gaps| {
-            MethodConfig::Bitmask(crate::methods::config::BitmaskConfig {
+            MethodConfig::Bitmask(crate::methods::BitmaskConfig {
                 samples: 256,
                 passes: Some(2),
                 occluder_resolution: Some((coarse_occ.width, coarse_occ.height)),

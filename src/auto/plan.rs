@@ -28,9 +28,9 @@
 //! is predicted from it by the largest ratio measured on the study's scenes.
 
 use crate::geom::light_shape::LightShape;
-use crate::methods::config::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 use crate::methods::shadow_mapping::config::Real;
 use crate::methods::target::Target;
+use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 
 /// What the planner reads of a framed scene (kernel units).
 #[derive(Debug, Clone, Copy)]
@@ -146,7 +146,7 @@ const CANDIDATES: [Candidate; 4] = [
         label: "ssm, 2 passes, quarter-resolution occluder maps (the sum)",
         worst_error: 0.046,
         time_ratio: 1.0,
-        config: |r| MethodConfig::Ssm(crate::methods::config::auto_rule(r)),
+        config: |r| MethodConfig::Ssm(crate::methods::auto_rule(r)),
     },
     Candidate {
         label: "bitmask, 256 samples, gaps closed, hierarchy",
@@ -805,7 +805,7 @@ mod tests {
 
     #[test]
     fn the_eye_view_takes_the_rule_for_loose_targets_and_exact_below() {
-        let rule = MethodConfig::Auto(crate::methods::config::AutoConfig::default());
+        let rule = MethodConfig::Auto(crate::methods::AutoConfig::default());
         let pick = |e: f64| plan_eye(&Target::new(Some(e), None).unwrap(), rule).config;
         assert_eq!(pick(0.05), rule);
         assert!(matches!(pick(0.01), MethodConfig::Exact(c) if c.samples == 81));

@@ -138,14 +138,14 @@ pub fn casting_faces<'s>(
     ) {
         return Cow::Borrowed(&scene.faces);
     }
-    let half = f.light_size.map(|s| 0.5 * s);
     let facing: Vec<[f64; 3]> = f
         .points
         .par_iter()
         .zip(&f.normals)
         .filter(|(p, n)| {
             let n = glam::Vec3::from_array(**n).as_dvec3();
-            tangent_plane::front_of(&f.space, f.unit, half, DVec3::from_array(**p), n) > 0.0
+            tangent_plane::front_of(&f.space, f.unit, f.light_shape, DVec3::from_array(**p), n)
+                > 0.0
         })
         .map(|(p, _)| *p)
         .collect();

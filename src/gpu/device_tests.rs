@@ -439,8 +439,8 @@ mod eye {
     use crate::geom::light_space::Light;
     use crate::geom::mesh::MeshRef;
     use crate::geom::sun::DirectionalLight;
-    use crate::methods::config::{BitmaskConfig, ExactConfig, SsmConfig};
     use crate::methods::MethodConfig;
+    use crate::methods::{BitmaskConfig, ExactConfig, SsmConfig};
     use glam::Vec3;
 
     type Mesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
@@ -892,7 +892,7 @@ mod eye {
         if !device_or_skip() {
             return;
         }
-        use crate::methods::config::SmoothiesConfig;
+        use crate::methods::SmoothiesConfig;
         let meshes = scene();
         let cam = camera((96, 72));
         for (lname, light) in lights() {
@@ -1249,7 +1249,7 @@ mod eye {
         if !device_or_skip() {
             return;
         }
-        use crate::methods::config::PcssConfig;
+        use crate::methods::PcssConfig;
         let meshes = scene();
         let cam = camera((96, 72));
         for (lname, light) in lights() {

@@ -20,11 +20,23 @@
 //! four projected corners: no light passes between connected neighbours.
 //! `Open` keeps the flat per-texel micro-patches, whose gaps between
 //! neighbours at different depths leak light inside the penumbra (§4.1.2).
+//!
+//! Its config (`BitmaskConfig`, its checks and its `MethodSpec`: name,
+//! string form, resolution, capabilities row) is at the end of this file.
 
+use super::config::{
+    check_passes, check_resolution, hierarchy_option, occluder_resolution_option, passes_option,
+    resolve_maps, CallContext, LooseOptions, MethodSpec, DEFAULT_PASSES, DEFAULT_SAMPLES,
+    PRECISION_SSM_ONLY,
+};
 use super::gather::{
     self, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
+use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
+use crate::backend::Backend;
+use crate::error::{Error, Result};
 use glam::Vec4;
 
 /// A set of up to 64 W light samples.
@@ -625,6 +637,153 @@ impl ShadowMethod for Bitmask {
             points,
             self.hierarchy
         ))
+    }
+}
+
+/// Whether the hierarchy is on by default on the CPU: on for bitmask
+/// (the level choice, `HIERARCHY`, is measured with it).
+pub const HIERARCHY_DEFAULT_BITMASK: bool = true;
+
+/// Micro-patches marking light samples in a bit mask per receiver
+/// (Schwarz & Stamminger 2007).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BitmaskConfig {
+    /// One of `SAMPLE_COUNTS`.
+    pub samples: u32,
+    pub passes: Option<u32>,
+    pub occluder_resolution: Option<(usize, usize)>,
+    /// `None`: on where the backend has a hierarchy (the CPU), else off.
+    pub hierarchy: Option<bool>,
+    /// How neighbouring micro-patches meet.
+    pub gaps: Gaps,
+}
+
+/// Light samples of `bitmask`: one of its patterns' sizes.
+pub fn check_bitmask_samples(n: i64) -> Result<u32> {
+    match SAMPLE_COUNTS.iter().find(|&&c| c as i64 == n) {
+        Some(&c) => Ok(c),
+        None => Err(Error::invalid(
+            "samples",
+            format!("bitmask takes one of {:?} samples, got {n}", SAMPLE_COUNTS),
+        )),
+    }
+}
+
+impl BitmaskConfig {
+    pub fn new(
+        samples: Option<i64>,
+        passes: Option<i64>,
+        occluder_resolution: Option<(i64, i64)>,
+        hierarchy: Option<bool>,
+        gaps: Option<&str>,
+    ) -> Result<Self> {
+        let gaps = match gaps {
+            None => Gaps::default(),
+            Some(g) => Gaps::parse(g).ok_or_else(|| {
+                let names: Vec<&str> = Gaps::ALL.iter().map(|g| g.name()).collect();
+                Error::invalid("gaps", format!("must be one of {names:?}, got {g:?}"))
+            })?,
+        };
+        Ok(BitmaskConfig {
+            gaps,
+            samples: samples
+                .map(check_bitmask_samples)
+                .transpose()?
+                .unwrap_or(DEFAULT_SAMPLES),
+            passes: passes.map(check_passes).transpose()?,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+            hierarchy,
+        })
+    }
+}
+
+impl Default for BitmaskConfig {
+    fn default() -> Self {
+        BitmaskConfig {
+            samples: DEFAULT_SAMPLES,
+            passes: None,
+            occluder_resolution: None,
+            hierarchy: None,
+            gaps: Default::default(),
+        }
+    }
+}
+
+impl MethodSpec for BitmaskConfig {
+    const NAME: &'static str = "bitmask";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if o.precision.is_some() {
+            return Err(refuse("precision", PRECISION_SSM_ONLY));
+        }
+        BitmaskConfig::new(
+            o.samples,
+            o.passes,
+            o.occluder_resolution,
+            o.hierarchy,
+            None,
+        )
+    }
+    type Resolved = Self;
+    fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
+        let c = self;
+        let (passes, occ, hierarchy) = resolve_maps(
+            c.passes,
+            c.occluder_resolution,
+            c.hierarchy,
+            HIERARCHY_DEFAULT_BITMASK,
+            ctx,
+        )?;
+        Ok(BitmaskConfig {
+            samples: c.samples,
+            gaps: c.gaps,
+            passes: Some(passes),
+            occluder_resolution: Some(occ),
+            hierarchy: Some(hierarchy),
+        })
+    }
+    fn passes(&self) -> u32 {
+        self.passes.unwrap_or(DEFAULT_PASSES)
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "bitmask",
+            config: "Bitmask",
+            summary: "The same micro-patches marking the light samples they hide in a bit mask \
+                      per receiver, merged by OR (Schwarz & Stamminger 2007)",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                OptionInfo {
+                    name: "samples",
+                    kind: Kind::OneOf(SAMPLE_COUNTS.iter().map(|&n| n as i64).collect()),
+                    default: Value::Int(DEFAULT_SAMPLES as i64),
+                    default_doc: "256",
+                    doc: "light samples per receiver, a multi-jittered pattern shared by all \
+                          receivers",
+                    restricted_on: vec![],
+                },
+                passes_option(),
+                occluder_resolution_option(),
+                hierarchy_option(HIERARCHY_DEFAULT_BITMASK),
+                OptionInfo {
+                    name: "gaps",
+                    kind: Kind::Choice(Gaps::ALL.iter().map(|g| g.name()).collect()),
+                    default: Value::Str(Gaps::default().name()),
+                    default_doc: "closed",
+                    doc: "how neighbouring micro-patches meet: closed, connected micro-quads \
+                          (no light between neighbours on one surface; a depth step steeper \
+                          than 76° from the light's direction stays open); open, the flat \
+                          per-texel micro-patches of the paper, whose gaps leak light (§4.1.2)",
+                    restricted_on: vec![],
+                },
+            ],
+        }
     }
 }
 

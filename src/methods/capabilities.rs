@@ -1,6 +1,6 @@
 //! The table of methods: their options, defaults, limits, the backends that
 //! run them and what they read. Each method's config describes itself
-//! (`MethodSpec::info`, `config.rs`, from the constants its checks use, so
+//! (`MethodSpec::info`, in its own module, from the constants its checks use, so
 //! the table cannot drift from the checks); the registry lists them in
 //! order. The Python package reads it from `_core` and copies nothing.
 
@@ -42,7 +42,7 @@ pub fn limits() -> Limits {
 
 /// The methods, in the order a user meets them (the registry's).
 pub fn methods() -> Vec<MethodInfo> {
-    super::config::MethodConfig::infos()
+    super::MethodConfig::infos()
 }
 
 #[cfg(test)]
@@ -52,7 +52,7 @@ mod tests {
     #[test]
     fn every_method_name_has_one_row() {
         let names: Vec<_> = methods().iter().map(|m| m.name).collect();
-        assert_eq!(names, super::super::config::METHOD_NAMES);
+        assert_eq!(names, super::super::METHOD_NAMES);
     }
 
     /// A default written out as a number in the docs is the default the

@@ -13,11 +13,22 @@
 //! f64 and then stored in f32), so a scene far from the world origin keeps its
 //! precision. The light is its shape at Z = 0 (geom/light_shape.rs: where the
 //! samples lie).
+//!
+//! Its config (`ExactConfig`, its checks and its `MethodSpec`: name, string
+//! form, resolution, capabilities row) is at the end of this file.
 
 pub use super::bvh::Bvh;
+use super::config::{
+    check_passes, CallContext, LooseOptions, MethodSpec, DEFAULT_SAMPLES, MAX_SAMPLES,
+    PRECISION_SSM_ONLY,
+};
+use super::info::{Kind, MethodInfo, OptionInfo, Value};
 pub(crate) use super::shadow_rays::RAY_EPS;
 use super::shadow_rays::{tile_order, visibilities, Sampling};
+use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
+use crate::backend::Backend;
+use crate::error::{Error, Result};
 use crate::geom::light_shape::{LightSamples, LightShape};
 use glam::Vec3;
 
@@ -84,6 +95,102 @@ impl ShadowMethod for Exact {
         let pts: Vec<Option<Vec3>> = points.iter().map(light_point).collect();
         let order: Vec<usize> = (0..pts.len()).collect();
         self.shade(inputs, &pts, &order)
+    }
+}
+
+/// Ray casting through a BVH of the occluder triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ExactConfig {
+    pub samples: u32,
+}
+
+/// Light samples of `exact`: 1 to MAX_SAMPLES.
+pub fn check_exact_samples(n: i64) -> Result<u32> {
+    if (1..=MAX_SAMPLES as i64).contains(&n) {
+        Ok(n as u32)
+    } else {
+        Err(Error::invalid(
+            "samples",
+            format!("must be in [1, {MAX_SAMPLES}], got {n}"),
+        ))
+    }
+}
+
+impl ExactConfig {
+    pub fn new(samples: Option<i64>) -> Result<Self> {
+        Ok(ExactConfig {
+            samples: samples
+                .map(check_exact_samples)
+                .transpose()?
+                .unwrap_or(DEFAULT_SAMPLES),
+        })
+    }
+}
+
+impl Default for ExactConfig {
+    fn default() -> Self {
+        ExactConfig {
+            samples: DEFAULT_SAMPLES,
+        }
+    }
+}
+
+impl MethodSpec for ExactConfig {
+    const NAME: &'static str = "exact";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        // `passes` beside "exact" is accepted and has no effect (the
+        // string form always allowed it: it reads no layers).
+        if let Some(p) = o.passes {
+            check_passes(p)?;
+        }
+        for (given, opt) in [
+            (o.occluder_resolution.is_some(), "occluder_resolution"),
+            (o.hierarchy.is_some(), "hierarchy"),
+        ] {
+            if given {
+                return Err(refuse(
+                    opt,
+                    "the occluder-map methods (\"ssm\", \"bitmask\"); \"exact\" traces the occluder triangles",
+                ));
+            }
+        }
+        if o.precision.is_some() {
+            return Err(refuse("precision", PRECISION_SSM_ONLY));
+        }
+        ExactConfig::new(o.samples)
+    }
+    type Resolved = Self;
+    fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
+        if ctx.depth_layers.is_some() {
+            return Err(Error::invalid(
+                "method",
+                "\"exact\" traces the occluder triangles, which depth maps do not have; \
+                 use soft_shadow_map with meshes",
+            ));
+        }
+        Ok(self)
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "exact",
+            config: "Exact",
+            summary: "Ray casting against the occluder triangles (a BVH) with stratified light \
+                      samples, jittered deterministically: converges to the true visibility",
+            reads: vec![Input::OccluderTriangles],
+            backends: Backend::built().to_vec(),
+            options: vec![OptionInfo {
+                name: "samples",
+                kind: Kind::Int {
+                    min: 1,
+                    max: MAX_SAMPLES as i64,
+                },
+                default: Value::Int(DEFAULT_SAMPLES as i64),
+                default_doc: "256 (a 16x16 stratification)",
+                doc: "light samples per receiver",
+                restricted_on: vec![],
+            }],
+        }
     }
 }
 

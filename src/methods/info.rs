@@ -1,6 +1,6 @@
 //! What the table of methods says of one method and its options (the
 //! types `capabilities()` returns): each method's config describes itself
-//! with them (`MethodSpec::info`, `config.rs`).
+//! with them (`MethodSpec::info`, in the method's own module).
 
 use super::Input;
 use crate::backend::Backend;

@@ -1,5 +1,5 @@
 //! What every method reads and writes, apart from the registry that picks
-//! one (`registry.rs`): the methods' modules read these types, the registry
+//! one (`mod.rs`): the methods' modules read these types, the registry
 //! reads the methods.
 
 use crate::geom::light::MapGrid;

@@ -66,9 +66,20 @@
 //!   a box far wider than the map, i.e. visibility 1).
 //!
 //! Only the front layer (`occluder_layers[0]`) is read.
+//!
+//! Its config (`PcssConfig` and its `MethodSpec`: name, string form,
+//! resolution, capabilities row) is at the end of this file.
 
+use super::config::{
+    check_resolution, occluder_resolution_option, resolve_maps, CallContext, LooseOptions,
+    MethodSpec,
+};
+use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::pcf::{self, occludes, Axis, Border};
+use super::Input;
 use super::{point_light, LightPoint, ShadowInputs, ShadowMethod};
+use crate::backend::Backend;
+use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use rayon::prelude::*;
@@ -236,6 +247,106 @@ impl ShadowMethod for Pcss {
             .par_iter()
             .map(|p| kernel.visibility(p.x, p.y, p.z))
             .collect()
+    }
+}
+
+/// PCSS: blocker search, penumbra estimate and PCF on the shadow map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PcssConfig {
+    /// Taps per axis of the blocker search and of the filter (each box
+    /// wider than this many texels is sampled by as many strata).
+    pub max_taps: u32,
+    /// The shadow map's (W, H); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
+}
+
+impl PcssConfig {
+    pub fn new(max_taps: Option<i64>, occluder_resolution: Option<(i64, i64)>) -> Result<Self> {
+        let t = max_taps.unwrap_or(DEFAULT_MAX_TAPS as i64);
+        let max = MAX_TAPS as i64;
+        if !(1..=max).contains(&t) {
+            return Err(Error::invalid(
+                "max_taps",
+                format!("must be in [1, {max}], got {t}"),
+            ));
+        }
+        Ok(PcssConfig {
+            max_taps: t as u32,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+        })
+    }
+}
+
+impl Default for PcssConfig {
+    fn default() -> Self {
+        PcssConfig {
+            max_taps: DEFAULT_MAX_TAPS,
+            occluder_resolution: None,
+        }
+    }
+}
+
+impl MethodSpec for PcssConfig {
+    const NAME: &'static str = "pcss";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if let Some(opt) = o.given().into_iter().find(|o| *o != "occluder_resolution") {
+            return Err(refuse(opt, "other methods; give PCSS(...) its own options"));
+        }
+        PcssConfig::new(None, o.occluder_resolution)
+    }
+    type Resolved = Self;
+    fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
+        // From depth maps: the front layer the user gave.
+        let (_, occ, _) = resolve_maps(
+            Some(1),
+            self.occluder_resolution,
+            Some(false),
+            false,
+            &CallContext {
+                depth_layers: ctx.depth_layers.map(|(_, shape)| (1, shape)),
+                ..*ctx
+            },
+        )?;
+        Ok(PcssConfig {
+            occluder_resolution: Some(occ),
+            ..self
+        })
+    }
+    // The shadow map: the front layer.
+    fn passes(&self) -> u32 {
+        1
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "pcss",
+            config: "PCSS",
+            summary: "Percentage-closer soft shadows (Fernando 2005), what real-time engines \
+                      ship: a blocker search on the shadow map, the penumbra estimated from the \
+                      mean blocker depth, a box PCF of that width",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                OptionInfo {
+                    name: "max_taps",
+                    kind: Kind::Int {
+                        min: 1,
+                        max: MAX_TAPS as i64,
+                    },
+                    default: Value::Int(DEFAULT_MAX_TAPS as i64),
+                    default_doc: "16",
+                    doc: "taps per axis of the blocker search and of the filter: a box spanning \
+                          more texels is sampled by this many strata (bounded work per point)",
+                    restricted_on: vec![],
+                },
+                occluder_resolution_option(),
+            ],
+        }
     }
 }
 

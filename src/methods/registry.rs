@@ -1,169 +1,200 @@
-//! The registry of methods: the kernel enum (`Method`) with each method's
-//! names, what it reads and its implementation, and the dispatch of a map
-//! or points to it (the point-light path included).
+//! What one line of the registry (the `methods!` list in `mod.rs`) makes:
+//! the `MethodConfig` enum (a variant per config), `METHOD_NAMES`,
+//! `From<Config> for MethodConfig`, the string form's lookup and the
+//! dispatch of every `MethodConfig` method to the config's `MethodSpec`
+//! (its own module), the capabilities rows in the list's order.
+//!
+//! A macro, not a trait object: `MethodConfig` stays a plain `Copy + Eq +
+//! Hash` enum that the stages match on. It names only `config.rs` (the
+//! shared trait and types); the configs' modules never name it back (a
+//! resolution returns `MethodSpec::Resolved`, turned into a `MethodConfig`
+//! here), so no file imports itself through another.
 
-use super::gather::Hierarchy;
-use super::inputs::{Input, LightPoint, ShadowInputs, ShadowMethod};
-use super::{bitmask, exact, pcss, point_light, shadow_mapping, smoothies, ssm};
-
-/// A method's kernel, with the options that change what it computes (the
-/// options that change what it reads, layers and their resolution, are the
-/// pipeline's: see `config.rs`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Soft shadow maps, Atty et al. 2005, as published (additive
-    /// micro-patches); `hierarchy` reads coarser occluder texels where the
-    /// penumbra is wide (off by default: the paper has none).
-    Ssm {
-        hierarchy: bool,
-        precision: ssm::Precision,
-    },
-    /// Ray casting against the occluder triangles with stratified light samples.
-    Exact { samples: u32 },
-    /// Micro-patches marking light samples in a bit mask per receiver (OR);
-    /// `hierarchy` as for Ssm (on by default); `gaps` how neighbouring
-    /// micro-patches meet (closed: connected micro-quads).
-    Bitmask {
-        samples: u32,
-        hierarchy: bool,
-        gaps: bitmask::Gaps,
-    },
-    /// Scherzer 2005's shadow mapping: its own map and depth test
-    /// (`shadow_mapping/`, the eye view only).
-    ShadowMapping(shadow_mapping::config::ShadowMappingConfig),
-    /// Smoothies (Chan & Durand 2003) from the front layer and the
-    /// occluders' silhouette.
-    Smoothies {
-        width: shadow_mapping::config::Real,
-        falloff: smoothies::Falloff,
-    },
-    /// PCSS (Fernando 2005) on the front layer.
-    Pcss { max_taps: u32 },
-}
-
-/// The level choice of the occluder hierarchy: a texel may back-project onto
-/// at most this fraction of the light's width, seen from the receiver it is
-/// nearest to. Measured with bitmask (256 samples, two passes) against
-/// Mitsuba on the study's scenes (`benchmarks/bench_hierarchy.py`): at 3% the
-/// error moves by at most 0.001 while 512² maps take 1.2-4.4x less time; at
-/// 6% the error grew by up to 0.003 (a coarse texel misplaces an edge by half
-/// its back-projection), at 12.5% by up to 0.02.
-pub const HIERARCHY: Hierarchy = Hierarchy {
-    max_texel_on_light: 0.03,
-};
-
-/// Whether the hierarchy is on by default on the CPU: off for the paper's
-/// method (reproduced as published), on for bitmask.
-pub const HIERARCHY_DEFAULT_SSM: bool = false;
-pub const HIERARCHY_DEFAULT_BITMASK: bool = true;
-
-impl Method {
-    /// The name a user passes as `method=`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Ssm { .. } => "ssm",
-            Method::Exact { .. } => "exact",
-            Method::Bitmask { .. } => "bitmask",
-            Method::ShadowMapping(_) => "shadow_mapping",
-            Method::Smoothies { .. } => "smoothies",
-            Method::Pcss { .. } => "pcss",
+/// The registry of method configs; see the module's doc. Invoked once, in
+/// `mod.rs`, where each method's module is declared.
+macro_rules! methods {
+    ($($(#[doc = $doc:literal])* $variant:ident($config:ty),)*) => {
+        /// What a user picks: a method with its options, or `Auto` (see
+        /// `AutoConfig`).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum MethodConfig {
+            $($(#[doc = $doc])* $variant($config),)*
         }
-    }
 
-    /// What the method reads of the occluders.
-    pub fn reads(&self) -> &'static [Input] {
-        match self {
-            Method::Ssm { .. } | Method::Bitmask { .. } | Method::Pcss { .. } => {
-                &[Input::OccluderLayers]
+        /// The method names a user can pass as `method=`, in the table's order.
+        pub const METHOD_NAMES: &[&str] =
+            &[$(<$config as $crate::methods::config::MethodSpec>::NAME),*];
+
+        $(impl From<$config> for MethodConfig {
+            fn from(c: $config) -> Self {
+                MethodConfig::$variant(c)
             }
-            Method::Exact { .. } => &[Input::OccluderTriangles],
-            Method::ShadowMapping(_) => &[Input::SceneTriangles, Input::Camera],
-            Method::Smoothies { .. } => &[Input::OccluderLayers, Input::OccluderTriangles],
+        })*
+
+        impl MethodConfig {
+            /// The config named `name` with the loose options given: each
+            /// must apply to that method.
+            pub fn from_name(
+                name: &str,
+                o: &$crate::methods::config::LooseOptions,
+            ) -> $crate::error::Result<Self> {
+                use $crate::methods::config::MethodSpec;
+                let refuse = |opt: &str, applies: &str| {
+                    $crate::error::Error::invalid(
+                        opt,
+                        format!("applies to {applies}, not to {name:?}"),
+                    )
+                };
+                $(if name == <$config as MethodSpec>::NAME {
+                    return Ok(MethodConfig::$variant(<$config>::from_loose(o, &refuse)?));
+                })*
+                Err($crate::error::Error::invalid(
+                    "method",
+                    format!("unknown method {name:?}; available: {METHOD_NAMES:?}"),
+                ))
+            }
+
+            /// A typed config passed with loose options too: refused (one
+            /// place says each option).
+            pub fn refuse_loose(
+                o: &$crate::methods::config::LooseOptions,
+            ) -> $crate::error::Result<()> {
+                match o.given().first() {
+                    None => Ok(()),
+                    Some(opt) => Err($crate::error::Error::invalid(
+                        *opt,
+                        "give it inside the method config (for example \
+                         method=Bitmask(samples=64)), not beside it",
+                    )),
+                }
+            }
+
+            /// The name a user passes as `method=`.
+            pub fn name(&self) -> &'static str {
+                use $crate::methods::config::MethodSpec;
+                match self {
+                    $(MethodConfig::$variant(_) => <$config as MethodSpec>::NAME,)*
+                }
+            }
+
+            /// The config that runs for `ctx` (`MethodSpec::resolve`).
+            pub fn resolve(
+                &self,
+                ctx: &$crate::methods::config::CallContext,
+            ) -> $crate::error::Result<MethodConfig> {
+                use $crate::methods::config::MethodSpec;
+                match *self {
+                    $(MethodConfig::$variant(c) => c.resolve(ctx).map(MethodConfig::from),)*
+                }
+            }
+
+            /// Occluder layers of a resolved config (0 for methods that read none).
+            pub fn passes(&self) -> u32 {
+                use $crate::methods::config::MethodSpec;
+                match self {
+                    $(MethodConfig::$variant(c) => c.passes(),)*
+                }
+            }
+
+            /// Occluder maps' (W, H) of a resolved config (None for methods
+            /// that read no maps).
+            pub fn occluder_resolution(&self) -> Option<(usize, usize)> {
+                use $crate::methods::config::MethodSpec;
+                match self {
+                    $(MethodConfig::$variant(c) => c.occluder_resolution(),)*
+                }
+            }
+
+            /// Every method's row of `capabilities()`, in the registry's order.
+            pub fn infos() -> Vec<$crate::methods::info::MethodInfo> {
+                use $crate::methods::config::MethodSpec;
+                vec![$(<$config as MethodSpec>::info()),*]
+            }
+        }
+    };
+}
+
+pub(crate) use methods;
+
+#[cfg(test)]
+mod tests {
+    use crate::backend::Backend;
+    use crate::error::Error;
+    use crate::methods::config::{CallContext, LooseOptions};
+    use crate::methods::{bitmask, AutoConfig, BitmaskConfig, Method, MethodConfig};
+
+    fn cpu(resolution: (usize, usize)) -> CallContext {
+        CallContext {
+            backend: Backend::Cpu,
+            resolution,
+            depth_layers: None,
+            eye: false,
         }
     }
 
-    /// Whether the method only traces triangles (reads no occluder maps):
-    /// `exact`.
-    pub fn traces(&self) -> bool {
-        self.reads_input(Input::OccluderTriangles) && !self.reads_input(Input::OccluderLayers)
+    #[test]
+    fn auto_is_ssm_with_quarter_occluder_maps_at_least_64() {
+        let r = MethodConfig::Auto(AutoConfig::default())
+            .resolve(&cpu((512, 100)))
+            .unwrap();
+        assert_eq!(r.occluder_resolution(), Some((128, 64)));
+        assert_eq!(r.passes(), 2);
+        let r = MethodConfig::Auto(AutoConfig::default())
+            .resolve(&cpu((40, 40)))
+            .unwrap();
+        assert_eq!(r.occluder_resolution(), Some((40, 40)));
     }
 
-    /// Whether the method reads `input`.
-    pub fn reads_input(&self, input: Input) -> bool {
-        self.reads().contains(&input)
-    }
-
-    /// f32 maps the kernel keeps per occluder layer, each of the occluder
-    /// grid's size: for the gather methods the 1/depth copy and its nearest
-    /// and farthest bounds (`gather/hierarchy.rs`), and for connected
-    /// micro-quads their corner 1/depths and those corners' reciprocals
-    /// from the receivers' common plane (4 each); a hierarchy's levels add
-    /// a third. Other methods: one map.
-    pub fn kernel_maps_per_layer(&self) -> usize {
-        let (maps, hierarchy): (usize, bool) = match *self {
+    #[test]
+    fn defaults_depend_on_the_backend_and_the_entry() {
+        let b = MethodConfig::Bitmask(BitmaskConfig::default());
+        assert_eq!(
+            b.resolve(&cpu((8, 8))).unwrap().kernel(),
             Method::Bitmask {
-                hierarchy, gaps, ..
-            } => (
-                if gaps == bitmask::Gaps::Closed { 11 } else { 3 },
-                hierarchy,
-            ),
-            Method::Ssm { hierarchy, .. } => (3, hierarchy),
-            _ => (1, false),
+                samples: 256,
+                hierarchy: true,
+                gaps: bitmask::Gaps::Closed,
+            }
+        );
+        let gpu = CallContext {
+            backend: Backend::Gpu,
+            ..cpu((8, 8))
         };
-        if hierarchy {
-            maps + maps.div_ceil(3)
-        } else {
-            maps
-        }
-    }
-
-    pub fn implementation(&self) -> Box<dyn ShadowMethod> {
-        match *self {
-            Method::Ssm {
-                hierarchy,
-                precision,
-            } => Box::new(ssm::Ssm {
-                hierarchy: hierarchy.then_some(HIERARCHY),
-                precision,
-            }),
-            Method::Exact { samples } => Box::new(exact::Exact { samples }),
+        assert_eq!(
+            b.resolve(&gpu).unwrap().kernel(),
             Method::Bitmask {
-                samples,
-                hierarchy,
-                gaps,
-            } => Box::new(bitmask::Bitmask::new(
-                samples,
-                gaps,
-                hierarchy.then_some(HIERARCHY),
-            )),
-            // Refused outside the eye view when the config is resolved.
-            Method::ShadowMapping(_) => unreachable!("ShadowMapping has no light-view kernel"),
-            Method::Smoothies { width, falloff } => Box::new(smoothies::Smoothies {
-                width: width.0,
-                falloff,
-            }),
-            Method::Pcss { max_taps } => Box::new(pcss::Pcss { max_taps }),
-        }
+                samples: 256,
+                hierarchy: false,
+                gaps: bitmask::Gaps::Closed,
+            }
+        );
+        let depth = CallContext {
+            depth_layers: Some((1, (4, 4))),
+            ..cpu((8, 8))
+        };
+        let r = b.resolve(&depth).unwrap();
+        assert_eq!((r.passes(), r.occluder_resolution()), (1, Some((4, 4))));
+        let three =
+            MethodConfig::Bitmask(BitmaskConfig::new(None, Some(3), None, None, None).unwrap());
+        assert!(
+            matches!(three.resolve(&depth), Err(Error::InvalidArgument { ref arg, .. }) if arg == "passes")
+        );
     }
-}
 
-/// A texel-aligned square plate over a parallel floor, whose visibility has
-/// a closed form: the methods' shared accuracy check.
-/// Visibility of every receiver texel: the method's, or for a point light
-/// (size 0) on the map methods the hard shadow they converge to.
-pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
-    if inputs.light_shape.is_point() && method.reads_input(Input::OccluderLayers) {
-        point_light::visibility_map(inputs)
-    } else {
-        method.implementation().visibility_map(inputs)
-    }
-}
-
-/// Visibility at receiver points, as `shade_map`.
-pub fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
-    if inputs.light_shape.is_point() && method.reads_input(Input::OccluderLayers) {
-        point_light::visibility_points(inputs, pts)
-    } else {
-        method.implementation().visibility_points(inputs, pts)
+    #[test]
+    fn options_that_do_not_apply_are_refused_by_name() {
+        let o = LooseOptions {
+            samples: Some(64),
+            ..Default::default()
+        };
+        let e = MethodConfig::from_name("ssm", &o).unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument { ref arg, .. } if arg == "samples"));
+        let o = LooseOptions {
+            hierarchy: Some(true),
+            ..Default::default()
+        };
+        let e = MethodConfig::from_name("exact", &o).unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument { ref arg, .. } if arg == "hierarchy"));
+        assert!(MethodConfig::refuse_loose(&o).is_err());
     }
 }

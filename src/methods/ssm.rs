@@ -17,11 +17,22 @@
 //!
 //! The traversal is the shared gather of `gather/`; this module adds the
 //! published arithmetic: each pair adds its clipped area, the layers merge by max.
+//!
+//! Its config (`SsmConfig`, its checks and its `MethodSpec`: name, string
+//! form, resolution, capabilities row) is at the end of this file.
 
+use super::config::{
+    check_passes, check_resolution, hierarchy_option, occluder_resolution_option, passes_option,
+    resolve_maps, CallContext, LooseOptions, MethodSpec, DEFAULT_PASSES, SAMPLES_ONLY,
+};
 use super::gather::{
     self, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
+use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
+use crate::backend::Backend;
+use crate::error::{Error, Result};
 
 /// The published method; with a hierarchy, occluder texels are read at a
 /// coarser level where the penumbra is wide (not in the paper).
@@ -323,6 +334,125 @@ impl ShadowMethod for Ssm {
             Precision::F16Batched => {
                 gather::visibility_points(&SumF16 { batched: true }, inputs, points, h)
             }
+        }
+    }
+}
+
+/// Whether the hierarchy is on by default on the CPU: off for the paper's
+/// method (reproduced as published).
+pub const HIERARCHY_DEFAULT_SSM: bool = false;
+
+/// The paper's soft shadow maps (Atty et al. 2005): additive micro-patches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct SsmConfig {
+    /// Occluder depth layers; `None`: 2 from meshes, the layers given from
+    /// depth maps.
+    pub passes: Option<u32>,
+    /// Occluder maps' (W, H); `None`: the output's.
+    pub occluder_resolution: Option<(usize, usize)>,
+    /// The occluder hierarchy; `None`: off (the paper has none).
+    pub hierarchy: Option<bool>,
+    pub precision: Precision,
+}
+
+/// `precision=` by name.
+pub fn check_precision(name: &str) -> Result<Precision> {
+    Precision::parse(name).ok_or_else(|| {
+        Error::invalid(
+            "precision",
+            format!(
+                "must be one of {:?}, got {name:?}",
+                Precision::ALL.map(|p| p.name())
+            ),
+        )
+    })
+}
+
+impl SsmConfig {
+    /// Checks each given option; `None` keeps the default.
+    pub fn new(
+        passes: Option<i64>,
+        occluder_resolution: Option<(i64, i64)>,
+        hierarchy: Option<bool>,
+        precision: Option<&str>,
+    ) -> Result<Self> {
+        Ok(SsmConfig {
+            passes: passes.map(check_passes).transpose()?,
+            occluder_resolution: occluder_resolution
+                .map(|r| check_resolution("occluder_resolution", r))
+                .transpose()?,
+            hierarchy,
+            precision: precision
+                .map(check_precision)
+                .transpose()?
+                .unwrap_or_default(),
+        })
+    }
+}
+
+impl MethodSpec for SsmConfig {
+    const NAME: &'static str = "ssm";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if o.samples.is_some() {
+            return Err(refuse("samples", SAMPLES_ONLY));
+        }
+        SsmConfig::new(o.passes, o.occluder_resolution, o.hierarchy, o.precision)
+    }
+    type Resolved = Self;
+    fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
+        let c = self;
+        if ctx.backend == Backend::Gpu && c.precision != Precision::F32 {
+            return Err(Error::invalid(
+                "precision",
+                format!(
+                    "the GPU backend sums in \"f32\" only, got {:?}; use backend=\"cpu\"",
+                    c.precision.name()
+                ),
+            ));
+        }
+        let (passes, occ, hierarchy) = resolve_maps(
+            c.passes,
+            c.occluder_resolution,
+            c.hierarchy,
+            HIERARCHY_DEFAULT_SSM,
+            ctx,
+        )?;
+        Ok(SsmConfig {
+            passes: Some(passes),
+            occluder_resolution: Some(occ),
+            hierarchy: Some(hierarchy),
+            precision: c.precision,
+        })
+    }
+    fn passes(&self) -> u32 {
+        self.passes.unwrap_or(DEFAULT_PASSES)
+    }
+    fn occluder_resolution(&self) -> Option<(usize, usize)> {
+        self.occluder_resolution
+    }
+
+    fn info() -> MethodInfo {
+        MethodInfo {
+            name: "ssm",
+            config: "Ssm",
+            summary: "Soft shadow maps (Atty et al. 2005) as published: micro-patches of the \
+                      occluder maps back-projected onto the light, their occlusions summed",
+            reads: vec![Input::OccluderLayers],
+            backends: Backend::built().to_vec(),
+            options: vec![
+                passes_option(),
+                occluder_resolution_option(),
+                hierarchy_option(HIERARCHY_DEFAULT_SSM),
+                OptionInfo {
+                    name: "precision",
+                    kind: Kind::Choice(Precision::ALL.iter().map(|p| p.name()).collect()),
+                    default: Value::Str(Precision::default().name()),
+                    default_doc: "f32, each occluder row summed on its own",
+                    doc: "how the occlusions are summed (paper Appendix A): f32 two-level, f64, \
+                          emulated FP16 blending, or FP16 in batches of about sqrt(M)",
+                    restricted_on: vec![(Backend::Gpu, vec![Value::Str(Precision::F32.name())])],
+                },
+            ],
         }
     }
 }

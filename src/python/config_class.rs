@@ -96,6 +96,20 @@ macro_rules! config_class {
         #[derive(Clone, PartialEq, Eq, Hash)]
         pub struct $class $((pub $inner))?;
 
+        $(
+            impl From<$inner> for $class {
+                fn from(c: $inner) -> Self {
+                    $class(c)
+                }
+            }
+
+            impl From<&$class> for $inner {
+                fn from(c: &$class) -> Self {
+                    c.0
+                }
+            }
+        )?
+
         #[pyo3::pymethods]
         impl $class {
             #[new]

@@ -1,13 +1,18 @@
-//! The method configs as Python classes: `Ssm`, `Bitmask`, `Exact`, `Auto`.
+//! The method configs as Python classes: `Ssm`, `Bitmask`, `Exact`, `Auto`
+//! here, and the list of every method's class (`method_classes!`: the
+//! conversions to and from `MethodConfig`, the registration), the string
+//! form.
 //! Frozen, keyword-only, compared and hashed by value, picklable (pickle
 //! calls the keyword-only constructor again through `__getnewargs_ex__`).
-//! The values are checked by the core's constructors (`methods/config.rs`);
+//! The values are checked by the core's constructors (each in its method's module);
 //! `None` means "resolved when the config runs".
 
 use super::config_class::{config_class, newargs};
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string, string};
-use crate::methods::config::{auto_rule, check_resolution, AutoConfig, LooseOptions};
+use super::shadow_configs::{PyPcss, PyShadowMapping, PySmoothies};
+use crate::methods::config::{check_resolution, LooseOptions};
 use crate::methods::target::Target;
+use crate::methods::{auto_rule, AutoConfig};
 use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -81,6 +86,23 @@ config_class! {
     }
 }
 
+impl From<AutoConfig> for PyAuto {
+    // The options given beside `method="auto"` are the string form's; the
+    // class holds the target.
+    fn from(a: AutoConfig) -> Self {
+        PyAuto(a.target)
+    }
+}
+
+impl From<&PyAuto> for AutoConfig {
+    fn from(a: &PyAuto) -> Self {
+        AutoConfig {
+            given: SsmConfig::default(),
+            target: a.0,
+        }
+    }
+}
+
 /// The rule ``method="auto"`` names; it resolves to an ``Ssm`` when run
 /// (the result's ``method`` says which). See `capabilities()["auto"]`.
 #[pyclass(frozen, eq, hash, module = "softshadow._core", name = "Auto")]
@@ -144,35 +166,6 @@ impl PyAuto {
     }
 }
 
-/// The core config of a config object, if it is one.
-fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
-    if let Ok(c) = v.cast::<PySsm>() {
-        return Some(MethodConfig::Ssm(c.get().0));
-    }
-    if let Ok(c) = v.cast::<PyBitmask>() {
-        return Some(MethodConfig::Bitmask(c.get().0));
-    }
-    if let Ok(c) = v.cast::<PyExact>() {
-        return Some(MethodConfig::Exact(c.get().0));
-    }
-    if let Ok(a) = v.cast::<PyAuto>() {
-        return Some(MethodConfig::Auto(AutoConfig {
-            given: SsmConfig::default(),
-            target: a.get().0,
-        }));
-    }
-    if let Ok(c) = v.cast::<super::shadow_configs::PyPcss>() {
-        return Some(MethodConfig::Pcss(c.get().0));
-    }
-    if let Ok(c) = v.cast::<super::shadow_configs::PySmoothies>() {
-        return Some(MethodConfig::Smoothies(c.get().0));
-    }
-    if let Ok(c) = v.cast::<super::shadow_configs::PyShadowMapping>() {
-        return Some(MethodConfig::ShadowMapping(c.get().0));
-    }
-    None
-}
-
 /// The loose options beside `method=` (the string shorthand).
 pub struct Loose<'py> {
     pub passes: Option<Bound<'py, PyAny>>,
@@ -215,34 +208,56 @@ pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<Meth
     }
     if method.extract::<String>().is_err() {
         return Err(PyTypeError::new_err(format!(
-            "method: must be a method name or a config (Ssm, Bitmask, Exact, Auto, PCSS, Smoothies, ShadowMapping), got {}",
+            "method: must be a method name or a config ({}), got {}",
+            class_names(method.py())?,
             method.get_type().name()?
         )));
     }
     Ok(MethodConfig::from_name(&string("method", method)?, &o)?)
 }
 
-/// A method config as its Python object.
-pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
-    Ok(match *c {
-        MethodConfig::Ssm(c) => Py::new(py, PySsm(c))?.into_any(),
-        MethodConfig::Bitmask(c) => Py::new(py, PyBitmask(c))?.into_any(),
-        MethodConfig::Exact(c) => Py::new(py, PyExact(c))?.into_any(),
-        MethodConfig::Auto(a) => Py::new(py, PyAuto(a.target))?.into_any(),
-        MethodConfig::ShadowMapping(c) => {
-            Py::new(py, super::shadow_configs::PyShadowMapping(c))?.into_any()
+/// The method config classes, each with the `MethodConfig` variant it
+/// holds: one line a class makes its conversion both ways (`config_of`,
+/// `to_py`), its registration in `_core` and its name in `method=`'s
+/// TypeError. A class converts through `From` (made by `config_class!` for
+/// a class over its core config; `Auto`'s below).
+macro_rules! method_classes {
+    ($($class:ty => $variant:ident,)*) => {
+        /// The core config of a config object, if it is one.
+        fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
+            $(if let Ok(c) = v.cast::<$class>() {
+                return Some(MethodConfig::$variant(c.get().into()));
+            })*
+            None
         }
-        MethodConfig::Smoothies(c) => {
-            Py::new(py, super::shadow_configs::PySmoothies(c))?.into_any()
+
+        /// A method config as its Python object.
+        pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
+            Ok(match *c {
+                $(MethodConfig::$variant(c) => Py::new(py, <$class>::from(c))?.into_any(),)*
+            })
         }
-        MethodConfig::Pcss(c) => Py::new(py, super::shadow_configs::PyPcss(c))?.into_any(),
-    })
+
+        /// The config classes' Python names, in the list's order.
+        fn class_names(py: Python<'_>) -> PyResult<String> {
+            let names: Vec<String> =
+                vec![$(<$class as pyo3::PyTypeInfo>::type_object(py).name()?.to_string()),*];
+            Ok(names.join(", "))
+        }
+
+        pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+            $(m.add_class::<$class>()?;)*
+            Ok(())
+        }
+    };
 }
 
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PySsm>()?;
-    m.add_class::<PyBitmask>()?;
-    m.add_class::<PyExact>()?;
-    m.add_class::<PyAuto>()?;
-    Ok(())
+method_classes! {
+    PySsm => Ssm,
+    PyBitmask => Bitmask,
+    PyExact => Exact,
+    PyAuto => Auto,
+    PyPcss => Pcss,
+    PySmoothies => Smoothies,
+    PyShadowMapping => ShadowMapping,
 }

@@ -6,7 +6,8 @@
 //! * `convert.rs`: Python values to core values (TypeError naming the argument).
 //! * `config_class.rs`: the macro that makes a config class from one
 //!   description of its options; `configs.rs` (`Ssm`, `Bitmask`, `Exact`,
-//!   `Auto`, the string form) and `shadow_configs.rs` (ShadowMapping and
+//!   `Auto`, the string form, and the list of every method's class:
+//!   `method_classes!`) and `shadow_configs.rs` (ShadowMapping and
 //!   its parts, PCSS, Smoothies) describe them.
 //! * `camera.rs`: the eye view's `Camera`; `lights.rs`: `RectLight`,
 //!   `DirectionalLight`.

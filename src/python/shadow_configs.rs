@@ -1,14 +1,16 @@
 //! The ShadowMapping config and its parts, PCSS and Smoothies as Python
 //! classes (frozen, keyword-only, compared by value, picklable: see
 //! `config_class.rs`); the values are checked by the core
-//! (`methods/shadow_mapping/config.rs`, `methods/config.rs`).
+//! (`methods/shadow_mapping/config.rs`, `methods/pcss.rs`,
+//! `methods/smoothies/config.rs`). The method classes are registered by the
+//! list of `configs.rs`; this file registers the parts.
 
 use super::config_class::config_class;
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string};
-use crate::methods::config::{PcssConfig, SmoothiesConfig};
 use crate::methods::shadow_mapping::config::{
     check_pcf, DepthBias, EyeSpaceBlur, LiSPSM, Pcf, ShadowMappingConfig,
 };
+use crate::methods::{PcssConfig, SmoothiesConfig};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
@@ -286,9 +288,6 @@ config_class! {
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PyPcss>()?;
-    m.add_class::<PySmoothies>()?;
-    m.add_class::<PyShadowMapping>()?;
     m.add_class::<PyConstantBias>()?;
     m.add_class::<PySlopeScaleBias>()?;
     m.add_class::<PyLinearDepthBias>()?;

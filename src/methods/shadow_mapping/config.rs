@@ -1,9 +1,16 @@
 //! The typed config of `ShadowMapping` and its parts, as a user writes
 //! them; every value is checked here, once, when the config is built.
+//!
+//! `ShadowMappingConfig`'s `MethodSpec` (name, string form, resolution,
+//! capabilities row) is at the end of this file.
 
+use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::shadow_projection::ViewVector;
+use crate::methods::config::{CallContext, LooseOptions, MethodSpec};
+use crate::methods::info::{Kind, MethodInfo, OptionInfo, Value};
 use crate::methods::shadow_mapping::raster::{Distribution, Offset};
+use crate::methods::Input;
 
 /// A finite f64 that configs can hash and compare (by its bits).
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
@@ -308,6 +315,108 @@ impl ShadowMappingConfig {
             Some("focus")
         } else {
             None
+        }
+    }
+}
+
+impl MethodSpec for ShadowMappingConfig {
+    const NAME: &'static str = "shadow_mapping";
+    fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
+        if let Some(opt) = o.given().first() {
+            return Err(refuse(
+                opt,
+                "the soft shadow map methods; give ShadowMapping(...) its own options",
+            ));
+        }
+        Ok(ShadowMappingConfig::default())
+    }
+    type Resolved = Self;
+    fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
+        if !ctx.eye {
+            return Err(Error::invalid(
+                "method",
+                "ShadowMapping renders the eye view (ss.render): its map is focused, \
+                 warped and blurred for a camera; in the light view use method=\"ssm\" \
+                 or \"exact\" with a point light for hard shadows",
+            ));
+        }
+        if ctx.depth_layers.is_some() {
+            return Err(Error::invalid(
+                "method",
+                "ShadowMapping rasterizes its own map of the meshes; depth maps are not enough",
+            ));
+        }
+        Ok(self)
+    }
+    fn info() -> MethodInfo {
+        let part = |name, classes: Vec<&'static str>, doc| OptionInfo {
+            name,
+            kind: Kind::Config(classes),
+            default: Value::Resolved,
+            default_doc: "None (off)",
+            doc,
+            restricted_on: vec![],
+        };
+        MethodInfo {
+            name: "shadow_mapping",
+            config: "ShadowMapping",
+            summary: "The standard shadow map from the light's centre or direction with Scherzer \
+                  2005's practical extensions: bias methods, PCF, focusing on the \
+                  intersection body, LiSPSM (directional lights), the eye-space blur; hard \
+                  shadows, the eye view only",
+            reads: vec![Input::SceneTriangles, Input::Camera],
+            backends: Backend::built().to_vec(),
+            options: vec![
+            OptionInfo {
+                name: "resolution",
+                kind: Kind::Resolution {
+                    max_texels: (MAX_SM_SIDE * MAX_SM_SIDE) as i64,
+                },
+                default: Value::Int(DEFAULT_SM_RESOLUTION as i64),
+                default_doc: "2048 x 2048 (Scherzer's)",
+                doc: "the shadow map's (W, H), each side at most 16384",
+                restricted_on: vec![],
+            },
+            OptionInfo {
+                name: "bias",
+                kind: Kind::Config(vec![
+                    "ConstantBias",
+                    "SlopeScaleBias",
+                    "LinearDepthBias",
+                    "BackFaces",
+                    "MidpointBias",
+                ]),
+                default: Value::Str("SlopeScaleBias"),
+                default_doc:
+                    "SlopeScaleBias(constant=4, slope=2): glPolygonOffset(2, 4), Scherzer's",
+                doc: "how the depth test keeps surfaces from shadowing themselves (Scherzer §4.2)",
+                restricted_on: vec![],
+            },
+            part(
+                "filter",
+                vec!["PCF"],
+                "percentage-closer filtering of the depth test",
+            ),
+            part(
+                "warp",
+                vec!["LiSPSM"],
+                "LiSPSM (directional lights only): more texels near the camera",
+            ),
+            OptionInfo {
+                name: "focus",
+                kind: Kind::Bool,
+                default: Value::Bool(true),
+                default_doc: "True",
+                doc: "fit the map to the intersection body B (view frustum and scene bounds, \
+                      extended toward the light); False: to the whole scene",
+                restricted_on: vec![],
+            },
+            part(
+                "blur",
+                vec!["EyeSpaceBlur"],
+                "the depth-dependent eye-space blur of the shadow image (Scherzer §4.3)",
+            ),
+        ],
         }
     }
 }

@@ -21,6 +21,7 @@
 //! and does not shrink as the light grows (§2.1, §5).
 
 mod buffer;
+pub mod config;
 mod construct;
 mod lookup;
 pub mod method;
