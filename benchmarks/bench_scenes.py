@@ -10,7 +10,9 @@ samples a pixel, cached in ``.cache/references/``) and one call per method of
 scene, wall clock; speed lives in ``bench_eye.py``). Per call,
 ``softshadow.metrics.compare_images``: ``shadow_error`` (mean |V - V_ref|
 over the matched pixels the reference shadows), ``mean_abs`` (over every
-matched pixel), ``acne`` and ``leak`` (fractions of the matched pixels).
+matched pixel), ``acne`` and ``leak`` (fractions of the matched pixels);
+then the same call with ``estimate_error=True``: its ``error_estimate``
+against the measured error, and its share of the call's time.
 Writes ``docs/benchmarks/scenes_<W>x<H>.md``; the summary gives each method's
 worst scene of each set.
 """
@@ -42,10 +44,10 @@ METHODS: dict[str, Any] = {
 }
 
 
-def call(method: Any, scene: Any, light: Any, cam: Any) -> Any:
+def call(method: Any, scene: Any, light: Any, cam: Any, **kw: Any) -> Any:
     if method is None:
-        return ss.render(scene, light, cam)
-    return ss.render(scene, light, cam, method=method)
+        return ss.render(scene, light, cam, **kw)
+    return ss.render(scene, light, cam, method=method, **kw)
 
 
 def main() -> None:
@@ -61,6 +63,7 @@ def main() -> None:
         args.out = DOCS / f"scenes_{res[0]}x{res[1]}.md"
     report = Report(f"Scenes as users build them ({res[0]}×{res[1]})", command_line(__file__))
     worst: dict[tuple[str, str], list[float]] = {}
+    ratios: dict[str, list[tuple[float, float, float]]] = {}
     for name in args.scenes:
         scene, light, cam = SCENES[name](res)
         which = "calibration" if name in CALIBRATION else "held out" if name in HELD_OUT else "?"
@@ -73,8 +76,11 @@ def main() -> None:
             f"of the pixels that see a surface."
         )
         report.line()
-        report.line("| call | error over shadowed pixels | over all pixels | acne | leaks | time (ms) | ran |")
-        report.line("|---|---|---|---|---|---|---|")
+        report.line(
+            "| call | error over shadowed pixels | over all pixels | acne | leaks | time (ms) | ran "
+            "| estimate (95% interval) | estimate / error | its share of the call |"
+        )
+        report.line("|---|---|---|---|---|---|---|---|---|---|")
         for label in args.methods:
             try:
                 t = time.perf_counter()
@@ -85,10 +91,19 @@ def main() -> None:
                 continue
             c = compare_images(img, ref)
             ran = img.method.name if hasattr(img.method, "name") else str(img.method)
+            # The same call with its error estimate (Auto always has one).
+            est = (
+                img if img.error_estimate is not None else call(METHODS[label], scene, light, cam, estimate_error=True)
+            )
+            e = est.error_estimate
+            share = e.seconds / sum(est.timings.values())
+            ratio = f"{e.error / c.shadow_error:.2f}" if c.shadow_error > 0 else "–"
             report.line(
                 f"| {label} | {c.shadow_error:.4f} | {c.mean_abs:.4f} | {c.acne:.2%} | {c.leak:.2%} "
-                f"| {ms:.0f} | {ran} |"
+                f"| {ms:.0f} | {ran} | {e.error:.4f} ({e.interval[0]:.4f}–{e.interval[1]:.4f}), "
+                f"{e.traced} px | {ratio} | {share:.0%} |"
             )
+            ratios.setdefault(label, []).append((c.shadow_error, e.error, share))
             w = worst.setdefault((label, which), [0.0, 0.0, 0.0])
             w[0], w[1], w[2] = max(w[0], c.shadow_error), max(w[1], c.acne), max(w[2], c.leak)
         report.line()
@@ -98,6 +113,23 @@ def main() -> None:
     report.line("|---|---|---|---|---|")
     for (label, which), (e, a, lk) in worst.items():
         report.line(f"| {label} | {which} | {e:.4f} | {a:.2%} | {lk:.2%} |")
+    report.line()
+    report.line("## Summary: the error estimates")
+    report.line()
+    report.line(
+        "| call | scenes with the estimate within 1.5× of the error | worst ratio | median share of the call "
+        "| largest share |"
+    )
+    report.line("|---|---|---|---|---|")
+    for label, rs in ratios.items():
+        within = [r for r in rs if r[0] > 0 and 1 / 1.5 <= r[1] / r[0] <= 1.5]
+        graded = [r[1] / r[0] for r in rs if r[0] > 0]
+        worst_ratio = max(graded, key=lambda q: max(q, 1 / q) if q > 0 else float("inf")) if graded else 0.0
+        shares = sorted(r[2] for r in rs)
+        report.line(
+            f"| {label} | {len(within)} of {len(graded)} | {worst_ratio:.2f} | {shares[len(shares) // 2]:.0%} "
+            f"| {shares[-1]:.0%} |"
+        )
     if args.no_write:
         return
     intro = (
@@ -108,7 +140,10 @@ def main() -> None:
         "exceeds 0.001; *over all pixels* counts lit ones too; *acne* is the share of pixels "
         "the reference sees fully lit (V_ref ≥ 0.99) that the call darkens by more than 0.05, "
         "*leaks* the share in the reference umbra (V_ref ≤ 0.01) it lightens by more than 0.05. "
-        "Calibration scenes may be fitted to; held-out ones are not (docs/accuracy.md)."
+        "Calibration scenes may be fitted to; held-out ones are not (docs/accuracy.md). "
+        "*Estimate*: `img.error_estimate` of the same call with `estimate_error=True` (exact rays at a "
+        "random subset of the pixels; Auto always has one), its ratio to the error measured against "
+        "Mitsuba, and the estimate's share of that call's time."
     )
     report.write(args.out, intro=intro)
 

@@ -30,7 +30,10 @@ fn layer(module: &[String]) -> usize {
         Some("eye" | "frame" | "light_view" | "gpu") => 4,
         Some("methods" | "raster") => 3,
         Some("geom") => 2,
-        Some("error" | "memory" | "threads" | "timing" | "backend" | "block_cache") => 1,
+        Some(
+            "error" | "error_estimate" | "memory" | "threads" | "timing" | "backend"
+            | "block_cache",
+        ) => 1,
         other => panic!("src/layering.rs: no layer for module {other:?}; add it to `layer`"),
     }
 }

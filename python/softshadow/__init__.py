@@ -11,7 +11,7 @@ backends. See the README and docs/ for the conventions.
 What is exported here lives in modules that say what they hold:
 :mod:`.api` (the calls: ``soft_shadow_map``, ``soft_shadow_map_from_depth``,
 ``render``, ``gpu_available``, ``gpu_info``), :mod:`.results` (``ShadowMap``,
-``Image``, ``Plan``, ``Decision``), :mod:`.lights` (``RectLight``,
+``Image``, ``Plan``, ``Decision``, ``ErrorEstimate``), :mod:`.lights` (``RectLight``,
 ``DirectionalLight``), :mod:`.scene` (``Scene``, ``Camera``), :mod:`.methods`
 (the configs, ``capabilities``, ``limits``) and :mod:`.errors`. Built-in
 scenes are in :mod:`softshadow.scenes`, files in :mod:`softshadow.io`, error
@@ -29,13 +29,14 @@ from .lights import DirectionalLight, RectLight
 # new method's class is added there only); mypy and stubtest follow both the
 # star import and the `__all__ +=` below.
 from .methods import *  # noqa: F403
-from .results import Decision, Image, Plan, ShadowMap
+from .results import Decision, ErrorEstimate, Image, Plan, ShadowMap
 from .scene import Camera, Scene
 
 __all__ = [
     "Camera",
     "Decision",
     "DirectionalLight",
+    "ErrorEstimate",
     "GpuUnavailableError",
     "Image",
     "Plan",

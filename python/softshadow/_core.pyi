@@ -548,6 +548,33 @@ class EyeResult:
     def threads(self) -> int: ...
     @property
     def plan(self) -> list[tuple[str, bool, str]] | None: ...
+    @property
+    def error_estimate(self) -> ErrorEstimate | None: ...
+
+class ErrorEstimate:
+    """A result's error estimated from exact rays at a random subset of its
+    pixels: the mean |V - V_ref| over the pixels the exact rays find in
+    shadow, with a 95% confidence interval (docs/accuracy.md)."""
+
+    @property
+    def error(self) -> float:
+        """The estimated error over the shadowed pixels."""
+    @property
+    def interval(self) -> tuple[float, float]:
+        """The 95% confidence interval ``(low, high)``; ``(0.0, 1.0)`` when
+        no traced pixel is in shadow."""
+    @property
+    def traced(self) -> int:
+        """Pixels traced with exact rays."""
+    @property
+    def shadowed(self) -> int:
+        """Of those, the pixels the exact rays found in shadow."""
+    @property
+    def samples(self) -> int:
+        """Light samples per traced pixel."""
+    @property
+    def seconds(self) -> float:
+        """Seconds the estimate took."""
 
 def render(
     meshes: list[tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]],
@@ -567,6 +594,7 @@ def render(
     threads: int | None = None,
     emission: _Color | None = None,
     albedo: _Color | list[_Color] | None = None,
+    estimate_error: bool = False,
 ) -> EyeResult:
     """The eye view: first hits, then each pixel's visibility with every mesh
     casting and receiving, then the shading (``emission`` the light's

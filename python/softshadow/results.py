@@ -9,6 +9,8 @@
 * :class:`Plan` and its :class:`Decision` list: what ``Auto(error=...)`` or
   ``Auto(time=...)`` decided, held by either result (``sm.plan``,
   ``img.plan``).
+* :class:`ErrorEstimate`: a result's error measured from exact rays at a
+  random subset of its pixels (``img.error_estimate``), the core's class.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from ._core import ErrorEstimate
 from .lights import DirectionalLight, RectLight
 from .methods import MethodConfig
 from .scene import Camera
@@ -271,6 +274,10 @@ class Image:
     plan: Plan | None = None
     """What ``Auto(error=...)`` decided for the image (``None`` otherwise);
     ``print(img.plan)`` lists the decisions."""
+    error_estimate: ErrorEstimate | None = None
+    """The image's error estimated from exact rays at a subset of its pixels
+    (``estimate_error=True``, always for ``Auto`` with a target), else
+    ``None``."""
 
     @property
     def mask(self) -> np.ndarray:

@@ -6,6 +6,7 @@
 use super::gbuffer::GBuffer;
 use super::maps::{Bias, EyeMaps};
 use crate::backend::BackendChoice;
+use crate::error_estimate::ErrorEstimate;
 use crate::geom::camera::Camera;
 use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::mesh::MeshRef;
@@ -24,6 +25,9 @@ pub struct EyeCall<'a> {
     pub bias: Bias,
     pub backend: BackendChoice,
     pub threads: Option<i64>,
+    /// Estimate the result's error from exact rays at a subset of the
+    /// pixels (`estimate.rs`).
+    pub estimate_error: bool,
 }
 
 /// A rendered image.
@@ -37,4 +41,6 @@ pub struct EyeImage {
     /// The light space they are in.
     pub light_space: LightSpace,
     pub timings: Timings,
+    /// The error estimate, when the call asked for one.
+    pub estimate: Option<ErrorEstimate>,
 }

@@ -19,10 +19,11 @@
 //! of the texels (docs/eye_view.md); a box floor kept that, and its bottom
 //! face became every texel's back layer (docs/accuracy.md).
 //!
-//! Cost: each triangle's plane against the points, in chunks of
-//! consecutive pixels with their bounding boxes: a chunk whose box lies on
-//! the lit side is passed over whole, and a triangle stops at the first
-//! point on its dark side (most casters find one in the first chunks).
+//! Cost: each triangle's plane against the points, in chunks of 64
+//! consecutive pixels and groups of 64 chunks with their bounding boxes: a
+//! group or chunk whose box lies on the lit side is passed over whole, and
+//! a triangle stops at the first point on its dark side (most casters find
+//! one in the first chunks).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -35,7 +36,7 @@ use crate::geom::light_space::Light;
 /// floor lies on the floor's plane to about 1e-16 of the scene's size).
 const PLANE_TOLERANCE: f64 = 1e-9;
 
-/// Consecutive visible points per bounding box.
+/// Consecutive visible points per bounding box, and chunks per group.
 const CHUNK: usize = 64;
 
 /// Per triangle of `scene`, whether it can shadow one of `points` (world
@@ -45,28 +46,29 @@ pub(crate) fn casting_triangles(
     light: &Light,
     points: &[[f64; 3]],
 ) -> Vec<bool> {
-    let chunks: Vec<(DVec3, DVec3, &[[f64; 3]])> = points
+    let chunks: Vec<Chunk> = points
         .par_chunks(CHUNK)
         .map(|c| {
-            let (lo, hi) = c.iter().fold(
-                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-                |(lo, hi), p| {
-                    let p = DVec3::from_array(*p);
-                    (lo.min(p), hi.max(p))
-                },
-            );
-            (lo, hi, c)
+            let (lo, hi) = bounds(c.iter().map(|p| DVec3::from_array(*p)));
+            Chunk { lo, hi, points: c }
         })
         .collect();
-    let (lo, hi) = scene
-        .vertices
-        .iter()
-        .copied()
-        .chain(chunks.iter().flat_map(|c| [c.0, c.1]))
-        .fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(p), hi.max(p)),
-        );
+    // Groups of chunks with their boxes: a triangle that casts nothing
+    // (a floor's) passes over a group whole instead of over each chunk.
+    let groups: Vec<(DVec3, DVec3, &[Chunk])> = chunks
+        .chunks(CHUNK)
+        .map(|g| {
+            let (lo, hi) = bounds(g.iter().flat_map(|c| [c.lo, c.hi]));
+            (lo, hi, g)
+        })
+        .collect();
+    let (lo, hi) = bounds(
+        scene
+            .vertices
+            .iter()
+            .copied()
+            .chain(groups.iter().flat_map(|g| [g.0, g.1])),
+    );
     let tol = PLANE_TOLERANCE * (hi - lo).max_element().max(1e-300);
     scene
         .corners
@@ -83,15 +85,40 @@ pub(crate) fn casting_triangles(
                 return true;
             };
             let floor = n.dot(t[0]) - tol;
-            chunks.iter().any(|(lo, hi, pts)| {
-                // The box's lowest n·p: each axis at its low or high end.
-                let least = n.x * if n.x >= 0.0 { lo.x } else { hi.x }
-                    + n.y * if n.y >= 0.0 { lo.y } else { hi.y }
-                    + n.z * if n.z >= 0.0 { lo.z } else { hi.z };
-                least < floor && pts.iter().any(|p| n.dot(DVec3::from_array(*p)) < floor)
+            groups.iter().any(|(lo, hi, chunks)| {
+                least(n, *lo, *hi) < floor
+                    && chunks.iter().any(|c| {
+                        least(n, c.lo, c.hi) < floor
+                            && c.points
+                                .iter()
+                                .any(|p| n.dot(DVec3::from_array(*p)) < floor)
+                    })
             })
         })
         .collect()
+}
+
+/// Consecutive visible points and their bounding box.
+struct Chunk<'a> {
+    lo: DVec3,
+    hi: DVec3,
+    points: &'a [[f64; 3]],
+}
+
+/// The bounding box of `points` (empty: +inf, -inf).
+fn bounds(points: impl Iterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points.fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}
+
+/// The least n·p over the box [lo, hi]: each axis at its low or high end.
+#[inline]
+fn least(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    n.x * if n.x >= 0.0 { lo.x } else { hi.x }
+        + n.y * if n.y >= 0.0 { lo.y } else { hi.y }
+        + n.z * if n.z >= 0.0 { lo.z } else { hi.z }
 }
 
 /// The plane's normal turned toward the light when the whole light lies
@@ -286,7 +313,7 @@ mod tests {
         ];
         let scene = SceneTriangles::new(&meshes).unwrap();
         // Points on a spiral around the tetrahedron and on the ground.
-        let pts: Vec<[f64; 3]> = (0..1000)
+        let pts: Vec<[f64; 3]> = (0..6000)
             .map(|k| {
                 let a = k as f64 * 0.37;
                 let r = 0.05 + 0.002 * k as f64;
@@ -297,7 +324,7 @@ mod tests {
                 ]
             })
             .collect();
-        for n in [1, 10, 63, 64, 65, 1000] {
+        for n in [1, 10, 63, 64, 65, 1000, 4096, 4097, 6000] {
             assert_eq!(
                 casting_triangles(&scene, &light(), &pts[..n]),
                 brute_force(&scene, &pts[..n]),

@@ -22,6 +22,7 @@
 
 pub mod call;
 mod casters;
+pub mod estimate;
 pub mod focus;
 pub mod framing;
 pub mod gbuffer;

@@ -109,12 +109,23 @@ pub fn visibility(
     order: &[usize],
     samples: u32,
 ) -> Vec<f32> {
-    let bvh = Bvh::build(triangles);
+    visibility_in(&Bvh::build(triangles), light_shape, starts, order, samples)
+}
+
+/// `visibility` through a BVH already built (the error estimate traces
+/// several batches through one).
+pub fn visibility_in(
+    bvh: &Bvh,
+    light_shape: LightShape,
+    starts: &[Option<RayStart>],
+    order: &[usize],
+    samples: u32,
+) -> Vec<f32> {
     let s = Sampling {
         light: light_shape.samples(samples),
         t0: 0.0,
     };
-    visibilities(&bvh, starts, order, &s, 0.0)
+    visibilities(bvh, starts, order, &s, 0.0)
 }
 
 /// The order of `pixels` (flat indices into an image `width` wide, each

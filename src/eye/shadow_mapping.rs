@@ -269,5 +269,6 @@ pub(crate) fn image(
         maps: None,
         light_space,
         timings,
+        estimate: None,
     })
 }

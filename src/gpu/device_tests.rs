@@ -557,6 +557,7 @@ mod eye {
             bias: DEFAULT_BIAS,
             backend,
             threads: None,
+            estimate_error: false,
         })
     }
 
@@ -821,6 +822,7 @@ mod eye {
                     bias: DEFAULT_BIAS,
                     backend,
                     threads: None,
+                    estimate_error: false,
                 })
                 .unwrap()
             };
@@ -1058,6 +1060,7 @@ mod eye {
                         bias: DEFAULT_BIAS,
                         backend: BackendChoice::Gpu,
                         threads: None,
+                        estimate_error: false,
                     };
                     let mut sw = Stopwatch::new();
                     let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
@@ -1202,6 +1205,7 @@ mod eye {
                 bias: DEFAULT_BIAS,
                 backend: BackendChoice::Gpu,
                 threads: None,
+                estimate_error: false,
             };
             let mut sw = Stopwatch::new();
             let p = match sm::prepare(&call, &cfg, &scene, &gb, &mut sw).unwrap() {

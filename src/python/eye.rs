@@ -94,7 +94,7 @@ pub fn irradiance<'py>(
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.
 #[pyfunction]
-#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None))]
+#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None, estimate_error=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -114,6 +114,7 @@ pub fn render<'py>(
     threads: Option<Bound<'py, PyAny>>,
     emission: Option<Bound<'py, PyAny>>,
     albedo: Option<Bound<'py, PyAny>>,
+    estimate_error: bool,
 ) -> PyResult<EyeResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -138,6 +139,7 @@ pub fn render<'py>(
             bias: Bias::new(normal_offset, depth_bias)?,
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
+            estimate_error,
         };
         let arg = shading::emission_arg(&light);
         let lighting = Lighting::new(
@@ -197,6 +199,10 @@ pub struct EyeResult {
     /// What `Auto` with a target decided: (name, taken, why) per decision.
     #[pyo3(get)]
     plan: Option<Vec<(&'static str, bool, String)>>,
+    /// The error estimate (`estimate_error=True`, or `Auto` with a target),
+    /// else None.
+    #[pyo3(get)]
+    error_estimate: Option<Py<super::estimate::PyErrorEstimate>>,
 }
 
 #[pymethods]
@@ -259,6 +265,10 @@ impl EyeResult {
             backend: run.backend.name(),
             threads: run.threads,
             plan: super::results::plan_tuples(run.plan),
+            error_estimate: img
+                .estimate
+                .map(|e| Py::new(py, super::estimate::PyErrorEstimate(e)))
+                .transpose()?,
         })
     }
 }

@@ -25,6 +25,7 @@ mod configs;
 mod convert;
 mod entry;
 mod errors;
+mod estimate;
 mod eye;
 mod gpu;
 mod lights;
@@ -49,6 +50,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;
     m.add_class::<eye::EyeResult>()?;
+    m.add_class::<estimate::PyErrorEstimate>()?;
     m.add_function(wrap_pyfunction!(eye::render, m)?)?;
     m.add_function(wrap_pyfunction!(eye::light_emission, m)?)?;
     m.add_function(wrap_pyfunction!(eye::irradiance, m)?)?;
