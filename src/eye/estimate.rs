@@ -81,7 +81,11 @@ pub fn estimate(
         let normals: Vec<[f32; 3]> = pixels.iter().map(|&k| f.normals[k]).collect();
         let starts = rays::ray_starts(&f.space, f.unit, &points, &normals);
         let identity: Vec<usize> = (0..pixels.len()).collect();
-        let exact = rays::visibility_in(&bvh, f.light_shape, &starts, &identity, samples);
+        // Each pixel's samples are keyed by its place in the image, as
+        // `exact`'s are: with the same samples the estimate's rays are the
+        // full image's.
+        let key = |j: usize| f.hits[pixels[j]] as u64;
+        let exact = rays::visibility_in(&bvh, f.light_shape, &starts, key, &identity, samples);
         let mut at = 0;
         for (j, &u) in new.iter().enumerate() {
             let pairs = units[u]

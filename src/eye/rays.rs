@@ -97,19 +97,31 @@ impl RayOrigin for RayStart {
     }
 }
 
-/// Visibility at ray starts `starts` (a pixel's jitter key is its index in
-/// `starts`), every triangle of `triangles` (kernel light space,
-/// unit-scaled) blocking; 0 for `None`. `order` (a permutation of the
-/// indices of `starts`) is the order to trace them in: neighbours next to
-/// each other (`tiled`), so that packets are coherent.
+/// Visibility at ray starts `starts`, every triangle of `triangles`
+/// (kernel light space, unit-scaled) blocking; 0 for `None`. Start k's
+/// jitter key is `key(k)`: its pixel's flat index in the image (its
+/// texel's in a map), never its rank among the starts, so that a pixel's
+/// samples do not depend on which other pixels see a surface
+/// (`shadow_rays::visibilities`; eye_rays.wgsl reads the same key).
+/// `order` (a permutation of the indices of `starts`) is the order to
+/// trace them in: neighbours next to each other (`tiled`), so that packets
+/// are coherent.
 pub fn visibility(
     light_shape: LightShape,
     triangles: Vec<[Vec3; 3]>,
     starts: &[Option<RayStart>],
+    key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
     samples: u32,
 ) -> Vec<f32> {
-    visibility_in(&Bvh::build(triangles), light_shape, starts, order, samples)
+    visibility_in(
+        &Bvh::build(triangles),
+        light_shape,
+        starts,
+        key,
+        order,
+        samples,
+    )
 }
 
 /// `visibility` through a BVH already built (the error estimate traces
@@ -118,6 +130,7 @@ pub fn visibility_in(
     bvh: &Bvh,
     light_shape: LightShape,
     starts: &[Option<RayStart>],
+    key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
     samples: u32,
 ) -> Vec<f32> {
@@ -125,7 +138,7 @@ pub fn visibility_in(
         light: light_shape.samples(samples),
         t0: 0.0,
     };
-    visibilities(bvh, starts, order, &s, 0.0)
+    visibilities(bvh, starts, key, order, &s, 0.0)
 }
 
 /// The order of `pixels` (flat indices into an image `width` wide, each

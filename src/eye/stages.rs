@@ -104,10 +104,12 @@ impl EyeStages for CpuEye {
     ) -> Result<Vec<f32>> {
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
         let order = rays::tiled(&f.hits, camera.width, camera.height);
+        // Each point's jitter key is its pixel (as on the GPU).
         Ok(rays::visibility(
             f.light_shape,
             tris,
             &starts,
+            |k| f.hits[k] as u64,
             &order,
             samples,
         ))

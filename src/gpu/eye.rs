@@ -18,7 +18,8 @@
 //! * `exact` (`eye_rays.wgsl`): per visible point, stratified shadow rays
 //!   from the two spawn_ray_to origins of `rays::ray_starts` (made on the
 //!   CPU in f64, shared), t in (0, 1 - RAY_EPS), the jitter exact.rs's hash
-//!   of the point's index and the sample, as `rays::visibility`.
+//!   of the point's pixel (its flat index in the image) and the sample, as
+//!   `rays::visibility`.
 //! * `ssm`, `bitmask`: the occluder layers (front, peeled, back) rasterized
 //!   on the device from the CPU's set-up triangles (`raster.wgsl`, bit for bit
 //!   the CPU's `maps::occluder_layers`), the biased points and their
@@ -115,7 +116,8 @@ pub struct HitsParams {
 }
 
 /// `RayStart` of eye_rays.wgsl: a point's two origins (kernel light space)
-/// and the side test choosing between them; `valid` 0: visibility 0.
+/// and the side test choosing between them; `valid` 0: visibility 0;
+/// `key`: the jitter key, the point's pixel (`rays::visibility`'s).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct GpuRayStart {
@@ -129,7 +131,7 @@ pub struct GpuRayStart {
     pub a0: f32,
     pub au: f32,
     pub av: f32,
-    pub _pad0: u32,
+    pub key: u32,
     pub _pad1: u32,
 }
 
@@ -231,9 +233,11 @@ impl EyeStages for GpuEye {
         samples: u32,
         sw: &mut Stopwatch,
     ) -> Result<Vec<f32>> {
+        // Keyed by pixel, as the CPU's (`CpuEye::trace`).
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()
-            .map(GpuRayStart::new)
+            .zip(&f.hits)
+            .map(|(s, &pixel)| GpuRayStart::new(s, pixel))
             .collect();
         let (v, t) = exact_visibility(gpu()?, tris, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
@@ -388,10 +392,16 @@ pub(crate) fn first_hits(
 }
 
 impl GpuRayStart {
-    /// `rays::RayStart` as eye_rays.wgsl reads it; `None`: not valid.
-    pub fn new(s: &Option<RayStart>) -> GpuRayStart {
+    /// `rays::RayStart` of the point at flat index `pixel` of the image as
+    /// eye_rays.wgsl reads it; `None`: not valid.
+    pub fn new(s: &Option<RayStart>, pixel: usize) -> GpuRayStart {
+        // An image has at most MAX_TEXELS < 2^32 pixels (`check_resolution`).
+        let key = pixel as u32;
         match s {
-            None => GpuRayStart::default(),
+            None => GpuRayStart {
+                key,
+                ..Default::default()
+            },
             Some(s) => GpuRayStart {
                 ax: s.above.x,
                 ay: s.above.y,
@@ -403,7 +413,7 @@ impl GpuRayStart {
                 a0: s.side[0],
                 au: s.side[1],
                 av: s.side[2],
-                _pad0: 0,
+                key,
                 _pad1: 0,
             },
         }

@@ -2,9 +2,9 @@
 // visible surface point, through the BVH of every triangle in kernel light
 // space (built on the CPU). The CPU twin is src/eye/rays.rs (`visibility`,
 // through methods/exact.rs's `stratified`): for light sample (x, y, 0) of
-// point k (the jitter is exact.rs's hash of key k and the sample, as
-// exact.wgsl computes it for map texels), the segment starts at the origin
-// on the side of the surface the light point lies on,
+// point k (the jitter is exact.rs's hash of k's key, its pixel, and the
+// sample, as exact.wgsl computes it for map texels), the segment starts at
+// the origin on the side of the surface the light point lies on,
 //     o = above  if a0 + x au + y av >= 0,  else below
 // (the point moved off its surface along the normal by Mitsuba's
 // spawn_ray_to offset, computed in f64 on the CPU: rays::ray_starts),
@@ -32,7 +32,10 @@ struct RayStart {
     a0: f32,
     au: f32,
     av: f32,
-    _pad0: u32,
+    // The jitter key: the point's pixel (its flat index in the image), as
+    // rays.rs's; not `idx`, its rank among the visible points, which
+    // shifts after any pixel the two backends' first hits disagree on.
+    key: u32,
     _pad1: u32,
 }
 
@@ -54,8 +57,8 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
     }
     let above = vec3<f32>(s.ax, s.ay, s.az);
     let below = vec3<f32>(s.bx, s.by, s.bz);
-    // exact.rs's key: the point's index as a u64.
-    let key = vec2<u32>(idx, 0u);
+    // rays.rs's key: the point's pixel as a u64.
+    let key = vec2<u32>(s.key, 0u);
     var count = 0u;
     for (var k = ep.chunk_start; k < ep.chunk_start + ep.chunk_len; k++) {
         let sa = k % ep.na;

@@ -56,7 +56,8 @@ pub fn sample_grid(samples: u32, size: [f64; 2]) -> (u32, u32) {
 
 impl Exact {
     /// The visibility of receivers `pts` (light-space points; `None`: lit;
-    /// the jitter key is the index), traced in `order`.
+    /// the jitter key is the index: a map's texel, as exact.wgsl's), traced
+    /// in `order`.
     fn shade(&self, inputs: &ShadowInputs, pts: &[Option<Vec3>], order: &[usize]) -> Vec<f32> {
         let Some(tris) = inputs.occluder_triangles else {
             // Nothing to occlude with: callers check before (the pipeline
@@ -68,7 +69,7 @@ impl Exact {
             light: inputs.light_shape.samples(self.samples),
             t0: RAY_EPS,
         };
-        visibilities(&bvh, pts, order, &s, 1.0)
+        visibilities(&bvh, pts, |k| k as u64, order, &s, 1.0)
     }
 }
 

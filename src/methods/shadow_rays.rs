@@ -114,13 +114,22 @@ const CHUNK: usize = 64;
 
 /// The visibility of each receiver of `receivers` (`absent` for `None`):
 /// the fraction of its stratified light samples whose segment is clear,
-/// the jitter a hash of its index and the sample. `order` (a permutation of
-/// the receivers' indices) is the order to trace them in: `LANES`
-/// consecutive ones go in a packet, so neighbours should be consecutive
-/// (`tile_order`).
+/// the jitter a hash of its key `key(k)` (receiver k's texel or pixel: see
+/// below) and the sample. `order` (a permutation of the receivers' indices)
+/// is the order to trace them in: `LANES` consecutive ones go in a packet,
+/// so neighbours should be consecutive (`tile_order`).
+///
+/// The key names where the receiver is (its texel, its pixel), not its rank
+/// among the receivers traced: a rank shifts by one after any pixel that
+/// one backend sees and the other does not (the CPU rasterizes the first
+/// hits, the GPU casts them: they differ where a pixel centre grazes an
+/// edge), and every pixel after it would get another sample pattern
+/// (issue 28: 1.4-32% of the pixels' visibilities differed by multiples of
+/// one sample's weight).
 pub(crate) fn visibilities<R: RayOrigin>(
     bvh: &Bvh,
     receivers: &[Option<R>],
+    key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
     s: &Sampling,
     absent: f32,
@@ -140,7 +149,7 @@ pub(crate) fn visibilities<R: RayOrigin>(
                     // Every sample would be counted: the same 1.0 as tracing.
                     out.push((k, 1.0));
                 } else {
-                    pending.push((k as u64, r));
+                    pending.push((key(k), r));
                     keys.push(k);
                 }
             }

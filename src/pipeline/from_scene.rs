@@ -77,7 +77,7 @@ pub fn from_scene(
             all
         };
         let order = crate::methods::shadow_rays::tile_order(grid.width, grid.height);
-        let v = rays::visibility(light_shape, tris, &keyed, &order, samples);
+        let v = rays::visibility(light_shape, tris, &keyed, |k| k as u64, &order, samples);
         for &k in &texels {
             visibility[k] = v[k];
         }
