@@ -62,7 +62,8 @@ def main() -> None:
         else:
             summary.append(f"| {name} | none within {BAR_ERROR} | | | | |")
     table = [
-        f"| scene ({res[0]}×{res[1]}) | fastest call with error ≤ {BAR_ERROR} | time (ms) | error | "
+        f"| scene ({res[0]}×{res[1]}) | fastest call with error over shadowed pixels ≤ {BAR_ERROR} "
+        "| time (ms) | error | "
         "Mitsuba at equal error (ms) | speed-up |",
         "|---|---|---|---|---|---|",
         *summary,

@@ -43,6 +43,7 @@ __all__ = [
     "light_emission",
     "irradiance",
     "EyeResult",
+    "ErrorEstimate",
     "check_mesh",
     "shadow_map_from_meshes",
     "shadow_map_from_depth",
@@ -551,6 +552,7 @@ class EyeResult:
     @property
     def error_estimate(self) -> ErrorEstimate | None: ...
 
+@final
 class ErrorEstimate:
     """A result's error estimated from exact rays at a random subset of its
     pixels: the mean |V - V_ref| over the pixels the exact rays find in

@@ -208,7 +208,7 @@ def test_the_eye_view_plans_for_its_target_and_meets_it(contact_boxes_eye, targe
     img = ss.render(scene, light, cam, method=ss.Auto(error=target))
     assert isinstance(img.method, kind) and img.plan is not None and img.plan.method == img.method
     names = [d.name for d in img.plan.decisions]
-    assert names == ["setting", "focus"] and next(iter(img.timings)) == "plan"
+    assert names == ["setting", "focus", "estimate"] and next(iter(img.timings)) == "plan"
     assert compare_images(img, ref).mean_abs <= target, img.plan
     # Without a target: the rule, no plan.
     assert ss.render(scene, light, cam, method=ss.Auto()).plan is None
