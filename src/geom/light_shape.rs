@@ -191,7 +191,7 @@ impl LightSamples {
 }
 
 /// The map kernels' clipping scales: light coordinates (x, y) become
-/// (x * inv_half[0], y * inv_half[1]), in which the light is [-1, 1]^2;
+/// `(x * inv_half[0], y * inv_half[1])`, in which the light is `[-1, 1]^2`;
 /// `half` turns 1/depth differences back into tangent reach.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HalfLight {
