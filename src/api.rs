@@ -363,8 +363,8 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         _ => None,
     };
     // `Auto` with a target always says how right it is. The default call
-    // (`Auto` without one) does not: on scenes of 100 000+ triangles the
-    // estimate's BVH alone made it 1.6x slower (docs/accuracy.md).
+    // (`Auto` without one) does not unless asked: the estimate's first
+    // batch alone is 12-19% of a fast call (docs/accuracy.md).
     let planned = EyeCall {
         method: plan.as_ref().map_or(call.method, |p| p.config),
         estimate_error: call.estimate_error || plan.is_some(),
