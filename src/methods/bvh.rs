@@ -564,33 +564,6 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn the_morton_tree_holds_every_triangle_once_and_stays_shallow() {
-        let bvh = Bvh::build_fast(random_tris(1000, 5));
-        let mut seen = vec![0u32; 1000];
-        for n in bvh.nodes.iter().filter(|n| n.count > 0) {
-            assert!(n.count as usize <= LEAF);
-            for k in n.start..n.start + n.count {
-                seen[bvh.order[k as usize] as usize] += 1;
-            }
-        }
-        assert!(seen.iter().all(|&c| c == 1));
-        let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 5000];
-        assert!(Bvh::build_fast(same).depth() <= 32);
-        let chain: Vec<[Vec3; 3]> = (0..3000)
-            .map(|k| {
-                let x = 1.5f32.powi(k / 50);
-                [
-                    Vec3::new(x, 0.0, 0.0),
-                    Vec3::new(x, 1.0, 0.0),
-                    Vec3::new(x, 0.0, 1.0),
-                ]
-            })
-            .collect();
-        let d = Bvh::build_fast(chain).depth();
-        assert!(d <= SAH_DEPTH + 32, "depth {d}");
-    }
-
-    #[test]
     fn nearest_agrees_with_brute_force() {
         let tris = random_tris(300, 3);
         let bvh = Bvh::build(tris.clone());
@@ -613,24 +586,27 @@ pub(crate) mod tests {
 
     #[test]
     fn every_triangle_lands_in_one_leaf_of_at_most_leaf_size() {
-        let bvh = Bvh::build(random_tris(1000, 5));
-        let mut seen = vec![0u32; 1000];
-        for n in bvh.nodes.iter().filter(|n| n.count > 0) {
-            assert!(n.count as usize <= LEAF);
-            for k in n.start..n.start + n.count {
-                seen[bvh.order[k as usize] as usize] += 1;
+        for build in [Bvh::build, Bvh::build_fast] {
+            let bvh = build(random_tris(1000, 5));
+            let mut seen = vec![0u32; 1000];
+            for n in bvh.nodes.iter().filter(|n| n.count > 0) {
+                assert!(n.count as usize <= LEAF);
+                for k in n.start..n.start + n.count {
+                    seen[bvh.order[k as usize] as usize] += 1;
+                }
             }
+            assert!(seen.iter().all(|&c| c == 1));
         }
-        assert!(seen.iter().all(|&c| c == 1));
     }
 
     #[test]
     fn depth_stays_within_the_traversal_stacks() {
         // Identical triangles (no plane separates them) and a geometric
         // progression (SAH peels one triangle a level): both must stay
-        // under the 64-entry stacks.
+        // under the 64-entry stacks, with SAH or Morton splits.
         let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 5000];
-        assert!(Bvh::build(same).depth() <= 32);
+        assert!(Bvh::build(same.clone()).depth() <= 32);
+        assert!(Bvh::build_fast(same).depth() <= 32);
         let chain: Vec<[Vec3; 3]> = (0..3000)
             .map(|k| {
                 let x = 1.5f32.powi(k / 50);
@@ -641,8 +617,12 @@ pub(crate) mod tests {
                 ]
             })
             .collect();
-        let d = Bvh::build(chain).depth();
-        assert!(d <= SAH_DEPTH + 32, "depth {d}");
+        for d in [
+            Bvh::build(chain.clone()).depth(),
+            Bvh::build_fast(chain).depth(),
+        ] {
+            assert!(d <= SAH_DEPTH + 32, "depth {d}");
+        }
     }
 
     #[test]
