@@ -362,23 +362,66 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         )),
         _ => None,
     };
-    // `Auto` with a target always says how right it is. The default call
-    // (`Auto` without one) does not unless asked: the estimate's first
-    // batch alone is 12-19% of a fast call (docs/accuracy.md).
+    // `Auto` with a target always says how right it is, from a fixed draw
+    // of pixels (its refinements must not depend on the machine's speed).
+    // The default call (`Auto` without one) does not unless asked: the
+    // estimate's first batch alone is 12-19% of a fast call
+    // (docs/accuracy.md).
     let planned = EyeCall {
         method: plan.as_ref().map_or(call.method, |p| p.config),
-        estimate_error: call.estimate_error || plan.is_some(),
+        estimate_error: if plan.is_some() {
+            Some(crate::error_estimate::Draw::Fixed)
+        } else {
+            call.estimate_error
+        },
         ..*call
     };
     let planning = t0.elapsed().as_secs_f64();
-    let ((mut image, method), threads) =
-        threads::run_capped(cap, || pipeline::eye_view::render(&planned, backend))?;
+    // An error target is checked against the run's own estimate and the
+    // call run again until it is met (`auto/refine.rs`).
+    let error = match call.method {
+        MethodConfig::Auto(a) => a.target.error.map(|e| e.0),
+        _ => None,
+    };
+    let run = |m: &MethodConfig| {
+        pipeline::eye_view::render(
+            &EyeCall {
+                method: *m,
+                ..planned
+            },
+            backend,
+        )
+    };
+    let mut refinements = vec![];
+    let (((mut image, method), replaced), threads) = threads::run_capped(cap, || {
+        let t = std::time::Instant::now();
+        let first = run(&planned.method)?;
+        let Some(e) = error else {
+            return Ok((first, 0.0));
+        };
+        let seconds = t.elapsed().as_secs_f64();
+        let (image, method, replaced) = crate::auto::refine::refined(
+            e,
+            crate::auto::plan::EYE_EXACT,
+            (first, seconds),
+            &mut refinements,
+            |img: &EyeImage| img.estimate,
+            run,
+        )?;
+        Ok(((image, method), replaced))
+    })?;
     if let Some(p) = plan.as_mut() {
+        let verdict = refinements.pop_if(|d| d.name == "target");
+        p.decisions.extend(refinements);
         p.decisions.push(focus_decision(&image));
         if let Some(e) = &image.estimate {
             p.decisions.push(estimate_decision(e));
         }
+        p.decisions.extend(verdict);
         p.config = method;
+        if replaced > 0.0 {
+            image.timings.insert(0, ("replaced", replaced));
+        }
         image.timings.insert(0, ("plan", planning));
     }
     Ok(Run {

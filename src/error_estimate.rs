@@ -44,6 +44,33 @@ pub struct ErrorEstimate {
     pub seconds: f64,
 }
 
+/// How many pixels an estimate draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Draw {
+    /// Batches while the estimate has spent less than a set share of the
+    /// call so far (the first batch always): its cost a bounded share of
+    /// the call, its pixel count the machine's (`estimate_error=True`).
+    Timed,
+    /// A set count of pixels, whatever the time: the same inputs draw the
+    /// same pixels and give the same estimate, so a plan checked against it
+    /// (`Auto` with a target, `crate::auto::refine`) gives the same bits.
+    Fixed,
+}
+
+impl Draw {
+    /// The draw named by the API's `estimate_error` (`True` is "timed").
+    pub fn parse(name: &str) -> crate::error::Result<Draw> {
+        match name {
+            "timed" => Ok(Draw::Timed),
+            "fixed" => Ok(Draw::Fixed),
+            other => Err(crate::error::Error::invalid(
+                "estimate_error",
+                format!("must be True, False, \"timed\" or \"fixed\", got {other:?}"),
+            )),
+        }
+    }
+}
+
 /// One stratum: its size in units and, per drawn unit, its pixels' pairs
 /// (the result's visibility, the exact one).
 #[derive(Debug, Clone, Default)]

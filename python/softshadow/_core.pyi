@@ -596,7 +596,7 @@ def render(
     threads: int | None = None,
     emission: _Color | None = None,
     albedo: _Color | list[_Color] | None = None,
-    estimate_error: bool = False,
+    estimate_error: str | None = None,
 ) -> EyeResult:
     """The eye view: first hits, then each pixel's visibility with every mesh
     casting and receiving, then the shading (``emission`` the light's

@@ -27,7 +27,7 @@ surfaces, unshadowed and times the visibility (``Image.unshadowed``,
 from __future__ import annotations
 
 import numbers
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -312,7 +312,7 @@ def render(
     backend: str = "cpu",
     threads: int | None = None,
     albedo: Any = None,
-    estimate_error: bool = False,
+    estimate_error: bool | Literal["timed", "fixed"] = False,
 ) -> Image:
     """Renders the visibility and shaded images of ``scene`` under ``light`` seen by ``camera``.
 
@@ -364,15 +364,18 @@ def render(
         Keyword-only. Also estimate the image's error (``img.error_estimate``):
         exact stratified rays (256 light samples; for ``exact``, four times
         its own) at a random subset of the visible pixels, three quarters of
-        them in the image's shadow, as many as fit in a tenth of the call;
-        the mean |V - V_ref| over those the rays find in shadow, with a 95%
-        interval (docs/accuracy.md). Always on for ``Auto(error=...)`` and
-        ``Auto(time=...)``.
+        them in the image's shadow; the mean |V - V_ref| over those the rays
+        find in shadow, with a 95% interval (docs/accuracy.md). ``True`` (or
+        ``"timed"``): as many pixels as fit in a tenth of the call, so the
+        estimate depends on the machine's speed; ``"fixed"``: 1024 pixels
+        whatever the time, the same estimate for the same inputs. Always on,
+        fixed, for ``Auto(error=...)`` and ``Auto(time=...)``.
 
     Bad values raise ValueError or TypeError naming the argument.
     """
-    if not isinstance(estimate_error, bool):
-        raise TypeError(f"estimate_error: must be True or False, got {type(estimate_error).__name__}")
+    if not isinstance(estimate_error, (bool, str)):
+        raise TypeError(f'estimate_error: must be True, False, "timed" or "fixed", got {type(estimate_error).__name__}')
+    draw = ("timed" if estimate_error else None) if isinstance(estimate_error, bool) else estimate_error
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
     if not isinstance(light, (RectLight, DirectionalLight)):
@@ -396,7 +399,7 @@ def render(
         threads=threads,
         emission=light._emission(),
         albedo=check.color(albedo),
-        estimate_error=estimate_error,
+        estimate_error=draw,
     )
     return Image(
         visibility=r.visibility,

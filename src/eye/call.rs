@@ -6,7 +6,7 @@
 use super::gbuffer::GBuffer;
 use super::maps::{Bias, EyeMaps};
 use crate::backend::BackendChoice;
-use crate::error_estimate::ErrorEstimate;
+use crate::error_estimate::{Draw, ErrorEstimate};
 use crate::geom::camera::Camera;
 use crate::geom::light_space::{Light, LightSpace};
 use crate::geom::mesh::MeshRef;
@@ -26,8 +26,8 @@ pub struct EyeCall<'a> {
     pub backend: BackendChoice,
     pub threads: Option<i64>,
     /// Estimate the result's error from exact rays at a subset of the
-    /// pixels (`estimate.rs`).
-    pub estimate_error: bool,
+    /// pixels drawn as it says (`estimate.rs`); None: no estimate.
+    pub estimate_error: Option<Draw>,
 }
 
 /// A rendered image.

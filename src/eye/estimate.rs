@@ -10,7 +10,9 @@
 //! quarter (a shadow the result missed is found there). The units are
 //! traced in batches of `BATCH`, while the estimate has spent less than
 //! `SHARE` of the call so far (the first batch always), at most
-//! `MAX_UNITS`.
+//! `MAX_UNITS` (`Draw::Timed`); or `PLANNED_UNITS` of them whatever the
+//! time (`Draw::Fixed`, for a plan checked against its estimate: it must
+//! not depend on how fast the machine is).
 //!
 //! A batch's rays meet only the triangles in the shafts from its tiles to
 //! the light (`in_shaft`, a box test), so each batch builds a small BVH of
@@ -27,7 +29,7 @@ use rayon::prelude::*;
 
 use super::framing::Framed;
 use super::rays::{self, RayStart};
-use crate::error_estimate::{draw, ratio_estimate, ErrorEstimate, Stratum, SHADOW_THRESHOLD};
+use crate::error_estimate::{draw, ratio_estimate, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD};
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_rays::RayOrigin;
 
@@ -42,6 +44,11 @@ pub const UNIT: usize = 8;
 pub const BATCH: usize = 16;
 /// The most units traced (16384 pixels).
 pub const MAX_UNITS: usize = 2048;
+/// The units a fixed draw traces (1024 pixels): a 95% interval about a
+/// fifth of the estimate wide on the as-built scenes' shadows, at 7% of an
+/// `exact` call's rays at 320x240 (its own four times the samples at 1024
+/// of about 60 000 pixels).
+pub const PLANNED_UNITS: usize = 128;
 /// The estimate's share of the call's time: at most a ninth of the rest
 /// (a tenth of the whole).
 pub const SHARE: f64 = 1.0 / 9.0;
@@ -56,16 +63,33 @@ const TESTS_PER_BUILD: usize = 64;
 /// The estimate of `visibility` (per visible point of `f`, in its order)
 /// against exact rays with `samples` light samples through `triangles`
 /// (kernel light space: every triangle that can shadow a point), the
-/// image `width` x `height`, the call having taken `spent` seconds so far.
+/// image `width` x `height`, drawn as `how` says, the call having taken
+/// `spent` seconds so far.
 pub fn estimate(
     f: &Framed,
     size: (usize, usize),
     triangles: Vec<[Vec3; 3]>,
     visibility: &[f32],
     samples: u32,
-    spent: f64,
+    (how, spent): (Draw, f64),
 ) -> ErrorEstimate {
-    estimate_with(f, size, triangles, visibility, samples, spent, true)
+    let budget = match how {
+        Draw::Timed => SHARE * spent,
+        Draw::Fixed => f64::INFINITY,
+    };
+    let units = match how {
+        Draw::Timed => MAX_UNITS,
+        Draw::Fixed => PLANNED_UNITS,
+    };
+    estimate_with(
+        f,
+        size,
+        triangles,
+        visibility,
+        samples,
+        (units, budget),
+        true,
+    )
 }
 
 /// `estimate`; `cull` false traces every batch through one BVH of the
@@ -76,7 +100,7 @@ fn estimate_with(
     triangles: Vec<[Vec3; 3]>,
     visibility: &[f32],
     samples: u32,
-    spent: f64,
+    (most, budget): (usize, f64),
     cull: bool,
 ) -> ErrorEstimate {
     let t0 = Instant::now();
@@ -89,7 +113,7 @@ fn estimate_with(
             .iter()
             .any(|&k| 1.0 - visibility[k] > SHADOW_THRESHOLD)
     });
-    let total = units.len().min(MAX_UNITS);
+    let total = units.len().min(most);
     let want0 = ((total as f64 * SHADOW_SHARE).round() as usize).min(shadow.len());
     let want1 = (total - want0).min(lit.len());
     let want0 = (total - want1).min(shadow.len());
@@ -116,7 +140,6 @@ fn estimate_with(
     let mut strata = [Stratum::default(), Stratum::default()];
     strata[0].population = shadow.len();
     strata[1].population = lit.len();
-    let budget = SHARE * spent;
     let (mut traced, mut culled, mut cull_seconds) = (0, 0usize, 0f64);
     let mut whole: Option<Bvh> = (!cull).then(|| Bvh::build_fast(triangles.clone()));
     for batch in order.chunks(BATCH) {
@@ -294,7 +317,7 @@ mod tests {
             bias: Bias::new(None, None).unwrap(),
             backend: BackendChoice::Cpu,
             threads: None,
-            estimate_error: true,
+            estimate_error: Some(Draw::Timed),
         };
         let scene = SceneTriangles::new(&meshes).unwrap();
         let g = CpuEye.first_hits(&camera, &scene).unwrap();
@@ -306,13 +329,20 @@ mod tests {
         let tris = traced_triangles(&f, &scene);
         let size = (camera.width, camera.height);
         // A budget no batch reaches: every unit is traced both ways.
-        let a = estimate_with(&f, size, tris.clone(), &v, 64, 1e9, true);
-        let b = estimate_with(&f, size, tris, &v, 64, 1e9, false);
+        let a = estimate_with(&f, size, tris.clone(), &v, 64, (MAX_UNITS, 1e9), true);
+        let b = estimate_with(&f, size, tris, &v, 64, (MAX_UNITS, 1e9), false);
         assert!(a.shadowed > 0 && a.traced == b.traced);
         assert_eq!(
             (a.error, a.low, a.high, a.shadowed),
             (b.error, b.low, b.high, b.shadowed)
         );
+        // A fixed draw: PLANNED_UNITS units (96 x 72 has more), the same
+        // estimate whatever the call has spent.
+        let tris = traced_triangles(&f, &scene);
+        let c = estimate(&f, size, tris.clone(), &v, 64, (Draw::Fixed, 1e-9));
+        let d = estimate(&f, size, tris, &v, 64, (Draw::Fixed, 1e9));
+        assert_eq!(c.traced, PLANNED_UNITS * UNIT);
+        assert_eq!((c.error, c.high, c.traced), (d.error, d.high, d.traced));
     }
 
     /// Every box a sampled segment from the origins' box to the light

@@ -557,7 +557,7 @@ mod eye {
             bias: DEFAULT_BIAS,
             backend,
             threads: None,
-            estimate_error: false,
+            estimate_error: None,
         })
     }
 
@@ -914,7 +914,7 @@ mod eye {
                     bias: DEFAULT_BIAS,
                     backend,
                     threads: None,
-                    estimate_error: false,
+                    estimate_error: None,
                 })
                 .unwrap()
             };
@@ -1152,7 +1152,7 @@ mod eye {
                         bias: DEFAULT_BIAS,
                         backend: BackendChoice::Gpu,
                         threads: None,
-                        estimate_error: false,
+                        estimate_error: None,
                     };
                     let mut sw = Stopwatch::new();
                     let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
@@ -1297,7 +1297,7 @@ mod eye {
                 bias: DEFAULT_BIAS,
                 backend: BackendChoice::Gpu,
                 threads: None,
-                estimate_error: false,
+                estimate_error: None,
             };
             let mut sw = Stopwatch::new();
             let p = match sm::prepare(&call, &cfg, &scene, &gb, &mut sw).unwrap() {

@@ -11,6 +11,7 @@
 
 use crate::backend::Backend;
 use crate::error::Result;
+use crate::error_estimate::Draw;
 use crate::eye::estimate::{self, REFERENCE_SAMPLES};
 use crate::eye::framing::{
     casting_faces, exact_samples, frame, light_triangles, map_grid, resolve_at_camera,
@@ -57,11 +58,18 @@ pub fn render_with<S: EyeStages>(
         let visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
         // The estimate frames the scene for its exact rays: every
         // triangle can shadow (ShadowMapping does not pick casters).
-        let estimate = if call.estimate_error {
+        let estimate = if let Some(how) = call.estimate_error {
             let f = frame(call, &scene, &g)?;
             let at_hits: Vec<f32> = f.hits.iter().map(|&k| visibility[k]).collect();
             let tris = traced_triangles(&f, &scene);
-            let e = estimate::estimate(&f, size, tris, &at_hits, REFERENCE_SAMPLES, elapsed(start));
+            let e = estimate::estimate(
+                &f,
+                size,
+                tris,
+                &at_hits,
+                REFERENCE_SAMPLES,
+                (how, elapsed(start)),
+            );
             sw.lap("estimate");
             Some(e)
         } else {
@@ -89,14 +97,21 @@ pub fn render_with<S: EyeStages>(
         let samples = exact_samples(call, &method);
         let tris = traced_triangles(&f, &scene);
         sw.lap("triangles");
-        let again = call.estimate_error.then(|| tris.clone());
+        let again = call.estimate_error.map(|how| (how, tris.clone()));
         let v = stages.trace(&f, tris, call.camera, samples, &mut sw)?;
         sw.lap("shadow");
         // `exact` against itself with four times its samples: its own
         // sampling error.
-        if let Some(tris) = again {
+        if let Some((how, tris)) = again {
             let more = samples.saturating_mul(4).min(MAX_SAMPLES);
-            estimate = Some(estimate::estimate(&f, size, tris, &v, more, elapsed(start)));
+            estimate = Some(estimate::estimate(
+                &f,
+                size,
+                tris,
+                &v,
+                more,
+                (how, elapsed(start)),
+            ));
             sw.lap("estimate");
         }
         for (&k, v) in f.hits.iter().zip(v) {
@@ -110,18 +125,26 @@ pub fn render_with<S: EyeStages>(
         // The estimate's rays meet the casters only: the other triangles
         // cannot shadow a point that faces the light (casters.rs), and a
         // point facing away is 0 in both.
-        let traced: Option<Vec<[Vec3; 3]>> = call.estimate_error.then(|| {
-            casting
+        let traced: Option<(Draw, Vec<[Vec3; 3]>)> = call.estimate_error.map(|how| {
+            let t = casting
                 .iter()
                 .map(|t| t.map(|i| f.verts[i as usize].as_vec3()))
-                .collect()
+                .collect();
+            (how, t)
         });
         let tris = light_triangles(&mut f, &casting);
         let (v, m) = stages.shade_maps(call, &f, &tris, grid, &method, &mut sw)?;
         maps = Some(m);
         sw.lap("maps_out");
-        if let Some(traced) = traced {
-            let e = estimate::estimate(&f, size, traced, &v, REFERENCE_SAMPLES, elapsed(start));
+        if let Some((how, traced)) = traced {
+            let e = estimate::estimate(
+                &f,
+                size,
+                traced,
+                &v,
+                REFERENCE_SAMPLES,
+                (how, elapsed(start)),
+            );
             estimate = Some(e);
             sw.lap("estimate");
         }

@@ -10,6 +10,7 @@ use super::errors;
 use super::results::{map, sun_depth};
 use crate::api::Run;
 use crate::backend::BackendChoice;
+use crate::error_estimate::Draw;
 use crate::eye::shading::{self, ColorValue};
 use crate::eye::{Bias, EyeCall, EyeImage, Lighting, Shaded};
 use crate::geom::mesh::MeshRef;
@@ -94,7 +95,7 @@ pub fn irradiance<'py>(
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.
 #[pyfunction]
-#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None, estimate_error=false))]
+#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None, estimate_error=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -114,7 +115,7 @@ pub fn render<'py>(
     threads: Option<Bound<'py, PyAny>>,
     emission: Option<Bound<'py, PyAny>>,
     albedo: Option<Bound<'py, PyAny>>,
-    estimate_error: bool,
+    estimate_error: Option<&str>,
 ) -> PyResult<EyeResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -139,7 +140,7 @@ pub fn render<'py>(
             bias: Bias::new(normal_offset, depth_bias)?,
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
-            estimate_error,
+            estimate_error: estimate_error.map(Draw::parse).transpose()?,
         };
         let arg = shading::emission_arg(&light);
         let lighting = Lighting::new(

@@ -72,7 +72,18 @@ def test_the_estimate_is_near_the_true_error(name, method):
     assert truth / 2 <= e.error <= 2 * truth or low - 0.005 <= truth <= high + 0.005, (truth, e)
 
 
+def test_a_fixed_draw_gives_the_same_estimate_every_time():
+    scene, light, cam = as_built.torus_on_slab(RES)
+    a = ss.render(scene, light, cam, method=ss.Ssm(), estimate_error="fixed").error_estimate
+    b = ss.render(scene, light, cam, method=ss.Ssm(), estimate_error="fixed").error_estimate
+    assert a.traced == 1024 and (a.error, a.interval, a.shadowed) == (b.error, b.interval, b.shadowed)
+    timed = ss.render(scene, light, cam, method=ss.Ssm(), estimate_error="timed").error_estimate
+    assert timed.samples == a.samples and timed.traced >= 128
+
+
 def test_bad_estimate_error_is_refused():
     scene, light, cam = as_built.torus_on_slab(RES)
-    with pytest.raises(TypeError, match="estimate_error"):
+    with pytest.raises(ValueError, match="estimate_error"):
         ss.render(scene, light, cam, estimate_error="yes")  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="estimate_error"):
+        ss.render(scene, light, cam, estimate_error=1)  # type: ignore[arg-type]

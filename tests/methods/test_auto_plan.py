@@ -8,6 +8,7 @@ import pytest
 
 import softshadow as ss
 from softshadow import metrics, scenes
+from softshadow.metrics import compare_images
 
 
 def decision(sm: ss.ShadowMap, name: str) -> ss.Decision:
@@ -200,15 +201,39 @@ def contact_boxes_eye():
     return scene, light, cam, render_visibility(scene, light, cam, samples=1024)
 
 
-@pytest.mark.parametrize(("target", "kind"), [(0.05, ss.Ssm), (0.01, ss.Exact)])
+@pytest.mark.parametrize(("target", "kind"), [(0.35, ss.Ssm), (0.02, ss.Exact)])
 def test_the_eye_view_plans_for_its_target_and_meets_it(contact_boxes_eye, target, kind):
-    from softshadow.metrics import compare_images
-
     scene, light, cam, ref = contact_boxes_eye
     img = ss.render(scene, light, cam, method=ss.Auto(error=target))
     assert isinstance(img.method, kind) and img.plan is not None and img.plan.method == img.method
     names = [d.name for d in img.plan.decisions]
-    assert names == ["setting", "focus", "estimate"] and next(iter(img.timings)) == "plan"
-    assert compare_images(img, ref).mean_abs <= target, img.plan
+    # The setting, any refinements, then the verdict on the last run's estimate.
+    assert names[0] == "setting" and names[-3:] == ["focus", "estimate", "target"], names
+    assert set(names[1:-3]) <= {"refine"} and next(iter(img.timings)) == "plan"
+    assert img.plan.decisions[-1].taken and img.error_estimate.interval[1] <= target, img.plan
+    assert compare_images(img, ref).shadow_error <= target, img.plan
     # Without a target: the rule, no plan.
     assert ss.render(scene, light, cam, method=ss.Auto()).plan is None
+
+
+@pytest.mark.parametrize("name", ["fence_slats", "blinds"])
+def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
+    """Held-out scenes (nothing was fitted to them) where the plan's first
+    setting missed 0.01 (0.026 and 0.033 before refining): the estimate
+    sends the call round again, and the answer meets the target against
+    exact with 1024 samples (its own error about 0.003)."""
+    from softshadow.scenes import as_built
+
+    scene, light, cam = as_built.HELD_OUT[name]((160, 120))
+    img = ss.render(scene, light, cam, method=ss.Auto(error=0.01))
+    ref = ss.render(scene, light, cam, method=ss.Exact(samples=1024))
+    names = [d.name for d in img.plan.decisions]
+    assert "refine" in names and img.plan.decisions[-1].name == "target" and img.plan.decisions[-1].taken
+    assert isinstance(img.method, ss.Exact) and img.method.samples > 144, img.plan
+    assert "replaced" in img.timings and img.timings["replaced"] > 0
+    shadowed = img.mask & (1.0 - ref.visibility > 1e-3)
+    assert float(np.abs(img.visibility - ref.visibility)[shadowed].mean()) <= 0.01, img.plan
+    # The same inputs give the same bits: the estimate the plan reads draws
+    # a fixed set of pixels, whatever the machine's speed.
+    again = ss.render(scene, light, cam, method=ss.Auto(error=0.01))
+    assert again.method == img.method and np.array_equal(again.visibility, img.visibility)
