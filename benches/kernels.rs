@@ -137,6 +137,7 @@ fn call<'a>(s: &'a Scene, method: MethodConfig) -> MeshCall<'a> {
         method,
         backend: BackendChoice::Cpu,
         threads: None,
+        estimate_error: None,
     }
 }
 

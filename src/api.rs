@@ -11,6 +11,7 @@
 
 use crate::backend::{Backend, BackendChoice};
 use crate::error::{Error, Result};
+use crate::error_estimate::Draw;
 use crate::eye::{EyeCall, EyeImage, Lighting, Shaded};
 use crate::frame::{orthographic_maps, MapSettings, ShadowResult};
 use crate::geom::light::MapGrid;
@@ -79,6 +80,10 @@ pub struct MeshCall<'a> {
     pub backend: BackendChoice,
     /// Worker threads; `None`: SOFTSHADOW_THREADS, else all cores.
     pub threads: Option<i64>,
+    /// Estimate the result's error from exact rays at texels drawn as it
+    /// says (`crate::light_view::estimate`); None: no estimate (`Auto`
+    /// with a target always estimates, from a fixed draw).
+    pub estimate_error: Option<Draw>,
 }
 
 /// Meshes -> light-view maps -> visibility, on the chosen backend.
@@ -114,16 +119,24 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         )?;
         // A sun's map extent is given in world units; the kernels' in tangents.
         let extent = call.extent.map(|e| space.kernel_extent(e));
+        // `Auto` with a target always says how right it is, from a fixed
+        // draw (its refinements must not depend on the machine's speed).
+        let estimate = if target.is_some() {
+            Some(Draw::Fixed)
+        } else {
+            call.estimate_error
+        };
         let run =
             |method: &MethodConfig, hard: bool, size: (usize, usize), extent: Option<[f64; 2]>| {
                 let mut settings = MapSettings::new(size.0, size.1, extent, method);
                 settings.hard = hard;
+                settings.estimate = estimate;
                 pipeline::from_meshes(call.occluders, call.receivers, &space, &settings, backend)
             };
         let Some(target) = target else {
             return Ok((run(&method, false, (w, h), extent)?, method, None));
         };
-        crate::auto::driver::planned(
+        let (first, cfg, plan) = crate::auto::driver::planned(
             (call.occluders, call.receivers),
             &call.method,
             &space,
@@ -131,7 +144,50 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
             &ctx,
             &target,
             run,
-        )
+        )?;
+        let Some(mut plan) = plan else {
+            return Ok((first, cfg, None));
+        };
+        // An error target is checked against the run's own estimate and
+        // the call run again with `exact` until it is met (`auto/refine.rs`).
+        let planning = first.timings.iter().find(|t| t.0 == "plan").map(|t| t.1);
+        let mut refinements = vec![];
+        let (mut out, method, replaced) = match target.error {
+            Some(e) => {
+                let seconds = first
+                    .timings
+                    .iter()
+                    .filter(|t| t.0 != "plan")
+                    .map(|t| t.1)
+                    .sum();
+                crate::auto::refine::refined(
+                    e.0,
+                    crate::auto::plan::LIGHT_EXACT,
+                    ((first, cfg), seconds),
+                    &mut refinements,
+                    |r: &ShadowResult| r.estimate,
+                    |m| {
+                        let m = m.resolve(&ctx)?;
+                        Ok((run(&m, false, (w, h), extent)?, m))
+                    },
+                )?
+            }
+            None => (first, cfg, 0.0),
+        };
+        let verdict = refinements.pop_if(|d| d.name == "target");
+        plan.decisions.extend(refinements);
+        if let Some(e) = &out.estimate {
+            plan.decisions.push(estimate_decision(e, "texels"));
+        }
+        plan.decisions.extend(verdict);
+        plan.config = method;
+        if replaced > 0.0 {
+            out.timings.insert(0, ("replaced", replaced));
+            if let Some(p) = planning {
+                out.timings.insert(0, ("plan", p));
+            }
+        }
+        Ok((out, method, Some(plan)))
     })?;
     Ok(Run {
         output,
@@ -155,6 +211,8 @@ pub struct SceneCall<'a> {
     pub bias: crate::eye::Bias,
     pub backend: BackendChoice,
     pub threads: Option<i64>,
+    /// As `MeshCall::estimate_error`.
+    pub estimate_error: Option<Draw>,
 }
 
 /// A self-shadowing scene -> light-view maps -> visibility (the CPU: its
@@ -180,7 +238,8 @@ pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
     let (output, threads) = threads::run_capped(cap, || {
         let space = mesh_space(call.light, &[("meshes", call.scene)])?;
         let extent = call.extent.map(|e| space.kernel_extent(e));
-        let settings = MapSettings::new(w, h, extent, &method);
+        let mut settings = MapSettings::new(w, h, extent, &method);
+        settings.estimate = call.estimate_error;
         pipeline::from_scene(call.scene, &space, &settings, &call.bias)
     })?;
     Ok(Run {
@@ -415,7 +474,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         p.decisions.extend(refinements);
         p.decisions.push(focus_decision(&image));
         if let Some(e) = &image.estimate {
-            p.decisions.push(estimate_decision(e));
+            p.decisions.push(estimate_decision(e, "pixels"));
         }
         p.decisions.extend(verdict);
         p.config = method;
@@ -466,14 +525,14 @@ pub fn render_shaded(call: &EyeCall, lighting: &Lighting) -> Result<(Run<EyeImag
     Ok((run, shaded))
 }
 
-/// The error estimate, reported in a plan.
-fn estimate_decision(e: &crate::error_estimate::ErrorEstimate) -> crate::auto::Decision {
+/// The error estimate, reported in a plan (`at`: "pixels" or "texels").
+fn estimate_decision(e: &crate::error_estimate::ErrorEstimate, at: &str) -> crate::auto::Decision {
     crate::auto::Decision {
         name: "estimate",
         taken: true,
         why: format!(
             "measured error {:.4} (95% interval {:.4}-{:.4}) from exact rays ({} light samples) \
-             at {} pixels, {} of them in shadow, in {:.1} ms",
+             at {} {at}, {} of them in shadow, in {:.1} ms",
             e.error,
             e.low,
             e.high,

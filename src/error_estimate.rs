@@ -127,6 +127,35 @@ pub fn ratio_estimate(strata: &[Stratum]) -> (f64, f64, f64, usize) {
     )
 }
 
+/// The units to trace, in order, as (stratum, unit): of `shadow` units in
+/// the result's shadow and `lit` others, `total` in all, `shadow_share` of
+/// them in the shadow where both strata have enough, drawn at random
+/// (seeds 1 and 2) and interleaved three to one so that any prefix keeps
+/// the strata's shares (a timed draw stops after any batch).
+pub fn strata_order(
+    (shadow, lit): (&[usize], &[usize]),
+    total: usize,
+    shadow_share: f64,
+) -> Vec<(usize, usize)> {
+    let want0 = ((total as f64 * shadow_share).round() as usize).min(shadow.len());
+    let want1 = (total - want0).min(lit.len());
+    let want0 = (total - want1).min(shadow.len());
+    let (d0, d1) = (draw(shadow.len(), want0, 1), draw(lit.len(), want1, 2));
+    let mut order: Vec<(usize, usize)> = Vec::with_capacity(total);
+    let (mut i0, mut i1) = (0, 0);
+    while i0 < d0.len() || i1 < d1.len() {
+        let take_shadow = i1 >= d1.len() || (i0 < d0.len() && i0 <= 3 * i1 + 2);
+        if take_shadow {
+            order.push((0, shadow[d0[i0]]));
+            i0 += 1;
+        } else {
+            order.push((1, lit[d1[i1]]));
+            i1 += 1;
+        }
+    }
+    order
+}
+
 /// The first `k` of a random permutation of `0..n` (partial Fisher–Yates),
 /// the same for the same `seed`: a longer draw extends a shorter one.
 pub fn draw(n: usize, k: usize, seed: u64) -> Vec<usize> {

@@ -25,6 +25,7 @@
 //!     method: MethodConfig::Bitmask(BitmaskConfig::new(Some(64), None, None, None, None)?),
 //!     backend: BackendChoice::Cpu,
 //!     threads: Some(1),
+//!     estimate_error: None,
 //! })?;
 //! // The config that ran, every default filled in; visibility in [0, 1].
 //! assert_eq!(run.method.passes(), 2);

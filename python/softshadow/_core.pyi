@@ -512,6 +512,8 @@ class MeshShadowResult:
     def threads(self) -> int: ...
     @property
     def plan(self) -> list[tuple[str, bool, str]] | None: ...
+    @property
+    def error_estimate(self) -> ErrorEstimate | None: ...
 
 @final
 class EyeResult:
@@ -661,6 +663,7 @@ def shadow_map_from_meshes(
     precision: str | None = None,
     backend: str = "cpu",
     threads: int | None = None,
+    estimate_error: str | None = None,
 ) -> MeshShadowResult:
     """Meshes -> light-view maps -> visibility, on ``backend`` ("cpu", "gpu"
     or "auto"). ``method`` is a config, or a name with the loose options."""
@@ -682,6 +685,7 @@ def shadow_map_from_scene(
     precision: str | None = None,
     backend: str = "cpu",
     threads: int | None = None,
+    estimate_error: str | None = None,
 ) -> MeshShadowResult:
     """A scene shadowing itself (every mesh as one) -> light-view maps ->
     visibility, each receiver texel shaded at its own surface point."""

@@ -107,6 +107,11 @@ class ShadowMap:
     plan: Plan | None = None
     """What ``Auto(error=...)`` or ``Auto(time=...)`` decided (light-view maps
     of a split scene); None for every other method."""
+    error_estimate: ErrorEstimate | None = None
+    """The map's error estimated from exact rays at a subset of its receiver
+    texels (``estimate_error=True``, always for ``Auto`` with a target of a
+    split scene), else ``None``; maps from depth have no triangles to trace
+    and never have one."""
 
     def _light_args(self) -> tuple[Any, ...]:
         if isinstance(self.light, DirectionalLight):

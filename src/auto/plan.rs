@@ -172,10 +172,16 @@ const CANDIDATES: [Candidate; 4] = [
     },
 ];
 
-/// exact's error at `samples` per receiver, measured: about 0.05 / sqrt(n)
-/// (1024 samples: 0.0012-0.0019 against 4096 on the test scenes).
+/// The light view's `exact` law, error about LIGHT_EXACT / sqrt(samples):
+/// measured against 4096 samples on the test scenes (1024 samples:
+/// 0.0012-0.0019, under 0.05 / 32). The plan's exact samples and a
+/// refinement from a map setting (`refine.rs`) both read it; not refitted
+/// on the fence.
+pub const LIGHT_EXACT: f64 = 0.05;
+
+/// exact's samples per receiver for `error` by `LIGHT_EXACT`'s law.
 fn exact_samples_for(error: f64) -> u32 {
-    let n = (0.05 / error).powi(2).ceil();
+    let n = (LIGHT_EXACT / error).powi(2).ceil();
     n.clamp(16.0, crate::methods::config::MAX_SAMPLES as f64) as u32
 }
 

@@ -29,7 +29,9 @@ use rayon::prelude::*;
 
 use super::framing::Framed;
 use super::rays::{self, RayStart};
-use crate::error_estimate::{draw, ratio_estimate, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD};
+use crate::error_estimate::{
+    ratio_estimate, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
+};
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_rays::RayOrigin;
 
@@ -53,7 +55,7 @@ pub const PLANNED_UNITS: usize = 128;
 /// (a tenth of the whole).
 pub const SHARE: f64 = 1.0 / 9.0;
 /// The share of the drawn units taken in the result's shadow.
-const SHADOW_SHARE: f64 = 0.75;
+pub const SHADOW_SHARE: f64 = 0.75;
 /// Tiles culled (each tests every triangle's box once) that a whole-scene
 /// BVH build is worth, at least: on `crowd` (339 000 triangles, 2 cores) a
 /// Morton build took 144–163 ms and a whole first batch of 16 tiles
@@ -114,24 +116,7 @@ fn estimate_with(
             .any(|&k| 1.0 - visibility[k] > SHADOW_THRESHOLD)
     });
     let total = units.len().min(most);
-    let want0 = ((total as f64 * SHADOW_SHARE).round() as usize).min(shadow.len());
-    let want1 = (total - want0).min(lit.len());
-    let want0 = (total - want1).min(shadow.len());
-    // The draw order: shadow and lit units interleaved three to one, so
-    // that any prefix keeps the strata's shares.
-    let (d0, d1) = (draw(shadow.len(), want0, 1), draw(lit.len(), want1, 2));
-    let mut order: Vec<(usize, usize)> = Vec::with_capacity(total);
-    let (mut i0, mut i1) = (0, 0);
-    while i0 < d0.len() || i1 < d1.len() {
-        let take_shadow = i1 >= d1.len() || (i0 < d0.len() && i0 <= 3 * i1 + 2);
-        if take_shadow {
-            order.push((0, shadow[d0[i0]]));
-            i0 += 1;
-        } else {
-            order.push((1, lit[d1[i1]]));
-            i1 += 1;
-        }
-    }
+    let order = strata_order((&shadow, &lit), total, SHADOW_SHARE);
     let boxes: Vec<(Vec3, Vec3)> = triangles
         .par_iter()
         .map(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])))

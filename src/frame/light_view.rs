@@ -3,6 +3,7 @@
 //! fall (extent.rs). Both backends start from a framed scene.
 
 use crate::error::{Error, Result};
+use crate::error_estimate::{Draw, ErrorEstimate};
 use crate::geom::extent::fit_extent;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -128,6 +129,9 @@ pub struct MapSettings {
     /// whatever the light's size: what a plan decides where every penumbra
     /// is under half a texel (`auto/plan.rs`).
     pub hard: bool,
+    /// Estimate the result's error from exact rays at texels drawn as it
+    /// says (`crate::light_view::estimate`); None: no estimate.
+    pub estimate: Option<Draw>,
 }
 
 impl MapSettings {
@@ -146,6 +150,7 @@ impl MapSettings {
             passes: method.passes(),
             method: method.kernel(),
             hard: false,
+            estimate: None,
         }
     }
 }
@@ -166,6 +171,8 @@ pub struct ShadowResult {
     /// The light space the maps were computed in (the sun's depth origin
     /// and range are the scene's).
     pub light_space: LightSpace,
+    /// The error estimate, when the settings asked for one.
+    pub estimate: Option<ErrorEstimate>,
 }
 
 impl ShadowResult {

@@ -81,6 +81,7 @@ fn run_at(gpu: bool, passes: u32, method: Method, (width, height): (usize, usize
         passes,
         method,
         hard: false,
+        estimate: None,
     };
     let occ = MeshRef {
         vertices: &ov,
@@ -211,6 +212,7 @@ fn gpu_bitmask_is_the_cpus_bit_for_bit_both_gaps_every_mask() {
                     passes,
                     method,
                     hard: false,
+                    estimate: None,
                 };
                 let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
                 let (rv, rf) = floor();

@@ -10,6 +10,7 @@
 //! kernels' unit; each backend times its own steps inside it.
 
 mod cpu;
+pub mod estimate;
 mod stages;
 
 pub use cpu::CpuLightView;

@@ -73,7 +73,10 @@ impl Exact {
     }
 }
 
-fn light_point(p: &LightPoint) -> Option<Vec3> {
+/// A receiver texel's point in the kernels' light space (tangents times
+/// depth), None where there is no receiver: where `exact`'s rays start
+/// (the light view's error estimate starts its own there too).
+pub(crate) fn light_point(p: &LightPoint) -> Option<Vec3> {
     (p.z.is_finite() && p.z > 0.0).then(|| Vec3::new(p.x * p.z, p.y * p.z, p.z))
 }
 

@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::frame::{frame_scene, MapSettings, ShadowResult};
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
-use crate::light_view::{CpuLightView, LightMaps, LightViewStages};
+use crate::light_view::{estimate, CpuLightView, LightMaps, LightViewStages};
 use crate::timing::Stopwatch;
 
 /// Soft shadow map from meshes on `backend`.
@@ -53,6 +53,20 @@ pub fn from_meshes_with<S: LightViewStages>(
         middle,
         back,
     } = stages.meshes(&f, (occluders.faces, receivers.faces), s, &mut sw)?;
+    // The estimate traces on the CPU whatever the backend, from the
+    // receiver map the backend made.
+    let estimate = s.estimate.map(|how| {
+        let spent = sw.timings.iter().map(|t| t.1).sum();
+        let e = estimate::of_meshes(
+            &f,
+            occluders.faces,
+            (&receiver, &visibility),
+            estimate::reference_samples(s.method),
+            (how, spent),
+        );
+        sw.lap("estimate");
+        e
+    });
     Ok(ShadowResult {
         grid: f.grid,
         occluder_grid: f.occluder_grid,
@@ -63,6 +77,7 @@ pub fn from_meshes_with<S: LightViewStages>(
         occluder_back: back,
         timings: stages.timings(sw.timings),
         light_space: *light,
+        estimate,
     }
     .in_user_units(f.unit))
 }

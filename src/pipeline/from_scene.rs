@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::eye::{maps, rays, Bias};
 use crate::geom::light_space::LightSpace;
 use crate::geom::mesh::MeshRef;
+use crate::light_view::estimate;
 use crate::raster::Prepared;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -59,6 +60,11 @@ pub fn from_scene(
         })
         .unzip();
     sw.lap("receiver_points");
+    // The estimate's rays meet every triangle, as `exact`'s (copied before
+    // the map methods take the light-space vertices).
+    let traced = s
+        .estimate
+        .map(|how| (how, light_space_triangles(&occ_ls, scene.faces)));
     let mut visibility = vec![1f32; grid.len()];
     let (front, back, middle) = if s.method.traces() {
         let tris: Vec<[Vec3; 3]> = light_space_triangles(&occ_ls, scene.faces);
@@ -115,6 +121,25 @@ pub fn from_scene(
         let front = Some(layers.remove(0));
         (front, back, layers)
     };
+    let estimate = traced.map(|(how, tris)| {
+        let spent = sw.timings.iter().map(|t| t.1).sum();
+        // Ray starts and keys as `exact`'s above: texel indices, segments
+        // from the offset starts (t0 = 0).
+        let mut origins = vec![None; grid.len()];
+        let starts = rays::ray_starts(light, unit, &points, &normals);
+        for (&k, st) in texels.iter().zip(starts) {
+            origins[k] = st;
+        }
+        let at = estimate::Receivers {
+            size: (grid.width, grid.height),
+            origins: &origins,
+            t0: 0.0,
+        };
+        let samples = estimate::reference_samples(s.method);
+        let e = estimate::estimate(&at, light_shape, tris, &visibility, samples, (how, spent));
+        sw.lap("estimate");
+        e
+    });
     let mut out = ShadowResult {
         grid,
         occluder_grid,
@@ -125,6 +150,7 @@ pub fn from_scene(
         occluder_back: None,
         timings: sw.timings,
         light_space: *light,
+        estimate,
     }
     .in_user_units(unit);
     out.occluder_front = front;

@@ -7,6 +7,7 @@ use super::errors;
 use super::results::{DepthShadowResult, MeshShadowResult};
 use crate::api::{self, DepthCall, MeshCall, SceneCall};
 use crate::backend::BackendChoice;
+use crate::error_estimate::Draw;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::Light as CoreLight;
@@ -41,7 +42,7 @@ pub fn check_mesh<'py>(
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, resolution, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, resolution, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, estimate_error=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -60,6 +61,7 @@ pub fn shadow_map_from_meshes<'py>(
     precision: Option<Bound<'py, PyAny>>,
     backend: &str,
     threads: Option<Bound<'py, PyAny>>,
+    estimate_error: Option<&str>,
 ) -> PyResult<MeshShadowResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -79,6 +81,7 @@ pub fn shadow_map_from_meshes<'py>(
             method: method_arg(method, &loose)?,
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
+            estimate_error: estimate_error.map(Draw::parse).transpose()?,
         };
         let run = py.detach(|| api::shadow_map(&call))?;
         MeshShadowResult::new(py, run)
@@ -88,7 +91,7 @@ pub fn shadow_map_from_meshes<'py>(
 /// A scene shadowing itself (one mesh of every mesh) -> light-view maps ->
 /// visibility.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, light, resolution, extent, method, *, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[pyo3(signature = (vertices, faces, light, resolution, extent, method, *, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, estimate_error=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn shadow_map_from_scene<'py>(
     py: Python<'py>,
@@ -107,6 +110,7 @@ pub fn shadow_map_from_scene<'py>(
     precision: Option<Bound<'py, PyAny>>,
     backend: &str,
     threads: Option<Bound<'py, PyAny>>,
+    estimate_error: Option<&str>,
 ) -> PyResult<MeshShadowResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -126,6 +130,7 @@ pub fn shadow_map_from_scene<'py>(
             bias: crate::eye::Bias::new(normal_offset, depth_bias)?,
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
+            estimate_error: estimate_error.map(Draw::parse).transpose()?,
         };
         let run = py.detach(|| api::scene_shadow_map(&call))?;
         MeshShadowResult::new(py, run)

@@ -76,6 +76,10 @@ pub struct MeshShadowResult {
     /// What `Auto` with a target decided: (name, taken, why) per decision.
     #[pyo3(get)]
     plan: Option<Vec<(&'static str, bool, String)>>,
+    /// The error estimate (`estimate_error=True`, or `Auto` with a target),
+    /// else None.
+    #[pyo3(get)]
+    error_estimate: Option<Py<super::estimate::PyErrorEstimate>>,
 }
 
 #[pymethods]
@@ -105,6 +109,10 @@ impl MeshShadowResult {
         let og = r.occluder_grid;
         let [ex, ey] = r.user_extent();
         let layer = |m: Option<Vec<f32>>| m.map(|m| map(py, &og, m)).transpose();
+        let error_estimate = r
+            .estimate
+            .map(|e| Py::new(py, super::estimate::PyErrorEstimate(e)))
+            .transpose()?;
         Ok(MeshShadowResult {
             visibility: map(py, &r.grid, r.visibility)?,
             receiver_depth: map(py, &r.grid, r.receiver)?,
@@ -123,6 +131,7 @@ impl MeshShadowResult {
             backend: run.backend.name(),
             threads: run.threads,
             plan: plan_tuples(run.plan),
+            error_estimate,
         })
     }
 }
