@@ -151,6 +151,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         // An error target is checked against the run's own estimate and
         // the call run again with `exact` until it is met (`auto/refine.rs`).
         let planning = first.timings.iter().find(|t| t.0 == "plan").map(|t| t.1);
+        plan.planned = Some(cfg);
         let mut refinements = vec![];
         let (mut out, method, replaced) = match target.error {
             Some(e) => {
@@ -162,7 +163,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
                     .sum();
                 crate::auto::refine::refined(
                     e.0,
-                    crate::auto::plan::LIGHT_EXACT,
+                    crate::auto::plan::LIGHT_REFINE,
                     ((first, cfg), seconds),
                     &mut refinements,
                     |r: &ShadowResult| r.estimate,

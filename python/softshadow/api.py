@@ -215,7 +215,7 @@ def soft_shadow_map(
         self_shadowing=not scene.split,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
-        plan=plan_from_core(r.plan, r.method),
+        plan=plan_from_core(r.plan, r.method, r.planned_method),
         error_estimate=r.error_estimate,
     )
 

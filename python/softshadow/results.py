@@ -47,16 +47,25 @@ class Plan:
 
     decisions: tuple[Decision, ...]
     method: MethodConfig
+    planned: MethodConfig | None = None
+    """The setting the plan chose, where runs checked against the result's
+    error estimate replaced it (light-view maps: ``method`` is then the last
+    run's, ``exact``); ``None`` where no run was replaced."""
 
     def __str__(self) -> str:
         lines = [f"[{'x' if d.taken else ' '}] {d.name}: {d.why}" for d in self.decisions]
         return "\n".join([*lines, f"ran: {self.method!r}"])
 
 
-def plan_from_core(decisions: Iterable[Any] | None, method: MethodConfig) -> Plan | None:
+def plan_from_core(
+    decisions: Iterable[Any] | None, method: MethodConfig, planned: MethodConfig | None = None
+) -> Plan | None:
     """The core's plan (``(name, taken, why)`` triples, or None when nothing
-    was planned) as a :class:`Plan`."""
-    return None if decisions is None else Plan(tuple(Decision(*d) for d in decisions), method)
+    was planned) as a :class:`Plan`; ``planned`` the setting it chose where
+    a run replaced it."""
+    if decisions is None:
+        return None
+    return Plan(tuple(Decision(*d) for d in decisions), method, None if planned == method else planned)
 
 
 @dataclass(frozen=True, eq=False, repr=False)

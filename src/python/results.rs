@@ -76,6 +76,10 @@ pub struct MeshShadowResult {
     /// What `Auto` with a target decided: (name, taken, why) per decision.
     #[pyo3(get)]
     plan: Option<Vec<(&'static str, bool, String)>>,
+    /// The setting the plan chose, before runs checked against its
+    /// estimate replaced it (None without a plan).
+    #[pyo3(get)]
+    planned_method: Option<Py<PyAny>>,
     /// The error estimate (`estimate_error=True`, or `Auto` with a target),
     /// else None.
     #[pyo3(get)]
@@ -113,6 +117,10 @@ impl MeshShadowResult {
             .estimate
             .map(|e| Py::new(py, super::estimate::PyErrorEstimate(e)))
             .transpose()?;
+        let planned_method = (run.plan.as_ref())
+            .and_then(|p| p.planned)
+            .map(|m| configs::to_py(py, &m))
+            .transpose()?;
         Ok(MeshShadowResult {
             visibility: map(py, &r.grid, r.visibility)?,
             receiver_depth: map(py, &r.grid, r.receiver)?,
@@ -131,6 +139,7 @@ impl MeshShadowResult {
             backend: run.backend.name(),
             threads: run.threads,
             plan: plan_tuples(run.plan),
+            planned_method,
             error_estimate,
         })
     }

@@ -17,6 +17,22 @@ def decision(sm: ss.ShadowMap, name: str) -> ss.Decision:
     return d
 
 
+def setting(sm: ss.ShadowMap) -> ss.MethodConfig:
+    """The setting the plan chose: where its estimate missed the target,
+    ``exact`` ran instead (``sm.method``) and the plan keeps it aside."""
+    assert sm.plan is not None
+    return sm.plan.planned or sm.method
+
+
+def as_planned(sm: ss.ShadowMap, scene_light: tuple[ss.Scene, ss.RectLight]) -> np.ndarray:
+    """The visibility of the planned setting (``sm``'s own where it ran)."""
+    if sm.plan is None or sm.plan.planned is None:
+        return sm.visibility
+    scene, light = scene_light
+    n = sm.visibility.shape[1]
+    return ss.soft_shadow_map(scene, light, resolution=n, extent=sm.extent, method=sm.plan.planned).visibility
+
+
 def planned(make, target=0.01, res=64, **kw) -> ss.ShadowMap:
     scene, light = make(**kw)
     return ss.soft_shadow_map(scene, light, resolution=res, method=ss.Auto(error=target))
@@ -54,48 +70,48 @@ def stacked() -> tuple[ss.Scene, ss.RectLight]:
 
 def test_one_plane_takes_the_sum_and_occluders_off_it_the_union():
     flat = planned(scenes.square_plate, target=0.005)
-    assert not decision(flat, "union").taken and isinstance(flat.method, ss.Ssm)
+    assert not decision(flat, "union").taken and isinstance(setting(flat), ss.Ssm)
     # Tilted, the plate still covers each direction from the light once.
     tilted = planned(scenes.tilted_plate, target=0.005)
-    assert not decision(tilted, "union").taken and isinstance(tilted.method, ss.Ssm)
+    assert not decision(tilted, "union").taken and isinstance(setting(tilted), ss.Ssm)
     assert "tilted" in decision(tilted, "union").why
     apart = planned(side_by_side, target=0.005)
-    assert decision(apart, "union").taken and isinstance(apart.method, ss.Bitmask)
+    assert decision(apart, "union").taken and isinstance(setting(apart), ss.Bitmask)
 
 
 def test_single_surfaces_take_one_layer_and_a_back_layer_would_change_nothing():
     sm = planned(side_by_side)
-    assert decision(sm, "layers").taken and sm.method.passes == 1
+    assert decision(sm, "layers").taken and setting(sm).passes == 1
     two = ss.soft_shadow_map(*side_by_side(), resolution=64, extent=sm.extent, method=ss.Bitmask(passes=2))
-    assert np.array_equal(sm.visibility, two.visibility)
+    assert np.array_equal(as_planned(sm, side_by_side()), two.visibility)
     # Closed meshes have a back: front and back.
     spheres = planned(scenes.two_spheres)
-    assert not decision(spheres, "layers").taken and spheres.method.passes == 2
+    assert not decision(spheres, "layers").taken and setting(spheres).passes == 2
 
 
 def test_a_peeled_layer_is_kept_where_it_changes_the_shadow_and_only_there():
     scene, light = stacked()
     sm = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(error=0.01))
-    assert decision(sm, "layers").taken and sm.method.passes == 3
+    assert decision(sm, "layers").taken and setting(sm).passes == 3
     # The kept layer brings the map closer to the ray-traced shadow.
     exact = ss.soft_shadow_map(scene, light, resolution=64, extent=sm.extent, method=ss.Exact(samples=1024))
     two = ss.soft_shadow_map(scene, light, resolution=64, extent=sm.extent, method=ss.Bitmask(passes=2))
     error = metrics.shadow_error
-    assert error(sm.visibility, exact.visibility) < error(two.visibility, exact.visibility)
+    assert error(as_planned(sm, stacked()), exact.visibility) < error(two.visibility, exact.visibility)
     # The bunny's folds give texels more than two surfaces, but its first
     # peeled layer changes the shadow by less than LAYER_CHANGE.
     bunny = planned(scenes.bunny_floating)
     layers = decision(bunny, "layers")
-    assert not layers.taken and bunny.method.passes == 2 and "peeled layer" in layers.why
+    assert not layers.taken and setting(bunny).passes == 2 and "peeled layer" in layers.why
 
 
 def test_thin_occluders_refine_the_maps_for_tight_targets_only():
     tight = planned(scenes.fence, target=0.005)
-    assert decision(tight, "thin_occluders").taken and tight.method.occluder_resolution == (128, 128)
+    assert decision(tight, "thin_occluders").taken and setting(tight).occluder_resolution == (128, 128)
     loose = planned(scenes.fence, target=0.01)
-    assert not decision(loose, "thin_occluders").taken and loose.method.occluder_resolution == (64, 64)
+    assert not decision(loose, "thin_occluders").taken and setting(loose).occluder_resolution == (64, 64)
     bunny = planned(scenes.bunny_floating, target=0.005)
-    assert not decision(bunny, "thin_occluders").taken and bunny.method.occluder_resolution == (64, 64)
+    assert not decision(bunny, "thin_occluders").taken and setting(bunny).occluder_resolution == (64, 64)
 
 
 def test_gaps_open_where_closing_them_changes_nothing_and_stay_closed_where_light_leaks():
@@ -139,8 +155,8 @@ def test_receivers_beyond_every_penumbra_are_reported():
 
 def test_tighter_targets_cost_more_samples():
     loose, tight = (planned(scenes.torus_floating, target=t) for t in (0.01, 0.005))
-    assert isinstance(loose.method, ss.Bitmask) and isinstance(tight.method, ss.Bitmask)
-    assert tight.method.samples > loose.method.samples
+    assert isinstance(setting(loose), ss.Bitmask) and isinstance(setting(tight), ss.Bitmask)
+    assert setting(tight).samples > setting(loose).samples
     below_maps = planned(scenes.torus_floating, target=0.001)
     assert isinstance(below_maps.method, ss.Exact)
     assert "exact" in str(below_maps.plan)
