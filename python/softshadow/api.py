@@ -144,7 +144,7 @@ def soft_shadow_map(
         result does not depend on it.
     estimate_error
         Keyword-only. Also estimate the map's error (``sm.error_estimate``),
-        as :func:`render` does for an image: exact rays (256 light samples;
+        as :func:`render` does for an image: exact rays (1024 light samples;
         for ``exact``, four times its own) from a random subset of the
         receiver texels, in 4 x 2 tiles, three quarters of them in the map's
         shadow, each texel's samples keyed as ``exact`` keys them; the mean

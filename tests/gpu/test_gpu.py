@@ -360,12 +360,21 @@ def test_a_plan_with_measured_layers_and_doubled_maps_runs_the_same_on_the_gpu(g
     """The planner measures the occluders on the CPU whatever the backend;
     the GPU then runs what it planned: one layer, three, and maps at twice
     the output's side, bit for bit the CPU's."""
-    from methods.test_auto_plan import side_by_side, stacked
+    from methods.test_auto_plan import setting, side_by_side, stacked
 
     for make, target, passes in [(side_by_side, 0.01, 1), (stacked, 0.01, 3), (scenes.fence, 0.005, 2)]:
         scene, light = make()
         cpu = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(error=target))
         dev = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Auto(error=target), backend="gpu")
-        assert dev.backend == "gpu" and dev.method == cpu.method and cpu.method.passes == passes
+        # Where the estimate (CPU rays either way) sent the call to exact,
+        # the planned maps are run again here on both backends.
+        assert dev.backend == "gpu" and dev.method == cpu.method and setting(dev) == setting(cpu)
+        assert setting(cpu).passes == passes
         np.testing.assert_array_equal(dev.visibility, cpu.visibility)
-    assert cpu.method.occluder_resolution == (128, 128)
+        if cpu.plan is not None and cpu.plan.planned is not None:
+            maps = [
+                ss.soft_shadow_map(scene, light, resolution=64, extent=cpu.extent, method=setting(cpu), backend=b)
+                for b in ("cpu", "gpu")
+            ]
+            np.testing.assert_array_equal(maps[0].visibility, maps[1].visibility)
+    assert setting(cpu).occluder_resolution == (128, 128)
