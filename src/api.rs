@@ -151,7 +151,6 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         // An error target is checked against the run's own estimate and
         // the call run again with `exact` until it is met (`auto/refine.rs`).
         let planning = first.timings.iter().find(|t| t.0 == "plan").map(|t| t.1);
-        plan.planned = Some(cfg);
         let mut refinements = vec![];
         let (mut out, method, replaced) = match target.error {
             Some(e) => {
@@ -182,6 +181,7 @@ pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
         }
         plan.decisions.extend(verdict);
         plan.config = method;
+        plan.planned = (method != cfg).then_some(cfg);
         if replaced > 0.0 {
             out.timings.insert(0, ("replaced", replaced));
             if let Some(p) = planning {

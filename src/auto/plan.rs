@@ -106,7 +106,7 @@ pub struct Plan {
     pub config: MethodConfig,
     /// The setting planned, where runs checked against the estimate
     /// replaced it (`refine.rs`: `config` is then the last run's); None
-    /// where no run was checked.
+    /// where the planned run was kept.
     pub planned: Option<MethodConfig>,
     /// For a map setting chosen for an error target under COARSE_TARGET:
     /// the target less the setting's measured worst error, what `set_gaps`
