@@ -70,6 +70,7 @@ def test_bad_input_names_the_argument() -> None:
         _plate(estimate_error=1)
     # Depth maps have no triangles to trace: the argument does not exist.
     base = _plate()
+    assert base.occluder_depth is not None
     with pytest.raises(TypeError, match="estimate_error"):
         ss.soft_shadow_map_from_depth(  # type: ignore[call-arg]
             base.occluder_depth,
