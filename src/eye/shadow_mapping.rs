@@ -22,7 +22,7 @@ use crate::geom::shadow_projection::{ShadowProjection, ViewVector, MIN_SIN_GAMMA
 use crate::geom::sun::SunSpace;
 use crate::methods::shadow_mapping::blur::blur;
 use crate::methods::shadow_mapping::config::{DepthBias, ShadowMappingConfig};
-use crate::methods::shadow_mapping::lookup::Lookup;
+use crate::methods::shadow_mapping::lookup::{receiver_gradient, Lookup};
 use crate::methods::shadow_mapping::raster::{
     scan, setup_triangles, DepthMap, Faces, SetupTri, Toward,
 };
@@ -135,8 +135,9 @@ pub(crate) struct Prepared {
     /// (or lies behind a rectangle's plane); the looked-up pixels' values
     /// are written over it.
     pub visibility: Vec<f32>,
-    /// The pixels to look up and their world points.
-    pub lookups: Vec<(usize, DVec3)>,
+    /// The pixels to look up, their world points and, with a PCF filter,
+    /// their receivers' depth gradients (`lookup::receiver_gradient`).
+    pub lookups: Vec<(usize, DVec3, [f32; 2])>,
 }
 
 /// The stages before the map, on the CPU for both backends: `Err(v)` when
@@ -194,8 +195,14 @@ pub(crate) fn prepare(
         if !in_front(p) || n.dot(tw.at(p)) <= 0.0 {
             visibility[k] = 0.0;
         } else {
-            lookups.push((k, p));
+            lookups.push((k, p, [0.0; 2]));
         }
+    }
+    if cfg.filter.is_some() {
+        lookups.par_iter_mut().for_each(|(k, p, gradient)| {
+            let n = glam::Vec3::from_array(g.normal[*k]).as_dvec3();
+            *gradient = receiver_gradient(&proj, cfg.bias, cfg.resolution, *p, n);
+        });
     }
     Ok(Ok(Prepared {
         projection: proj,
@@ -230,10 +237,10 @@ pub(crate) fn render(
         .lookups
         .par_iter()
         .with_min_len(256)
-        .map(|&(_, q)| lookup.visibility(q))
+        .map(|&(_, q, gradient)| lookup.visibility(q, gradient))
         .collect();
     let mut visibility = p.visibility;
-    for (&(k, _), v) in p.lookups.iter().zip(v) {
+    for (&(k, _, _), v) in p.lookups.iter().zip(v) {
         visibility[k] = v;
     }
     sw.lap("shadow");

@@ -502,8 +502,10 @@ fn shadow_mapping_structs_have_the_same_layout_in_rust_and_wgsl() {
             fx,
             fy,
             depth,
-            _pad0,
-            _pad1
+            gx,
+            gy,
+            ox,
+            oy
         }),
     );
     assert_same(

@@ -42,7 +42,7 @@ use crate::methods::shadow_mapping::blur::spacing;
 use crate::methods::shadow_mapping::config::{
     DepthBias, EyeSpaceBlur, ShadowMappingConfig, DEPTH_TOLERANCE,
 };
-use crate::methods::shadow_mapping::lookup::{query, Query};
+use crate::methods::shadow_mapping::lookup::{box_origin, query, Query, TapPlane};
 use crate::methods::shadow_mapping::raster::{DepthMap, Distribution, SetupTri};
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
@@ -111,8 +111,12 @@ pub struct GpuSmPoint {
     pub fx: f32,
     pub fy: f32,
     pub depth: f32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// The receiver's depth gradient per texel and the offsets of the
+    /// box's first texel from the point (`lookup::TapPlane`).
+    pub gx: f32,
+    pub gy: f32,
+    pub ox: f32,
+    pub oy: f32,
 }
 
 /// `BlurPixel` of shadow_mapping.wgsl.
@@ -253,7 +257,13 @@ fn groups_2d(n: u32) -> (u32, u32) {
 }
 
 /// A point's lookup as the device reads it (`None`: lit, nothing to read).
-pub fn point(q: Query, pixel: usize, pcf: u32, (w, h): (usize, usize)) -> Option<GpuSmPoint> {
+pub fn point(
+    q: Query,
+    pixel: usize,
+    pcf: u32,
+    (w, h): (usize, usize),
+    gradient: [f32; 2],
+) -> Option<GpuSmPoint> {
     let Query::At { x, y, depth } = q else {
         return None;
     };
@@ -267,9 +277,12 @@ pub fn point(q: Query, pixel: usize, pcf: u32, (w, h): (usize, usize)) -> Option
         // floor(a) on, the first weighted 1 - f and the last f.
         let ax = x + 0.5 - 0.5 * pcf as f64;
         let ay = y + 0.5 - 0.5 * pcf as f64;
-        let (fx, fy) = (clamp(ax.floor(), w), clamp(ay.floor(), h));
+        let (fx, fy) = (clamp(box_origin(x, pcf), w), clamp(box_origin(y, pcf), h));
         (fx, fy, (ax - fx).clamp(0.0, 1.0), (ay - fy).clamp(0.0, 1.0))
     };
+    // The tangent plane over the box (a clamped box reads no texel of the
+    // map: its offsets do not matter).
+    let plane = TapPlane::new(x, y, depth, gradient, pcf);
     Some(GpuSmPoint {
         pixel: pixel as u32,
         i: i as i32,
@@ -277,7 +290,10 @@ pub fn point(q: Query, pixel: usize, pcf: u32, (w, h): (usize, usize)) -> Option
         fx: fx as f32,
         fy: fy as f32,
         depth,
-        ..Default::default()
+        gx: gradient[0],
+        gy: gradient[1],
+        ox: plane.ox,
+        oy: plane.oy,
     })
 }
 
@@ -357,18 +373,19 @@ pub fn run(
     let points: Vec<GpuSmPoint> = p
         .lookups
         .iter()
-        .filter_map(|&(k, q)| {
+        .filter_map(|&(k, q, gradient)| {
             point(
                 query(&p.projection, cfg.bias, w, h, q),
                 k,
                 pcf,
                 cfg.resolution,
+                gradient,
             )
         })
         .collect();
     // Points that project nowhere on the map are lit (lookup.rs).
     let mut base = p.visibility.clone();
-    for &(k, _) in &p.lookups {
+    for &(k, _, _) in &p.lookups {
         base[k] = 1.0;
     }
     let npix = gb.len();

@@ -15,7 +15,9 @@
 //
 // sm_lookup (the depth test, Williams; PCF, Reeves et al. 1987): per point,
 // its texel (nearest) or the (size+1)^2 texels of its box, weights
-// (1 - f), 1, ..., 1, f per axis, projected on the CPU in f64.
+// (1 - f), 1, ..., 1, f per axis, projected on the CPU in f64; each box
+// texel tested at the receiver's tangent plane there (receiver plane depth
+// bias, lookup.rs).
 //
 // sm_blur (Scherzer §4.3): one iteration of the depth-dependent 3x3
 // [1 2 1]^2 blur per dispatch, ping-pong between two images; the spacing
@@ -59,7 +61,9 @@ struct SmTri {
 }
 
 // Shared with Rust (`GpuSmPoint`): the pixel to write, the first texel of
-// the box (or the nearest texel) and the fractions, the depth tested.
+// the box (or the nearest texel) and the fractions, the depth tested, and
+// for PCF the receiver's depth gradient per texel and the box's first
+// texel's offsets from the point (lookup.rs's `TapPlane`).
 struct SmPoint {
     pixel: u32,
     i: i32,
@@ -67,8 +71,10 @@ struct SmPoint {
     fx: f32,
     fy: f32,
     depth: f32,
-    _pad0: u32,
-    _pad1: u32,
+    gx: f32,
+    gy: f32,
+    ox: f32,
+    oy: f32,
 }
 
 // Shared with Rust (`GpuBlurPixel`).
@@ -275,7 +281,9 @@ fn sm_lookup(@builtin(global_invocation_id) gid: vec3<u32>,
             let wy = box_weight(b, s, p.fy);
             for (var a = 0u; a <= s; a++) {
                 let w = wy * box_weight(a, s, p.fx);
-                num = num + w * depth_test(p.i + i32(a), p.j + i32(b), p.depth);
+                // The receiver's tangent plane at this texel (`TapPlane::depth`).
+                let d = p.depth + p.gx * (p.ox + f32(a)) + p.gy * (p.oy + f32(b));
+                num = num + w * depth_test(p.i + i32(a), p.j + i32(b), d);
                 den = den + w;
             }
         }
