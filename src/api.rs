@@ -453,9 +453,11 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         )
     };
     let mut refinements = vec![];
+    let mut first_config = None;
     let (((mut image, method), replaced), threads) = threads::run_capped(cap, || {
         let t = std::time::Instant::now();
         let first = run(&planned.method)?;
+        first_config = Some(first.1);
         let Some(e) = error else {
             return Ok((first, 0.0));
         };
@@ -479,6 +481,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         }
         p.decisions.extend(verdict);
         p.config = method;
+        p.planned = first_config.filter(|&c| c != method);
         if replaced > 0.0 {
             image.timings.insert(0, ("replaced", replaced));
         }

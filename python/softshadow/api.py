@@ -442,7 +442,7 @@ def render(
         threads=r.threads,
         depth_origin=r.depth_origin,
         depth_range=r.depth_range,
-        plan=plan_from_core(r.plan, r.method),
+        plan=plan_from_core(r.plan, r.method, r.planned_method),
         error_estimate=r.error_estimate,
     )
 

@@ -49,8 +49,8 @@ class Plan:
     method: MethodConfig
     planned: MethodConfig | None = None
     """The setting the plan chose, where runs checked against the result's
-    error estimate replaced it (light-view maps: ``method`` is then the last
-    run's, ``exact``); ``None`` where no run was replaced."""
+    error estimate replaced it (``method`` is then the last run's, ``exact``;
+    both views); ``None`` where no run was replaced."""
 
     def __str__(self) -> str:
         lines = [f"[{'x' if d.taken else ' '}] {d.name}: {d.why}" for d in self.decisions]

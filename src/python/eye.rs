@@ -200,6 +200,10 @@ pub struct EyeResult {
     /// What `Auto` with a target decided: (name, taken, why) per decision.
     #[pyo3(get)]
     plan: Option<Vec<(&'static str, bool, String)>>,
+    /// The setting the plan chose, where runs checked against its estimate
+    /// replaced it; else None.
+    #[pyo3(get)]
+    planned_method: Option<Py<PyAny>>,
     /// The error estimate (`estimate_error=True`, or `Auto` with a target),
     /// else None.
     #[pyo3(get)]
@@ -265,6 +269,10 @@ impl EyeResult {
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),
             threads: run.threads,
+            planned_method: (run.plan.as_ref())
+                .and_then(|p| p.planned)
+                .map(|m| configs::to_py(py, &m))
+                .transpose()?,
             plan: super::results::plan_tuples(run.plan),
             error_estimate: img
                 .estimate

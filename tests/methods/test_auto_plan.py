@@ -246,6 +246,7 @@ def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
     names = [d.name for d in img.plan.decisions]
     assert "refine" in names and img.plan.decisions[-1].name == "target" and img.plan.decisions[-1].taken
     assert isinstance(img.method, ss.Exact) and img.method.samples > 144, img.plan
+    assert img.plan.planned == ss.Exact(samples=144) and img.plan.method == img.method
     assert "replaced" in img.timings and img.timings["replaced"] > 0
     shadowed = img.mask & (1.0 - ref.visibility > 1e-3)
     assert float(np.abs(img.visibility - ref.visibility)[shadowed].mean()) <= 0.01, img.plan
