@@ -28,6 +28,7 @@ use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
+use crate::geom::plane_gradient::plane_gradient;
 use crate::methods::{Input, LightPoint, Method, ShadowInputs};
 use crate::raster::Prepared;
 pub(crate) use crate::timing::Stopwatch;
@@ -142,6 +143,10 @@ pub struct ShadingPoints {
     /// (tangent_plane.rs); 0 where the biases move the point to or behind
     /// the light's plane, or it lies at or behind a rectangle's plane.
     pub bound: Vec<f32>,
+    /// Each point's tangent plane on the grid, (∂(1/z)/∂px, ∂(1/z)/∂py) in
+    /// kernel units (`methods::pcss::Plane`, for PCSS's boxes), where asked
+    /// for; else empty.
+    pub planes: Vec<[f32; 2]>,
 }
 
 /// The point no kernel shades (it has no depth in front of the light).
@@ -166,18 +171,34 @@ pub fn shading_points(
     pts_ls: &[DVec3],
     normals: &[[f32; 3]],
     bias: &Bias,
+    planes: bool,
 ) -> ShadingPoints {
     let inv_unit = 1.0 / unit;
     let mut out = ShadingPoints {
         points: vec![EMPTY_POINT; points.len()],
         bound: vec![0.0; points.len()],
+        planes: vec![[0.0; 2]; if planes { points.len() } else { 0 }],
+    };
+    // A world point on the grid: (px, py, 1/z), z its kernel depth.
+    let on_grid = |w: DVec3| {
+        let q = space.to_light(w) * inv_unit;
+        (q.z > 0.0).then(|| {
+            let (px, py) = grid.to_pixel(q.x / q.z, q.y / q.z);
+            DVec3::new(px, py, 1.0 / q.z)
+        })
+    };
+    let mut plane_slots: Vec<Option<&mut [f32; 2]>> = if planes {
+        out.planes.iter_mut().map(Some).collect()
+    } else {
+        (0..points.len()).map(|_| None).collect()
     };
     out.points
         .par_iter_mut()
         .zip(out.bound.par_iter_mut())
+        .zip(plane_slots.par_iter_mut())
         .zip(points.par_iter().zip(pts_ls).zip(normals))
         .with_min_len(1024)
-        .for_each(|((lp, b), ((p, q), n))| {
+        .for_each(|(((lp, b), slot), ((p, q), n))| {
             let p = DVec3::from_array(*p);
             let n = glam::Vec3::from_array(*n).as_dvec3();
             let front = tangent_plane::front_of(space, unit, light_shape, p, n);
@@ -185,7 +206,8 @@ pub fn shading_points(
                 return;
             }
             let texel = texel_world(space, grid, q.z);
-            let q = space.to_light(biased(space, p, n, texel, bias)) * inv_unit;
+            let moved = biased(space, p, n, texel, bias);
+            let q = space.to_light(moved) * inv_unit;
             if q.z > 0.0 {
                 let inv_z = 1.0 / q.z;
                 *lp = LightPoint {
@@ -194,8 +216,16 @@ pub fn shading_points(
                     z: q.z as f32,
                 };
                 *b = front as f32;
+                // The plane through the biased point: 1/z is linear on the
+                // grid over it, so a texel's step is exact at any size.
+                if let Some(slot) = slot {
+                    if let Some(g) = plane_gradient(on_grid, moved, n, texel) {
+                        **slot = g.map(|v| v as f32);
+                    }
+                }
             }
         });
+    drop(plane_slots);
     out
 }
 
@@ -228,6 +258,7 @@ pub(crate) fn shade(
         pts_ls,
         normals,
         bias,
+        matches!(method, Method::Pcss { .. }),
     );
     sw.lap("bias");
     let inputs = ShadowInputs {
@@ -246,6 +277,8 @@ pub(crate) fn shade(
             falloff,
         }
         .shade(&inputs, &tris.verts, tris.faces, &sp.points),
+        Method::Pcss { max_taps } => crate::methods::pcss::Pcss { max_taps }
+            .visibility_on_planes(&inputs, &sp.points, &sp.planes),
         _ => crate::methods::shade_points(method, &inputs, &sp.points),
     };
     sw.lap("shadow");

@@ -9,6 +9,7 @@ pub mod light;
 pub mod light_shape;
 pub mod light_space;
 pub mod mesh;
+pub mod plane_gradient;
 pub mod shadow_projection;
 pub mod sun;
 pub mod units;

@@ -1690,7 +1690,7 @@ mod pcss {
         let g = gpu().unwrap();
         let out = with_error_scopes(g, || {
             let maps = upload(&g.device, "maps", front);
-            let sh = PcssShading::points(g, og, light, taps, 0, points)?;
+            let sh = PcssShading::points(g, og, light, taps, 0, points, &[])?;
             let timer = StageTimer::new(g, 1);
             let mut enc = g
                 .device

@@ -664,6 +664,7 @@ fn shade_maps(
         &f.pts_ls,
         &f.normals,
         bias,
+        false,
     );
     let valid = &sp.points;
     let order = point_order(&grid, valid);

@@ -53,6 +53,7 @@ impl FrontLayer {
         tris: &LightTriangles,
         grid: MapGrid,
         bias: &Bias,
+        planes: bool,
     ) -> Result<FrontLayer> {
         let bytes = grid.len() as u64 * 4;
         if grid.len() as u64 >= u32::MAX as u64 || bytes > g.max_storage_binding {
@@ -79,6 +80,7 @@ impl FrontLayer {
             &f.pts_ls,
             &f.normals,
             bias,
+            planes,
         );
         Ok(FrontLayer {
             grid,

@@ -24,7 +24,7 @@ use crate::eye::maps::LightTriangles;
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::methods::pcss::{half_per_w, MAX_TAPS};
+use crate::methods::pcss::{half_per_w, split, Plane, MAX_TAPS};
 use crate::methods::LightPoint;
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
@@ -40,10 +40,6 @@ const NEAR_SPAN: u32 = 256;
 /// Loop iterations one invocation may run per dispatch: half of lavapipe's
 /// 65535 (llvmpipe counts every iteration of every loop of an invocation).
 const ITERATION_BUDGET: u32 = 32768;
-/// The largest |texel| of a split coordinate: f32 holds it exactly, so the
-/// map's ends relative to it are exact; a point farther off is carried by
-/// its fraction (its box then reaches the map only when far wider than it).
-const MAX_BASE: f64 = (1 << 24) as f64;
 
 /// `PcssParams` of pcss.wgsl.
 #[repr(C)]
@@ -82,13 +78,10 @@ pub struct Coord {
 }
 
 impl Coord {
-    /// `p` (finite) split at its texel, in f64 so that only the fraction rounds.
+    /// `p` (finite) split at its texel (`methods::pcss::split`).
     pub fn new(p: f64) -> Coord {
-        let base = p.floor().clamp(-MAX_BASE, MAX_BASE);
-        Coord {
-            base: base as i32,
-            frac: (p - base) as f32,
-        }
+        let (base, frac) = split(p);
+        Coord { base, frac }
     }
 }
 
@@ -102,15 +95,16 @@ pub struct GpuPcssPoint {
     pub fy: f32,
     pub z: f32,
     pub live: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// The receiver's tangent plane (`methods::pcss::Plane`).
+    pub pa: f32,
+    pub pb: f32,
 }
 
 impl GpuPcssPoint {
     /// A light-space point as the kernel reads it on `og`; not live where
     /// pcss.rs's visibility returns 1 whatever the map (z not in (0, inf),
     /// non-finite pixel coordinates). z_near is the device's test.
-    pub fn new(og: &MapGrid, p: &LightPoint) -> GpuPcssPoint {
+    pub fn new(og: &MapGrid, p: &LightPoint, plane: Plane) -> GpuPcssPoint {
         if !(p.z.is_finite() && p.z > 0.0) {
             return GpuPcssPoint::default();
         }
@@ -126,7 +120,8 @@ impl GpuPcssPoint {
             fy: cy.frac,
             z: p.z,
             live: 1,
-            ..Default::default()
+            pa: plane[0],
+            pb: plane[1],
         }
     }
 }
@@ -280,12 +275,14 @@ impl PcssShading {
         max_taps: u32,
         front_offset: u32,
         points: &[LightPoint],
+        planes: &[Plane],
     ) -> Result<PcssShading> {
         check_points(g, "resolution", points.len())?;
         let pts: Vec<GpuPcssPoint> = points
             .par_iter()
+            .enumerate()
             .with_min_len(1024)
-            .map(|p| GpuPcssPoint::new(og, p))
+            .map(|(i, p)| GpuPcssPoint::new(og, p, planes.get(i).copied().unwrap_or([0.0; 2])))
             .collect();
         let params = PcssParams {
             n: pts.len() as u32,
@@ -393,15 +390,16 @@ pub(crate) fn shade_points(
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let front = FrontLayer::new(g, f, tris, grid, bias)?;
+    let front = FrontLayer::new(g, f, tris, grid, bias, true)?;
     sw.lap("setup");
     let (grid, points) = (front.grid, front.points.points.clone());
+    let planes = front.points.planes.clone();
     front.shade(
         g,
         f,
         "softshadow eye pcss",
         2,
-        || PcssShading::points(g, &grid, f.light_shape, max_taps, 0, &points),
+        || PcssShading::points(g, &grid, f.light_shape, max_taps, 0, &points, &planes),
         sw,
     )
 }

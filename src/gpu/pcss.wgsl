@@ -85,7 +85,8 @@ struct Coord {
 }
 
 // A point of points mode: pixel coordinates on the occluder grid, planar
-// depth, and whether it is shaded at all (0: lit). Shared with Rust
+// depth, whether it is shaded at all (0: lit), and its tangent plane
+// (∂(1/z)/∂px, ∂(1/z)/∂py; pcss.rs's `Plane`). Shared with Rust
 // (`GpuPcssPoint`).
 struct PcssPoint {
     bx: i32,
@@ -94,8 +95,8 @@ struct PcssPoint {
     fy: f32,
     z: f32,
     live: u32,
-    _pad0: u32,
-    _pad1: u32,
+    pa: f32,
+    pb: f32,
 }
 
 @group(0) @binding(0) var<storage, read> maps: array<u32>;
@@ -159,6 +160,8 @@ struct Pt {
     by: i32,
     fy: f32,
     z: f32,
+    pa: f32,
+    pb: f32,
 }
 
 fn point(idx: u32, z_near: f32) -> Pt {
@@ -166,10 +169,10 @@ fn point(idx: u32, z_near: f32) -> Pt {
     if pp.mode == 0u {
         let cx = coords[idx % pp.out_w];
         let cy = coords[pp.out_w + idx / pp.out_w];
-        p = Pt(true, cx.base, cx.frac, cy.base, cy.frac, bitcast<f32>(maps[pp.rec_offset + idx]));
+        p = Pt(true, cx.base, cx.frac, cy.base, cy.frac, bitcast<f32>(maps[pp.rec_offset + idx]), 0.0, 0.0);
     } else {
         let q = points[idx];
-        p = Pt(q.live != 0u, q.bx, q.fx, q.by, q.fy, q.z);
+        p = Pt(q.live != 0u, q.bx, q.fx, q.by, q.fy, q.z, q.pa, q.pb);
     }
     p.ok = p.ok && p.z > 0.0 && p.z < bitcast<f32>(INF_BITS) && z_near < p.z;
     return p;
@@ -294,9 +297,24 @@ fn filter_axes(p: Pt, z_near: f32, s: vec4<f32>) -> array<Axis, 2> {
 var<private> sum: vec2<f32>;
 var<private> row: vec2<f32>;
 
+// pcss.rs's `plane_depth`: the depth of the point's tangent plane at
+// texel (i, j), the same f32 operations; z itself for a plane of (0, 0).
+fn plane_z(p: Pt, i: i32, j: i32) -> f32 {
+    if p.pa == 0.0 && p.pb == 0.0 {
+        return p.z;
+    }
+    let ox = (f32(i - p.bx) + 0.5) - p.fx;
+    let oy = (f32(j - p.by) + 0.5) - p.fy;
+    let den = 1.0 + p.z * (p.pa * ox + p.pb * oy);
+    if den > 0.0 {
+        return p.z / den;
+    }
+    return bitcast<f32>(INF_BITS);
+}
+
 fn add(i: i32, j: i32, w: f32, p: Pt, z_near: f32, search: bool) {
     let d = front(i, j);
-    let occludes = d > 0.0 && d < p.z;
+    let occludes = d > 0.0 && d < plane_z(p, i, j);
     if search {
         if occludes {
             row += vec2<f32>(w, w * (d - z_near));

@@ -561,8 +561,8 @@ fn pcss_structs_have_the_same_layout_in_rust_and_wgsl() {
             fy,
             z,
             live,
-            _pad0,
-            _pad1
+            pa,
+            pb
         }),
     );
 }

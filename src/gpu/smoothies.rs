@@ -618,7 +618,7 @@ pub(super) fn shade_eye(
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let front = FrontLayer::new(g, f, tris, grid, bias)?;
+    let front = FrontLayer::new(g, f, tris, grid, bias, false)?;
     // Every mesh is an occluder: the silhouette straight from the mesh.
     let prepared = Prepared::new(s, &grid, f.light_shape, &tris.verts, tris.faces, PER_CHUNK);
     prepared.check_fits(g)?;

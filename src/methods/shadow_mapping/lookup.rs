@@ -28,6 +28,7 @@
 use super::config::{DepthBias, Pcf};
 use super::raster::{DepthMap, Distribution};
 use crate::geom::light::MapGrid;
+use crate::geom::plane_gradient::plane_gradient;
 use crate::geom::shadow_projection::ShadowProjection;
 use crate::methods::pcf::Border;
 use glam::DVec3;
@@ -141,12 +142,10 @@ pub fn box_origin(x: f64, size: u32) -> f64 {
 
 /// The depth gradient (∂d/∂x, ∂d/∂y), per texel, of the receiver's tangent
 /// plane at world point `p` of normal `n` in a (width, height) map of
-/// `proj`, d the depth the lookup tests: by central differences of the
-/// projection along two tangents (the plane is flat; a perspective map's
-/// depth is smooth over the step, 1e-4 of the point's distance from the
-/// origin plus one). Zero where the plane is edge-on to the map (a texel
-/// Jacobian near singular: the tangent plane says nothing) or the steps
-/// project nowhere.
+/// `proj`, d the depth the lookup tests (`geom::plane_gradient`; the plane
+/// is flat and a perspective map's depth smooth over the step, 1e-4 of the
+/// point's distance from the origin plus one). Zero where the plane is
+/// edge-on to the map or the steps project nowhere.
 pub fn receiver_gradient(
     proj: &ShadowProjection,
     bias: DepthBias,
@@ -154,31 +153,9 @@ pub fn receiver_gradient(
     p: DVec3,
     n: DVec3,
 ) -> [f32; 2] {
-    let n = n.normalize_or_zero();
-    if n == DVec3::ZERO {
-        return [0.0; 2];
-    }
-    let (t1, t2) = n.any_orthonormal_pair();
-    let h = 1e-4 * (1.0 + p.length());
     let at =
         |q: DVec3| query_f64(proj, bias, width, height, q).map(|(x, y, d)| DVec3::new(x, y, d));
-    let diff = |t: DVec3| Some((at(p + h * t)? - at(p - h * t)?) / (2.0 * h));
-    let (Some(a), Some(b)) = (diff(t1), diff(t2)) else {
-        return [0.0; 2];
-    };
-    // [a.x b.x; a.y b.y] (s, t) = (Δx, Δy): the tangent steps for a texel.
-    let det = a.x * b.y - b.x * a.y;
-    let scale = (a.x * a.x + a.y * a.y).max(b.x * b.x + b.y * b.y);
-    if !(det.abs() > 1e-6 * scale) {
-        return [0.0; 2];
-    }
-    let gx = (a.z * b.y - b.z * a.y) / det;
-    let gy = (b.z * a.x - a.z * b.x) / det;
-    if gx.is_finite() && gy.is_finite() {
-        [gx as f32, gy as f32]
-    } else {
-        [0.0; 2]
-    }
+    plane_gradient(at, p, n, 1e-4 * (1.0 + p.length())).map_or([0.0; 2], |g| g.map(|v| v as f32))
 }
 
 /// `query`'s texel position and depth in f64 (None where it is lit).
