@@ -156,6 +156,48 @@ pub fn strata_order(
     order
 }
 
+/// Adds a traced batch to `strata`: its (stratum, unit) pairs, `units[u]`
+/// the unit's indices into `result`, and `exact` the exact visibilities of
+/// the batch's pixels in the same order.
+pub fn add_batch(
+    strata: &mut [Stratum],
+    batch: &[(usize, usize)],
+    units: &[&[usize]],
+    result: &[f32],
+    exact: &[f32],
+) {
+    let mut at = 0;
+    for &(h, u) in batch {
+        let pairs = units[u]
+            .iter()
+            .zip(&exact[at..])
+            .map(|(&k, &r)| (result[k], r))
+            .collect();
+        at += units[u].len();
+        strata[h].drawn.push(pairs);
+    }
+}
+
+/// The estimate from `strata`, `traced` pixels with `samples` light
+/// samples each, begun at `t0`.
+pub fn finish(
+    strata: &[Stratum],
+    traced: usize,
+    samples: u32,
+    t0: std::time::Instant,
+) -> ErrorEstimate {
+    let (error, low, high, shadowed) = ratio_estimate(strata);
+    ErrorEstimate {
+        error,
+        low,
+        high,
+        traced,
+        shadowed,
+        samples,
+        seconds: t0.elapsed().as_secs_f64(),
+    }
+}
+
 /// The first `k` of a random permutation of `0..n` (partial Fisher–Yates),
 /// the same for the same `seed`: a longer draw extends a shorter one.
 pub fn draw(n: usize, k: usize, seed: u64) -> Vec<usize> {

@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use super::framing::Framed;
 use super::rays::{self, RayStart};
 use crate::error_estimate::{
-    ratio_estimate, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
+    add_batch, finish, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
 };
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_rays::RayOrigin;
@@ -173,28 +173,10 @@ fn estimate_with(
                 rays::visibility_in(&bvh, f.light_shape, &starts, key, &identity, samples)
             }
         };
-        let mut at = 0;
-        for &(h, u) in batch {
-            let pairs = units[u]
-                .iter()
-                .zip(&exact[at..])
-                .map(|(&k, &r)| (visibility[k], r))
-                .collect();
-            at += units[u].len();
-            strata[h].drawn.push(pairs);
-        }
+        add_batch(&mut strata, batch, &units, visibility, &exact);
         traced += pixels.len();
     }
-    let (error, low, high, shadowed) = ratio_estimate(&strata);
-    ErrorEstimate {
-        error,
-        low,
-        high,
-        traced,
-        shadowed,
-        samples,
-        seconds: t0.elapsed().as_secs_f64(),
-    }
+    finish(&strata, traced, samples, t0)
 }
 
 /// The box of each tile's ray origins (`starts` in runs of `lens`); an

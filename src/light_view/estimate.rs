@@ -27,7 +27,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use crate::error_estimate::{
-    ratio_estimate, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
+    add_batch, finish, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
 };
 use crate::eye::estimate::{BATCH, MAX_UNITS, PLANNED_UNITS, SHADOW_SHARE, SHARE, UNIT};
 use crate::frame::{light_space_triangles, FramedScene};
@@ -148,29 +148,11 @@ pub(crate) fn estimate<R: RayOrigin + Copy>(
             let identity: Vec<usize> = (0..drawn.len()).collect();
             // Keyed by the texel, as `exact` keys its samples.
             let exact = visibilities(&bvh, &origins, |j| drawn[j] as u64, &identity, &s, 1.0);
-            let mut next = 0;
-            for &(h, u) in batch {
-                let pairs = units[u]
-                    .iter()
-                    .zip(&exact[next..])
-                    .map(|(&k, &r)| (visibility[k], r))
-                    .collect();
-                next += units[u].len();
-                strata[h].drawn.push(pairs);
-            }
+            add_batch(&mut strata, batch, &units, visibility, &exact);
             traced += drawn.len();
         }
     }
-    let (error, low, high, shadowed) = ratio_estimate(&strata);
-    ErrorEstimate {
-        error,
-        low,
-        high,
-        traced,
-        shadowed,
-        samples,
-        seconds: t0.elapsed().as_secs_f64(),
-    }
+    finish(&strata, traced, samples, t0)
 }
 
 #[cfg(test)]

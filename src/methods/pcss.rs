@@ -253,16 +253,8 @@ impl ShadowMethod for Pcss {
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
-        if inputs.light_shape.is_point() {
-            return point_light::visibility_points(inputs, points);
-        }
-        let Some(kernel) = Kernel::new(inputs, self.max_taps) else {
-            return vec![1.0; points.len()];
-        };
-        points
-            .par_iter()
-            .map(|p| kernel.visibility(p.x, p.y, p.z, [0.0; 2]))
-            .collect()
+        // No planes: every texel tested at the point's own depth.
+        self.visibility_on_planes(inputs, points, &[])
     }
 }
 
