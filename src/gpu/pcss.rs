@@ -390,10 +390,13 @@ pub(crate) fn shade_points(
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let front = FrontLayer::new(g, f, tris, grid, bias, true)?;
+    let mut front = FrontLayer::new(g, f, tris, grid, bias, true)?;
     sw.lap("setup");
-    let (grid, points) = (front.grid, front.points.points.clone());
-    let planes = front.points.planes.clone();
+    // The points and planes are the kernel's alone (`shade` reads their
+    // bounds only).
+    let grid = front.grid;
+    let points = std::mem::take(&mut front.points.points);
+    let planes = std::mem::take(&mut front.points.planes);
     front.shade(
         g,
         f,

@@ -33,9 +33,9 @@ use crate::eye::estimate::{BATCH, MAX_UNITS, PLANNED_UNITS, SHADOW_SHARE, SHARE,
 use crate::frame::{light_space_triangles, FramedScene};
 use crate::geom::light_shape::LightShape;
 use crate::methods::config::MAX_SAMPLES;
-use crate::methods::exact::{light_point, Bvh, RAY_EPS};
+use crate::methods::exact::{receiver_points, Bvh, RAY_EPS};
 use crate::methods::shadow_rays::{tile_order, visibilities, RayOrigin, Sampling};
-use crate::methods::{LightPoint, Method};
+use crate::methods::Method;
 
 /// Light samples of the exact rays at each drawn texel, for a result of
 /// the map methods: four times the eye view's `REFERENCE_SAMPLES`. At 256
@@ -68,15 +68,7 @@ pub fn of_meshes(
     drawn: (Draw, f64),
 ) -> ErrorEstimate {
     let g = &f.grid;
-    let origins: Vec<Option<Vec3>> = (0..g.len())
-        .map(|k| {
-            light_point(&LightPoint {
-                x: g.x_of(k % g.width) as f32,
-                y: g.y_of(k / g.width) as f32,
-                z: receiver[k],
-            })
-        })
-        .collect();
+    let origins = receiver_points(g, receiver);
     let at = Receivers {
         size: (g.width, g.height),
         origins: &origins,

@@ -29,6 +29,7 @@ use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
+use crate::geom::light::MapGrid;
 use crate::geom::light_shape::{LightSamples, LightShape};
 use glam::Vec3;
 
@@ -80,18 +81,24 @@ pub(crate) fn light_point(p: &LightPoint) -> Option<Vec3> {
     (p.z.is_finite() && p.z > 0.0).then(|| Vec3::new(p.x * p.z, p.y * p.z, p.z))
 }
 
+/// Every texel's `light_point` on `grid`, its depth from the receiver map
+/// `receiver`.
+pub(crate) fn receiver_points(grid: &MapGrid, receiver: &[f32]) -> Vec<Option<Vec3>> {
+    (0..grid.len())
+        .map(|k| {
+            light_point(&LightPoint {
+                x: grid.x_of(k % grid.width) as f32,
+                y: grid.y_of(k / grid.width) as f32,
+                z: receiver[k],
+            })
+        })
+        .collect()
+}
+
 impl ShadowMethod for Exact {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         let g = &inputs.grid;
-        let pts: Vec<Option<Vec3>> = (0..g.len())
-            .map(|k| {
-                light_point(&LightPoint {
-                    x: g.x_of(k % g.width) as f32,
-                    y: g.y_of(k / g.width) as f32,
-                    z: inputs.receiver[k],
-                })
-            })
-            .collect();
+        let pts = receiver_points(g, inputs.receiver);
         self.shade(inputs, &pts, &tile_order(g.width, g.height))
     }
 
