@@ -144,7 +144,7 @@ pub struct ShadingPoints {
     /// the light's plane, or it lies at or behind a rectangle's plane.
     pub bound: Vec<f32>,
     /// Each point's tangent plane on the grid, (∂(1/z)/∂px, ∂(1/z)/∂py) in
-    /// kernel units (`methods::pcss::Plane`, for PCSS's boxes), where asked
+    /// kernel units (`geom::plane_gradient::Plane`, for the taps of PCSS and Smoothies), where asked
     /// for; else empty.
     pub planes: Vec<[f32; 2]>,
 }
@@ -258,7 +258,7 @@ pub(crate) fn shade(
         pts_ls,
         normals,
         bias,
-        matches!(method, Method::Pcss { .. }),
+        method.tests_planes(),
     );
     sw.lap("bias");
     let inputs = ShadowInputs {
@@ -276,7 +276,7 @@ pub(crate) fn shade(
             width: width.0,
             falloff,
         }
-        .shade(&inputs, &tris.verts, tris.faces, &sp.points),
+        .shade(&inputs, &tris.verts, tris.faces, &sp.points, &sp.planes),
         Method::Pcss { max_taps } => crate::methods::pcss::Pcss { max_taps }
             .visibility_on_planes(&inputs, &sp.points, &sp.planes),
         _ => crate::methods::shade_points(method, &inputs, &sp.points),

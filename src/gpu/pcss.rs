@@ -24,7 +24,8 @@ use crate::eye::maps::LightTriangles;
 use crate::eye::{Bias, EyeMaps, Framed};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::methods::pcss::{half_per_w, split, Plane, MAX_TAPS};
+use crate::geom::plane_gradient::{split, Plane};
+use crate::methods::pcss::{half_per_w, MAX_TAPS};
 use crate::methods::LightPoint;
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
@@ -78,7 +79,7 @@ pub struct Coord {
 }
 
 impl Coord {
-    /// `p` (finite) split at its texel (`methods::pcss::split`).
+    /// `p` (finite) split at its texel (`geom::plane_gradient::split`).
     pub fn new(p: f64) -> Coord {
         let (base, frac) = split(p);
         Coord { base, frac }
@@ -95,7 +96,7 @@ pub struct GpuPcssPoint {
     pub fy: f32,
     pub z: f32,
     pub live: u32,
-    /// The receiver's tangent plane (`methods::pcss::Plane`).
+    /// The receiver's tangent plane (`geom::plane_gradient::Plane`).
     pub pa: f32,
     pub pb: f32,
 }

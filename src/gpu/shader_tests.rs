@@ -448,7 +448,10 @@ fn smoothie_structs_have_the_same_layout_in_rust_and_wgsl() {
             jb,
             wx,
             wy,
-            z,
+            z_aa,
+            z_ba,
+            z_ab,
+            z_bb,
             live
         }),
     );

@@ -37,6 +37,8 @@ use crate::eye::{Bias, EyeMaps, Framed};
 use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
+use crate::geom::plane_gradient::Plane;
+use crate::methods::smoothies::lookup::tent_depths;
 use crate::methods::smoothies::method::soup;
 use crate::methods::smoothies::{Falloff, Shape, Smoothies};
 use crate::methods::{LightPoint, Method};
@@ -119,7 +121,12 @@ pub struct TentPoint {
     pub jb: u32,
     pub wx: f32,
     pub wy: f32,
-    pub z: f32,
+    /// The receiver's depth at the taps (a, a), (b, a), (a, b), (b, b)
+    /// (`methods::smoothies::tent_depths`).
+    pub z_aa: f32,
+    pub z_ba: f32,
+    pub z_ab: f32,
+    pub z_bb: f32,
     pub live: u32,
 }
 
@@ -359,18 +366,22 @@ pub fn map_tents(grid: &MapGrid, og: &MapGrid) -> Vec<TentAxis> {
     v
 }
 
-/// The tent of each point on `og` (lookup.rs's at_point up to the taps);
-/// not live where at_point returns 1 without looking.
-pub fn point_tents(og: &MapGrid, points: &[LightPoint]) -> Vec<TentPoint> {
+/// The tent of each point on `og`, each tap's depth on the point's tangent
+/// plane `planes[i]` ((0, 0) where missing; lookup.rs's at_point up to the
+/// taps); not live where at_point returns 1 without looking.
+pub fn point_tents(og: &MapGrid, points: &[LightPoint], planes: &[Plane]) -> Vec<TentPoint> {
     points
         .par_iter()
+        .enumerate()
         .with_min_len(1024)
-        .map(|p| {
+        .map(|(i, p)| {
             if !(p.z.is_finite() && p.z > 0.0 && p.x.is_finite() && p.y.is_finite()) {
                 return TentPoint::default();
             }
             let (px, py) = og.to_pixel(p.x as f64, p.y as f64);
             let (cx, cy) = (tent_axis(px, og.width), tent_axis(py, og.height));
+            let plane = planes.get(i).copied().unwrap_or([0.0; 2]);
+            let [z_aa, z_ba, z_ab, z_bb] = tent_depths(px, py, p.z, plane);
             TentPoint {
                 ia: cx.a,
                 ib: cx.b,
@@ -378,7 +389,10 @@ pub fn point_tents(og: &MapGrid, points: &[LightPoint]) -> Vec<TentPoint> {
                 jb: cy.b,
                 wx: cx.w,
                 wy: cy.w,
-                z: p.z,
+                z_aa,
+                z_ba,
+                z_ab,
+                z_bb,
                 live: 1,
             }
         })
@@ -618,11 +632,11 @@ pub(super) fn shade_eye(
     bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let front = FrontLayer::new(g, f, tris, grid, bias, false)?;
+    let front = FrontLayer::new(g, f, tris, grid, bias, true)?;
     // Every mesh is an occluder: the silhouette straight from the mesh.
     let prepared = Prepared::new(s, &grid, f.light_shape, &tris.verts, tris.faces, PER_CHUNK);
     prepared.check_fits(g)?;
-    let tents = point_tents(&grid, &front.points.points);
+    let tents = point_tents(&grid, &front.points.points, &front.points.planes);
     sw.lap("setup");
     front.shade(
         g,

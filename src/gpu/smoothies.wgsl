@@ -84,8 +84,9 @@ struct TentAxis {
     _pad: u32,
 }
 
-// An eye-view point's tent (and depth); live 0: nothing to shade (v = 1).
-// Shared with Rust (`TentPoint`).
+// An eye-view point's tent and the receiver's depth at its four taps (on
+// the point's tangent plane: lookup.rs's tent_depths); live 0: nothing to
+// shade (v = 1). Shared with Rust (`TentPoint`).
 struct TentPoint {
     ia: u32,
     ib: u32,
@@ -93,7 +94,10 @@ struct TentPoint {
     jb: u32,
     wx: f32,
     wy: f32,
-    z: f32,
+    z_aa: f32,
+    z_ba: f32,
+    z_ab: f32,
+    z_bb: f32,
     live: u32,
 }
 
@@ -265,12 +269,13 @@ fn falloff(v: f32) -> f32 {
     return (1.0 - cos(PI * c)) * 0.5;
 }
 
-// lookup.rs's at_point given its texels and weights; z shadable.
-fn tent(ia: u32, ib: u32, ja: u32, jb: u32, wx: f32, wy: f32, z: f32) -> f32 {
+// lookup.rs's at_point given its texels, weights and the receiver's depth
+// at each tap (z: (a, a), (b, a), (a, b), (b, b)); the point shadable.
+fn tent(ia: u32, ib: u32, ja: u32, jb: u32, wx: f32, wy: f32, z: vec4<f32>) -> f32 {
     let ra = ja * params.occ_w;
     let rb = jb * params.occ_w;
-    let top = tap(ra + ia, z) * (1.0 - wx) + tap(ra + ib, z) * wx;
-    let bottom = tap(rb + ia, z) * (1.0 - wx) + tap(rb + ib, z) * wx;
+    let top = tap(ra + ia, z.x) * (1.0 - wx) + tap(ra + ib, z.y) * wx;
+    let bottom = tap(rb + ia, z.z) * (1.0 - wx) + tap(rb + ib, z.w) * wx;
     return falloff(top * (1.0 - wy) + bottom * wy);
 }
 
@@ -291,7 +296,7 @@ fn smoothie_lookup_map(@builtin(global_invocation_id) gid: vec3<u32>) {
     if shadable(z) {
         let cx = tent_axes[gid.x];
         let cy = tent_axes[params.rec_w + gid.y];
-        v = tent(cx.a, cx.b, cy.a, cy.b, cx.w, cy.w, z);
+        v = tent(cx.a, cx.b, cy.a, cy.b, cx.w, cy.w, vec4<f32>(z));
     }
     vis[k] = v;
 }
@@ -306,8 +311,9 @@ fn smoothie_lookup_points(@builtin(global_invocation_id) gid: vec3<u32>,
     }
     let p = points[n];
     var v = 1.0;
-    if p.live != 0u && shadable(p.z) {
-        v = tent(p.ia, p.ib, p.ja, p.jb, p.wx, p.wy, p.z);
+    // Live points are shadable (point_tents).
+    if p.live != 0u {
+        v = tent(p.ia, p.ib, p.ja, p.jb, p.wx, p.wy, vec4<f32>(p.z_aa, p.z_ba, p.z_ab, p.z_bb));
     }
     vis[n] = v;
 }

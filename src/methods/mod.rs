@@ -136,6 +136,15 @@ impl Method {
         self.reads_input(Input::OccluderTriangles) && !self.reads_input(Input::OccluderLayers)
     }
 
+    /// Whether the kernel tests its texels on each receiver point's tangent
+    /// plane where the eye view gives one (`geom/plane_gradient.rs`): the
+    /// methods whose taps reach texels beside the point's, PCSS's boxes and
+    /// the smoothies' tent. (The gather methods bound a receiver by its
+    /// tangent plane already, and ShadowMapping has its own.)
+    pub fn tests_planes(&self) -> bool {
+        matches!(self, Method::Pcss { .. } | Method::Smoothies { .. })
+    }
+
     /// Whether the method reads `input`.
     pub fn reads_input(&self, input: Input) -> bool {
         self.reads().contains(&input)

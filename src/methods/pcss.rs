@@ -94,6 +94,7 @@ use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
+use crate::geom::plane_gradient::{plane_depth, split, Plane};
 use rayon::prelude::*;
 
 /// The default taps per axis per stage (at most 16 x 16 taps per stage per
@@ -281,41 +282,6 @@ impl Pcss {
                 kernel.visibility(p.x, p.y, p.z, plane)
             })
             .collect()
-    }
-}
-
-/// A receiver's tangent plane on the occluder grid: (∂(1/z)/∂px,
-/// ∂(1/z)/∂py) per texel.
-pub type Plane = [f32; 2];
-
-/// The largest |texel| of a split coordinate: f32 holds it exactly, so the
-/// map's ends relative to it are exact; a point farther off is carried by
-/// its fraction (its box then reaches the map only when far wider than it).
-pub const MAX_BASE: f64 = (1 << 24) as f64;
-
-/// A continuous pixel coordinate `p` (finite) split at its texel, in f64 so
-/// that only the fraction rounds (the GPU twin reads it so).
-pub fn split(p: f64) -> (i32, f32) {
-    let base = p.floor().clamp(-MAX_BASE, MAX_BASE);
-    (base as i32, (p - base) as f32)
-}
-
-/// The depth of the receiver's plane at texel (i, j) (its centre at
-/// (i + 1/2, j + 1/2)) for a point split as `sx`, `sy` at depth z: z itself
-/// for a plane of (0, 0), +inf past the plane's horizon; in the f32
-/// operations pcss.wgsl's `plane_z` repeats.
-#[inline]
-pub fn plane_depth(z: f32, plane: Plane, sx: (i32, f32), sy: (i32, f32), i: i64, j: i64) -> f32 {
-    if plane == [0.0, 0.0] {
-        return z;
-    }
-    let ox = ((i - sx.0 as i64) as f32 + 0.5) - sx.1;
-    let oy = ((j - sy.0 as i64) as f32 + 0.5) - sy.1;
-    let den = 1.0 + z * (plane[0] * ox + plane[1] * oy);
-    if den > 0.0 {
-        z / den
-    } else {
-        f32::INFINITY
     }
 }
 

@@ -6,6 +6,7 @@
 //! transform, so the soup's adjacency is the mesh's.
 
 use super::Smoothies;
+use crate::geom::plane_gradient::Plane;
 use crate::methods::{LightPoint, ShadowInputs, ShadowMethod};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -25,13 +26,15 @@ impl Smoothies {
     /// depth r behind a smoothie sizes the penumbra): where the receiver
     /// map shares the occluder grid (a light-view map) it is merged in;
     /// in the eye view every mesh is an occluder, so the front layer is
-    /// already the whole scene.
+    /// already the whole scene, and each point is tested on its tangent
+    /// plane `planes[i]` (`lookup.rs`; empty: none).
     pub fn shade(
         &self,
         inputs: &ShadowInputs,
         verts: &[DVec3],
         faces: &[[u32; 3]],
         points: &[LightPoint],
+        planes: &[Plane],
     ) -> Vec<f32> {
         let front = inputs.occluder_layers.first().copied().unwrap_or(&[]);
         let og = &inputs.occluder_grid;
@@ -46,12 +49,12 @@ impl Smoothies {
             front
         };
         let buffer = self.buffer(og, inputs.light_shape, map, verts, faces);
-        self.visibility_points(og, map, &buffer, points)
+        self.visibility_points(og, map, &buffer, points, planes)
     }
 
     fn welded(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
         let (verts, faces) = soup(inputs.occluder_triangles.unwrap_or(&[]));
-        self.shade(inputs, &verts, &faces, points)
+        self.shade(inputs, &verts, &faces, points, &[])
     }
 }
 

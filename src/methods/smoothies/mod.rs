@@ -23,7 +23,7 @@
 mod buffer;
 pub mod config;
 mod construct;
-mod lookup;
+pub(crate) mod lookup;
 pub mod method;
 mod silhouette;
 #[cfg(test)]
@@ -31,6 +31,7 @@ mod tests;
 
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
+use crate::geom::plane_gradient::Plane;
 use crate::methods::LightPoint;
 pub(crate) use construct::Shape;
 use glam::DVec3;
@@ -218,18 +219,24 @@ impl Smoothies {
         buf
     }
 
-    /// Step 5 at receiver points in light space.
+    /// Step 5 at receiver points in light space, each tested on its
+    /// tangent plane `planes[i]` ((0, 0) where missing: `lookup.rs`).
     pub fn visibility_points(
         &self,
         grid: &MapGrid,
         front: &[f32],
         buffer: &SmoothieBuffer,
         points: &[LightPoint],
+        planes: &[Plane],
     ) -> Vec<f32> {
         check(grid, front, buffer);
         points
             .par_iter()
-            .map(|p| lookup::at_point(grid, front, buffer, self.falloff, p.x, p.y, p.z))
+            .enumerate()
+            .map(|(i, p)| {
+                let plane = planes.get(i).copied().unwrap_or([0.0; 2]);
+                lookup::at_point(grid, front, buffer, self.falloff, p.x, p.y, p.z, plane)
+            })
             .collect()
     }
 

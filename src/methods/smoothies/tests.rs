@@ -94,7 +94,7 @@ fn umbra_equals_the_hard_shadow() {
             z: 4.0,
         })
         .collect();
-    let vp = s.visibility_points(&g, &front, &buf, &pts);
+    let vp = s.visibility_points(&g, &front, &buf, &pts, &[]);
     for (p, v) in pts.iter().zip(&vp) {
         let (px, py) = g.to_pixel(p.x as f64, p.y as f64);
         let k = (py.floor() as usize).min(N - 1) * N + (px.floor() as usize).min(N - 1);
@@ -215,7 +215,7 @@ fn points_interpolate_the_texels_bilinearly_and_depth_tests_both_maps() {
                 z: 4.0,
             })
             .collect();
-        let v = s.visibility_points(&g, &front, &buf, &pts);
+        let v = s.visibility_points(&g, &front, &buf, &pts, &[]);
         for (f, got) in [0.0f32, 0.25, 0.5].iter().zip(&v) {
             let expect = (1.0 - f) * vis[k] + f * vis[k + 1];
             assert!((got - expect).abs() < 1e-5, "{i} +{f}: {got} vs {expect}");
@@ -501,7 +501,7 @@ fn no_occluders_and_no_receivers_are_lit() {
         .map(|&z| LightPoint { x: 0.0, y: 0.0, z })
         .collect();
     assert_eq!(
-        s.visibility_points(&g, &front, &buf, &pts),
+        s.visibility_points(&g, &front, &buf, &pts, &[]),
         vec![1.0, 1.0, 1.0, 1.0, 0.0]
     );
     let mut receiver = vec![f32::INFINITY; g.len()];
@@ -591,4 +591,49 @@ fn a_cube_has_a_silhouette_of_four_or_six_edges() {
     // And the closed cube shades: umbra = its hard shadow, with a penumbra.
     let (buf, vis) = run(&v, &f);
     assert!(buf.stats.texels > 0 && vis.iter().any(|v| *v > 0.0 && *v < 1.0));
+}
+
+/// A receiver tilted to the light (1/z = 0.5 + 0.2 x) that is also the
+/// shadow map, as in the eye view, with no smoothie over it: points moved
+/// 0.1% toward the light find their own surface behind one tap or more of
+/// the tent when tested at their own depth, and none on their tangent
+/// plane; a plane of (0, 0) is the point's own depth, bit for bit.
+#[test]
+fn a_tilted_receiver_on_its_own_plane_does_not_shadow_itself() {
+    let g = MapGrid::new(64, 64, [1.0, 1.0]).unwrap();
+    let inv_z = |x: f64| 0.5 + 0.2 * x;
+    let front: Vec<f32> = (0..g.len())
+        .map(|k| (1.0 / inv_z(g.x_of(k % g.width))) as f32)
+        .collect();
+    let buf = SmoothieBuffer {
+        depth: vec![f32::INFINITY; g.len()],
+        alpha: vec![1.0; g.len()],
+        stats: Default::default(),
+    };
+    // ∂(1/z)/∂px: 0.2 per unit of x, 2 tx / W units of x per texel.
+    let plane = [(0.2 * 2.0 * g.tx / g.width as f64) as f32, 0.0];
+    let s = sm(Falloff::Linear);
+    let (mut own, mut planar) = (0, 0);
+    for i in 0..100 {
+        let x = -0.8 + 1.6 * (i as f64 * 0.618).fract();
+        let y = -0.8 + 1.6 * (i as f64 * 0.377).fract();
+        let p = [LightPoint {
+            x: x as f32,
+            y: y as f32,
+            z: (0.999 / inv_z(x)) as f32,
+        }];
+        own += (s.visibility_points(&g, &front, &buf, &p, &[])[0] < 1.0) as u32;
+        planar += (s.visibility_points(&g, &front, &buf, &p, &[plane])[0] < 1.0) as u32;
+    }
+    assert!(own > 40, "{own} of 100 shadowed at their own depth");
+    assert_eq!(planar, 0);
+    let p = [LightPoint {
+        x: 0.1,
+        y: 0.2,
+        z: 1.9,
+    }];
+    assert_eq!(
+        s.visibility_points(&g, &front, &buf, &p, &[]),
+        s.visibility_points(&g, &front, &buf, &p, &[[0.0; 2]])
+    );
 }
