@@ -48,7 +48,9 @@ def _refused(opt: ss.OptionInfo) -> list:
 
 
 def test_every_method_has_a_config_class_exported_by_the_package():
-    assert list(CAPS) == ["ssm", "bitmask", "exact", "pcss", "smoothies", "shadow_mapping", "auto"]
+    # The core's table holds these (and any method added since, which needs
+    # no edit here).
+    assert {"ssm", "bitmask", "exact", "pcss", "smoothies", "shadow_mapping", "auto"} <= set(CAPS)
     for name, info in CAPS.items():
         assert info.config is getattr(ss, info.config.__name__)
         assert info.config().name == name
