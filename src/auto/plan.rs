@@ -185,8 +185,9 @@ pub const LIGHT_EXACT: f64 = 0.05;
 
 /// exact's samples per receiver for `error` by `LIGHT_EXACT`'s law.
 fn exact_samples_for(error: f64) -> u32 {
+    let max = crate::methods::config::MAX_SAMPLES;
     let n = (LIGHT_EXACT / error).powi(2).ceil();
-    n.clamp(16.0, crate::methods::config::MAX_SAMPLES as f64) as u32
+    square_samples(n.clamp(16.0, max as f64) as u32, max)
 }
 
 /// The plan for `stats` and `target`; `probe_seconds` is the probe's time
@@ -568,14 +569,21 @@ pub const MAX_REFINED_SAMPLES: u32 = crate::methods::config::MAX_SAMPLES / 4;
 /// calibration scenes).
 pub const LIGHT_REFINE: f64 = 0.17;
 
-/// `exact`'s samples for `target` by the law `error = c / sqrt(samples)`.
+/// `exact`'s samples for `target` by the law `error = c / sqrt(samples)`,
+/// rounded up to a near-square stratification (`LightShape::square_count`).
 pub fn exact_samples(c: f64, target: f64) -> u32 {
     let n = (c / target).powi(2).ceil();
     if n.is_finite() {
-        (n as u32).clamp(1, MAX_REFINED_SAMPLES)
+        square_samples((n as u32).max(1), MAX_REFINED_SAMPLES)
     } else {
         MAX_REFINED_SAMPLES
     }
+}
+
+/// `n` samples rounded up to a near-square stratification, at most `max`
+/// (a square: 128² or 256²).
+pub fn square_samples(n: u32, max: u32) -> u32 {
+    LightShape::square_count(n.min(max)).min(max)
 }
 
 /// The plan of an eye view (`ss.render`) for `target`: the rule's maps

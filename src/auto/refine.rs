@@ -14,7 +14,9 @@
 //!   (the map methods' error does not fall predictably with their settings
 //!   on a scene unlike the calibration ones; `exact`'s does);
 //! * `exact` with n samples: n (high / e)^2, high the interval's upper end
-//!   (the law error ∝ 1/sqrt(n) of a random sample). A stratified sample's
+//!   (the law error ∝ 1/sqrt(n) of a random sample), rounded up to a
+//!   near-square stratification (a prime count is stratified along one
+//!   axis only: `LightShape::square_count`). A stratified sample's
 //!   error mostly falls faster (n^-0.7 on the eye scenes: the count then
 //!   overshoots), but not everywhere: on the held-out blinds, slats
 //!   aliasing with the sample grid, the estimate fell as n^-0.3 from 144
@@ -25,7 +27,7 @@
 //! most a refinement asks for; a target out of reach there is reported as
 //! missed, not promised.
 
-use super::plan::{exact_samples, Decision, MAX_REFINED_SAMPLES};
+use super::plan::{exact_samples, square_samples, Decision, MAX_REFINED_SAMPLES};
 use crate::error::Result;
 use crate::error_estimate::ErrorEstimate;
 use crate::methods::{ExactConfig, Method, MethodConfig};
@@ -57,7 +59,10 @@ pub fn next(
                 return None;
             }
             let grown = samples as f64 * (e.high / target).powi(2);
-            let n = (grown.ceil() as u32).clamp(samples + 1, MAX_REFINED_SAMPLES);
+            let n = square_samples(
+                (grown.ceil() as u32).clamp(samples + 1, MAX_REFINED_SAMPLES),
+                MAX_REFINED_SAMPLES,
+            );
             (
                 n,
                 format!(
