@@ -13,7 +13,8 @@
 //! * a map setting: `exact` with the samples the plan's law gives
 //!   (the map methods' error does not fall predictably with their settings
 //!   on a scene unlike the calibration ones; `exact`'s does);
-//! * `exact` with n samples: n (high / e)^2, high the interval's upper end
+//! * `exact` with n samples: n (high / e)^2 and at least 2n, high the
+//!   interval's upper end
 //!   (the law error ∝ 1/sqrt(n) of a random sample), rounded up to a
 //!   near-square stratification (a prime count is stratified along one
 //!   axis only: `LightShape::square_count`). A stratified sample's
@@ -22,7 +23,9 @@
 //!   aliasing with the sample grid, the estimate fell as n^-0.3 from 144
 //!   to 877 samples, and a second run followed.
 //!
-//! At most `MAX_REFINES` runs follow the planned one. `exact`'s estimate
+//! At most `MAX_REFINES` runs follow the planned one, and one more where
+//! that was an `exact` pilot below the law's count (the eye view's
+//! `plan::EYE_PILOT`). `exact`'s estimate
 //! compares it with four times its samples, so `MAX_SAMPLES / 4` is the
 //! most a refinement asks for; a target out of reach there is reported as
 //! missed, not promised.
@@ -58,11 +61,24 @@ pub fn next(
             if samples >= MAX_REFINED_SAMPLES {
                 return None;
             }
-            let grown = samples as f64 * (e.high / target).powi(2);
-            let n = square_samples(
+            // At least twice the samples: a miss by a hair would otherwise
+            // creep (crowd at 320x240 went 16 -> 25 -> 30, each run paying
+            // its BVH and estimate again), and doubling bounds the runs
+            // replaced by the last one's time.
+            let grown = (samples as f64 * (e.high / target).powi(2)).max(2.0 * samples as f64);
+            let mut n = square_samples(
                 (grown.ceil() as u32).clamp(samples + 1, MAX_REFINED_SAMPLES),
                 MAX_REFINED_SAMPLES,
             );
+            // A run below the law's count (the eye view's pilot) grows to
+            // at most that count: the law is fitted to the widest
+            // penumbrae, and a 16-sample estimate extrapolated by 1/sqrt(n)
+            // overshoots (bunny_on_slab: 169 samples for 0.01, where 144
+            // measure 0.0055).
+            let law_n = exact_samples(law, target);
+            if samples < law_n {
+                n = n.min(law_n);
+            }
             (
                 n,
                 format!(
@@ -130,7 +146,9 @@ pub fn refined<T>(
 ) -> Result<(T, MethodConfig, f64)> {
     let (mut out, mut ran) = first;
     let (mut replaced, mut last) = (0.0, first_seconds);
-    for _ in 0..MAX_REFINES {
+    let pilot =
+        matches!(ran.kernel(), Method::Exact { samples } if samples < exact_samples(law, target));
+    for _ in 0..MAX_REFINES + pilot as usize {
         let Some(e) = estimate_of(&out) else { break };
         if met(target, &e) {
             break;
@@ -185,7 +203,8 @@ mod tests {
         let big = MethodConfig::Exact(ExactConfig {
             samples: MAX_REFINED_SAMPLES / 2,
         });
-        let (cfg, _) = next(0.001, &big, &estimate(0.5, 0.6, 10), 0.1).unwrap();
+        // (A law of 1.0 asks for the cap at 0.001: no pilot's bound.)
+        let (cfg, _) = next(0.001, &big, &estimate(0.5, 0.6, 10), 1.0).unwrap();
         assert_eq!(
             cfg,
             MethodConfig::Exact(ExactConfig {
@@ -196,6 +215,19 @@ mod tests {
             samples: MAX_REFINED_SAMPLES,
         });
         assert!(next(0.001, &top, &estimate(0.5, 0.6, 10), 0.1).is_none());
+    }
+
+    #[test]
+    fn a_pilot_grows_to_at_most_the_law_count() {
+        // The law asks 100 for 0.01; a 16-sample pilot missing by 4x would
+        // grow to 256 by its own estimate, and stops at 100.
+        let pilot = MethodConfig::Exact(ExactConfig { samples: 16 });
+        let (cfg, _) = next(0.01, &pilot, &estimate(0.03, 0.04, 10), 0.1).unwrap();
+        assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 100 }));
+        // Missing by less, it grows by its estimate: 16 (0.017 / 0.01)² = 46.2,
+        // rounded up to 7 x 7.
+        let (cfg, _) = next(0.01, &pilot, &estimate(0.015, 0.017, 10), 0.1).unwrap();
+        assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 49 }));
     }
 
     #[test]
@@ -225,9 +257,10 @@ mod tests {
             },
         )
         .unwrap();
+        // The pilot's estimate asks 256; the law's 100 caps it.
         assert_eq!(
             runs,
-            vec![MethodConfig::Exact(ExactConfig { samples: 256 })]
+            vec![MethodConfig::Exact(ExactConfig { samples: 100 })]
         );
         assert_eq!(ran, runs[0]);
         assert_eq!(out.high, 0.008);
@@ -254,8 +287,17 @@ mod tests {
             },
         )
         .unwrap();
-        assert_eq!(runs.len(), MAX_REFINES);
-        assert_eq!(runs[0], MethodConfig::Exact(ExactConfig { samples: 64 }));
+        // A pilot (16 samples, under the law's 100) gets one run more: 64,
+        // then the law's 100, then 400.
+        assert_eq!(runs.len(), MAX_REFINES + 1);
+        let counts: Vec<u32> = runs
+            .iter()
+            .map(|c| match c {
+                MethodConfig::Exact(e) => e.samples,
+                _ => 0,
+            })
+            .collect();
+        assert_eq!(counts, [64, 100, 400]);
         assert!(!d.last().unwrap().taken);
         // At the cap nothing more is run.
         let mut d = vec![];

@@ -246,7 +246,8 @@ def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
     names = [d.name for d in img.plan.decisions]
     assert "refine" in names and img.plan.decisions[-1].name == "target" and img.plan.decisions[-1].taken
     assert isinstance(img.method, ss.Exact) and img.method.samples > 144, img.plan
-    assert img.plan.planned == ss.Exact(samples=144) and img.plan.method == img.method
+    # The planned run was the 16-sample pilot (the law asks 144).
+    assert img.plan.planned == ss.Exact(samples=16) and img.plan.method == img.method
     assert "replaced" in img.timings and img.timings["replaced"] > 0
     shadowed = img.mask & (1.0 - ref.visibility > 1e-3)
     assert float(np.abs(img.visibility - ref.visibility)[shadowed].mean()) <= 0.01, img.plan
@@ -254,3 +255,22 @@ def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
     # a fixed set of pixels, whatever the machine's speed.
     again = ss.render(scene, light, cam, method=ss.Auto(error=0.01))
     assert again.method == img.method and np.array_equal(again.visibility, img.visibility)
+
+
+def test_the_eye_views_pilot_stands_where_the_penumbrae_are_narrow():
+    """A calibration scene under the sun: the law asks 144 samples for
+    0.01, the 16-sample pilot's estimate already meets it, and no run
+    follows; the answer meets the target against exact with 1024 samples.
+    Every count a plan runs stratifies near-square."""
+    from softshadow.scenes import as_built
+
+    scene, light, cam = as_built.CALIBRATION["stairs_low_sun"]((160, 120))
+    img = ss.render(scene, light, cam, method=ss.Auto(error=0.01))
+    setting = img.plan.decisions[0]
+    assert setting.name == "setting" and "exact with 144 samples" in setting.why and "pilot" in setting.why
+    assert img.method == ss.Exact(samples=16) and img.plan.planned is None, img.plan
+    assert "refine" not in [d.name for d in img.plan.decisions] and img.plan.decisions[-1].taken
+    ref = ss.render(scene, light, cam, method=ss.Exact(samples=1024))
+    shadowed = img.mask & (1.0 - ref.visibility > 1e-3)
+    assert shadowed.sum() > 100
+    assert float(np.abs(img.visibility - ref.visibility)[shadowed].mean()) <= 0.01
