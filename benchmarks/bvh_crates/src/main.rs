@@ -1,4 +1,4 @@
-//! softshadow's BVH against the BVH crates of crates.io on `exact`'s shadow
+//! softshadow's BVH against the published BVH crates on `exact`'s shadow
 //! rays (issue 12): every receiver texel's stratified rays on the study's
 //! scenes, read from .cache/bvh_crates/ (written by export.py, which this
 //! runs when a scene is missing). See README.md.
