@@ -194,55 +194,7 @@ impl Bvh {
             .map(|(k, t)| (t, k as u32))
             .collect();
         let codes = sah_depth.is_none().then(|| morton_order(&mut tris));
-        let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
-        let (lo, hi) = bounds(tris.iter().map(|t| &t.0));
-        nodes.push(Node {
-            min: lo,
-            max: hi,
-            start: 0,
-            count: tris.len() as u32,
-        });
-        // Iterative build: (node index, depth) work list.
-        let mut work = vec![(0usize, 0usize)];
-        while let Some((n, depth)) = work.pop() {
-            let Node { start, count, .. } = nodes[n];
-            let (s, c) = (start as usize, count as usize);
-            if c <= LEAF {
-                continue;
-            }
-            let slice = &mut tris[s..s + c];
-            let mid = match (&codes, sah_depth) {
-                // Median splits below SAH_DEPTH keep the depth bounded
-                // (they reorder within a node; its codes are not read again).
-                (Some(codes), _) if depth < SAH_DEPTH => morton_split(&codes[s..s + c]),
-                (None, Some(d)) if depth < d => match sah_split(slice) {
-                    Some((axis, plane)) => partition(slice, |t| centroid(&t.0)[axis] < plane),
-                    None => 0,
-                },
-                _ => 0,
-            };
-            // No SAH plane, or one that (by rounding at a bin edge) put
-            // everything on one side: the median on the longest axis.
-            let mid = if mid == 0 || mid == c {
-                median_split(slice)
-            } else {
-                mid
-            };
-            let left = nodes.len();
-            for (off, len) in [(0, mid), (mid, c - mid)] {
-                let (lo, hi) = bounds(tris[s + off..s + off + len].iter().map(|t| &t.0));
-                nodes.push(Node {
-                    min: lo,
-                    max: hi,
-                    start: (s + off) as u32,
-                    count: len as u32,
-                });
-            }
-            nodes[n].start = left as u32;
-            nodes[n].count = 0;
-            work.push((left, depth + 1));
-            work.push((left + 1, depth + 1));
-        }
+        let nodes = subtree(&mut tris, codes.as_deref(), 0, 0, sah_depth);
         let (tris, order): (Vec<[Vec3; 3]>, Vec<u32>) = tris.into_iter().unzip();
         let edges = tris
             .iter()
@@ -416,6 +368,148 @@ impl Bvh {
     }
 }
 
+/// A triangle with its input index, as the build moves them.
+type Slot = ([Vec3; 3], u32);
+
+/// Nodes over more triangles than this build their two children's
+/// subtrees in parallel (`rayon::join`); smaller ones are built by one
+/// thread. Each split reads its own slice only, so the tree (and the
+/// triangles' order) is the one a single thread builds, whatever the
+/// threads; only the nodes' numbering differs, which no traversal reads
+/// (children are visited through `start`, left then right). Built by one
+/// thread, a 2 000 000-triangle mesh took 1.7 s an `exact` call on 2 cores
+/// (docs/benchmarks/scale.md).
+const PARALLEL_TRIS: usize = 16_384;
+
+/// The split of the node over `slice` at `depth` (more than `LEAF`
+/// triangles): the left child's count, after reordering the slice.
+fn split(
+    slice: &mut [Slot],
+    codes: Option<&[u64]>,
+    depth: usize,
+    sah_depth: Option<usize>,
+) -> usize {
+    let c = slice.len();
+    let mid = match (codes, sah_depth) {
+        // Median splits below SAH_DEPTH keep the depth bounded
+        // (they reorder within a node; its codes are not read again).
+        (Some(codes), _) if depth < SAH_DEPTH => morton_split(codes),
+        (None, Some(d)) if depth < d => match sah_split(slice) {
+            Some((axis, plane)) => partition(slice, |t| centroid(&t.0)[axis] < plane),
+            None => 0,
+        },
+        _ => 0,
+    };
+    // No SAH plane, or one that (by rounding at a bin edge) put
+    // everything on one side: the median on the longest axis.
+    if mid == 0 || mid == c {
+        median_split(slice)
+    } else {
+        mid
+    }
+}
+
+fn node_over(tris: &[Slot], start: usize) -> Node {
+    let (lo, hi) = bounds(tris.iter().map(|t| &t.0));
+    Node {
+        min: lo,
+        max: hi,
+        start: start as u32,
+        count: tris.len() as u32,
+    }
+}
+
+/// The nodes of the subtree over `tris` (the triangles from `base` on, the
+/// root at `depth`): the root first; an internal node's `start` is its
+/// left child's index in the list (the right one follows it), a leaf's is
+/// its first triangle's index in the whole tree.
+fn subtree(
+    tris: &mut [Slot],
+    codes: Option<&[u64]>,
+    base: usize,
+    depth: usize,
+    sah_depth: Option<usize>,
+) -> Vec<Node> {
+    if tris.len() <= PARALLEL_TRIS {
+        return serial_subtree(tris, codes, base, depth, sah_depth);
+    }
+    let root = node_over(tris, base);
+    let mid = split(tris, codes, depth, sah_depth);
+    let (lt, rt) = tris.split_at_mut(mid);
+    let (lc, rc) = match codes {
+        Some(c) => {
+            let (a, b) = c.split_at(mid);
+            (Some(a), Some(b))
+        }
+        None => (None, None),
+    };
+    let (lv, rv) = rayon::join(
+        || subtree(lt, lc, base, depth + 1, sah_depth),
+        || subtree(rt, rc, base + mid, depth + 1, sah_depth),
+    );
+    // [root, left, right, left's descendants, right's descendants].
+    let (l_at, r_at) = (3, 3 + lv.len() - 1);
+    let moved = |n: Node, at: usize| {
+        if n.count == 0 {
+            Node {
+                start: (at + n.start as usize - 1) as u32,
+                ..n
+            }
+        } else {
+            n
+        }
+    };
+    let mut out = Vec::with_capacity(1 + lv.len() + rv.len());
+    out.push(Node {
+        start: 1,
+        count: 0,
+        ..root
+    });
+    out.push(moved(lv[0], l_at));
+    out.push(moved(rv[0], r_at));
+    out.extend(lv[1..].iter().map(|&n| moved(n, l_at)));
+    out.extend(rv[1..].iter().map(|&n| moved(n, r_at)));
+    out
+}
+
+/// `subtree` by one thread: a work list of (node, depth).
+fn serial_subtree(
+    tris: &mut [Slot],
+    codes: Option<&[u64]>,
+    base: usize,
+    depth: usize,
+    sah_depth: Option<usize>,
+) -> Vec<Node> {
+    let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
+    nodes.push(node_over(tris, 0));
+    let mut work = vec![(0usize, depth)];
+    while let Some((n, depth)) = work.pop() {
+        let Node { start, count, .. } = nodes[n];
+        let (s, c) = (start as usize, count as usize);
+        if c <= LEAF {
+            continue;
+        }
+        let mid = split(
+            &mut tris[s..s + c],
+            codes.map(|k| &k[s..s + c]),
+            depth,
+            sah_depth,
+        );
+        let left = nodes.len();
+        nodes.push(node_over(&tris[s..s + mid], s));
+        nodes.push(node_over(&tris[s + mid..s + c], s + mid));
+        nodes[n].start = left as u32;
+        nodes[n].count = 0;
+        work.push((left, depth + 1));
+        work.push((left + 1, depth + 1));
+    }
+    // Leaves' triangles by their place in the whole tree.
+    for n in nodes.iter_mut().filter(|n| n.count > 0) {
+        n.start += base as u32;
+    }
+    nodes
+}
+
 /// Moves the elements for which `left` holds to the front; their count.
 fn partition<T>(v: &mut [T], left: impl Fn(&T) -> bool) -> usize {
     let mut k = 0;
@@ -532,6 +626,49 @@ pub(crate) mod tests {
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (s >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// The nodes in traversal order (root, then each internal node's left
+    /// subtree before its right), with their triangles: what any traversal
+    /// reads of a tree, whatever its numbering.
+    fn canonical(b: &Bvh) -> Vec<(Vec3, Vec3, Vec<u32>)> {
+        let mut out = vec![];
+        let mut stack = vec![0usize];
+        while let Some(k) = stack.pop() {
+            let n = b.nodes[k];
+            let tris = if n.count > 0 {
+                b.order[n.start as usize..(n.start + n.count) as usize].to_vec()
+            } else {
+                stack.push(n.start as usize + 1);
+                stack.push(n.start as usize);
+                vec![]
+            };
+            out.push((n.min, n.max, tris));
+        }
+        out
+    }
+
+    #[test]
+    fn threads_build_the_tree_one_thread_builds() {
+        // Over PARALLEL_TRIS: the top splits run in parallel. Both builds.
+        let tris = random_tris(3 * PARALLEL_TRIS + 77, 5);
+        for sah in [Some(SAH_DEPTH), None] {
+            let par = Bvh::build_to(tris.clone(), sah);
+            let mut slots: Vec<Slot> = tris.iter().copied().zip(0..).collect();
+            let codes = sah.is_none().then(|| morton_order(&mut slots));
+            let nodes = serial_subtree(&mut slots, codes.as_deref(), 0, 0, sah);
+            let one = Bvh {
+                nodes,
+                tris: vec![],
+                order: slots.iter().map(|s| s.1).collect(),
+                edges: vec![],
+                wide: vec![],
+                wide_parent: vec![],
+            };
+            assert_eq!(par.order, one.order);
+            assert_eq!(canonical(&par), canonical(&one));
+            assert!(par.depth() < 64);
         }
     }
 
