@@ -1,8 +1,8 @@
 //! The eye view's stages as one interface, implemented by the CPU
-//! (`CpuEye`, here) and by the GPU (`crate::gpu::GpuEye`): the orchestrator
-//! (`crate::pipeline::eye_view`) runs one sequence of stages on either, so
-//! a stage is added once and both backends give the same answers from the
-//! same framing (framing.rs).
+//! (`CpuEye`, here) and by the GPU (`crate::gpu::eye::GpuEye`): the
+//! orchestrator (`crate::pipeline::eye_view`) runs one sequence of stages
+//! on either, so a stage is added once and both backends give the same
+//! answers from the same framing (framing.rs).
 
 use super::call::EyeCall;
 use super::framing::Framed;

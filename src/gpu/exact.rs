@@ -2,14 +2,27 @@
 //! `methods/exact.rs` builds it) and uploaded with the triangles; `exact.wgsl`
 //! casts the stratified samples of each receiver texel through it, a chunk of
 //! samples per dispatch, then resolves the counts into visibility.
+//!
+//! `ExactKernel` (its `GpuKernel`) runs the light view; in the eye view
+//! `exact` is no map method: `GpuEye::trace` casts its rays (`eye.rs`,
+//! `eye_rays.wgsl`, which appends to this module's WGSL).
 
 use super::context::Gpu;
 use super::dispatch::{bind, module, pipeline, storage, uniform, upload};
 use super::light;
+use super::method_kernel::{
+    mismatch, needs_triangles, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage,
+};
+use super::readback::words;
 use super::timing::StageTimer;
+use crate::error::{Error, Result};
+use crate::eye::EyeMaps;
+use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::methods::exact::{Bvh, RAY_EPS};
+use crate::methods::Method;
+use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use std::sync::OnceLock;
@@ -69,6 +82,14 @@ fn pipelines(device: &wgpu::Device) -> &'static ExactPipelines {
     })
 }
 
+/// A ray visited more nodes than `BUDGET` (the status word the shaders set).
+pub(super) fn budget_error() -> Error {
+    Error::gpu(
+        "a ray visited more BVH nodes than one invocation may (lavapipe stops an \
+         invocation after 65535 loop iterations); use backend=\"cpu\" for this scene",
+    )
+}
+
 /// The buffers and parameters of the ray-casting stage.
 pub struct ExactShading {
     params: ExactParams,
@@ -77,9 +98,9 @@ pub struct ExactShading {
     tris: wgpu::Buffer,
     axes: wgpu::Buffer,
     seen: wgpu::Buffer,
-    pub status: wgpu::Buffer,
-    pub vis: wgpu::Buffer,
-    pub vis_bytes: u64,
+    status: wgpu::Buffer,
+    vis: wgpu::Buffer,
+    vis_bytes: u64,
 }
 
 impl ExactShading {
@@ -139,16 +160,18 @@ impl ExactShading {
             vis_bytes,
         }
     }
+}
 
+impl Stage for ExactShading {
     /// Records the pass "shadow": one dispatch per chunk of samples, then
     /// the resolve.
-    pub fn record(
+    fn record(
         &self,
         g: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         timer: &StageTimer,
         maps: &wgpu::Buffer,
-    ) {
+    ) -> Result<()> {
         let device = &g.device;
         let p = pipelines(device);
         enc.clear_buffer(&self.seen, 0, None);
@@ -196,5 +219,58 @@ impl ExactShading {
         pass.set_pipeline(&p.resolve);
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(groups.0, groups.1, 1);
+        Ok(())
+    }
+
+    fn outputs(&self) -> Vec<(&wgpu::Buffer, u64)> {
+        vec![(&self.vis, self.vis_bytes), (&self.status, 4)]
+    }
+
+    fn check(&self, status: &[Vec<u8>]) -> Result<()> {
+        if words(&status[0])[0] != 0 {
+            return Err(budget_error());
+        }
+        Ok(())
+    }
+}
+
+/// `exact`'s kernel: rays through the occluders' BVH at every receiver
+/// texel (light view only).
+pub(super) struct ExactKernel;
+
+impl GpuKernel for ExactKernel {
+    fn check(&self, _method: Method) -> Result<()> {
+        Ok(())
+    }
+
+    fn light_view<'a>(
+        &self,
+        g: &'a Gpu,
+        method: Method,
+        i: LightViewInputs<'a>,
+    ) -> Result<Option<MakeStage<'a>>> {
+        let Method::Exact { samples } = method else {
+            return Err(mismatch(method));
+        };
+        let (verts, faces) = i.occluders.ok_or_else(|| needs_triangles(method))?;
+        Ok(Some(Box::new(move || {
+            let t = light_space_triangles(verts, faces);
+            let sh = ExactShading::new(g, i.grid, t, samples, i.light_shape);
+            Ok(Box::new(sh) as Box<dyn Stage>)
+        })))
+    }
+
+    // The eye view's `exact` traces (`EyeStages::trace`), never here.
+    fn eye(
+        &self,
+        _g: &Gpu,
+        _method: Method,
+        _inputs: &EyeInputs,
+        _sw: &mut Stopwatch,
+    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+        Err(Error::gpu(
+            "exact has no map stage: the eye view traces its rays (GpuEye::trace) \
+             (a bug: please report it)",
+        ))
     }
 }

@@ -5,45 +5,34 @@
 //! shading run in one command buffer, and the maps and the visibility come
 //! back in one readback.
 //!
-//! On the CPU stay the f64 work WGSL cannot do: the light-space transform,
-//! the extent fit and the triangle set-up (clip, project, snap). Bitmask
-//! with closed gaps also makes its micro-quads' corners there, with the CPU
-//! kernel's own function: it takes two submissions, the maps (read back),
-//! then, after the corners (stage "corners") go up, the shading.
+//! The shading is the method's kernel's (`super::kernel`,
+//! `GpuKernel::light_view`), recorded after the maps. On the CPU stay the
+//! f64 work WGSL cannot do: the light-space transform, the extent fit and
+//! the triangle set-up (clip, project, snap), and the kernel's own CPU part
+//! (Smoothies' steps 2-3). A kernel that waits for the maps' corners
+//! (bitmask with closed gaps, whose micro-quads' corners the CPU kernel's
+//! own function makes) takes two submissions: the maps (read back), then,
+//! after the corners (stage "corners") go up, the shading.
 
 use super::context::gpu;
 use super::dispatch::storage;
-use super::exact::ExactShading;
 use super::gather;
-use super::pcss::PcssShading;
+use super::method_kernel::{still_waits, LightViewInputs};
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
-use super::refusals::{check_method, check_side};
-use super::shading::{check_size, Shading};
-use super::smoothies::{self, Receivers, SmoothieShading};
+use super::refusals::check_side;
+use super::shading::check_size;
 use super::timing::StageTimer;
-use crate::error::{Error, Result};
-use crate::frame::{light_space_triangles, FramedScene, MapSettings};
+use crate::error::Result;
+use crate::frame::{FramedScene, MapSettings};
 use crate::light_view::LightMaps;
-use crate::methods::Method;
 use crate::raster::setup_triangles;
 use crate::timing::{Stopwatch, Timings};
-
-/// The shading stage of a method: over occluder maps, or over triangles.
-enum Stage {
-    Maps(Shading),
-    /// Bitmask with closed gaps: the shading waits for the maps' corners.
-    Quads,
-    Rays(ExactShading),
-    Smoothies(SmoothieShading),
-    /// PCSS reads the front layer at `grid.len()` in `maps`.
-    Pcss(PcssShading),
-}
 
 /// What the GPU refuses of a mesh call before any work: a method it has
 /// no kernel for, a map side beyond its fixed-point coordinates.
 pub(crate) fn check(s: &MapSettings) -> Result<()> {
-    check_method(s.method)?;
+    super::kernel(s.method).check(s.method)?;
     check_side("resolution", (s.width, s.height))?;
     if let Some(o) = s.occluder_resolution {
         check_side("occluder_resolution", o)?;
@@ -87,58 +76,25 @@ pub(crate) fn maps(
             .map(GpuTri::from_setup)
             .collect()
     };
-    // Smoothies: steps 2-3 on the CPU (smoothies.rs).
-    let smoothies = smoothies::options(s.method)
-        .map(|m| {
-            smoothies::prepare_light_view(
-                g,
-                &m,
-                &occluder_grid,
-                light_shape,
-                occ_ls,
-                occluder_faces,
-            )
-        })
-        .transpose()?;
-    sw.lap("setup");
     // The occluders' largest 1/depth, from their vertices in front of the near plane.
     let w_max = occ_ls.iter().fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
+    let kernel = super::kernel(s.method);
+    let inputs = LightViewInputs {
+        grid: &grid,
+        occluder_grid: &occluder_grid,
+        light_shape,
+        layers,
+        w_max,
+        occluders: Some((occ_ls, occluder_faces)),
+        corners: None,
+    };
+    // The kernel's CPU part (Smoothies: steps 2-3).
+    let make = kernel.light_view(g, s.method, inputs)?;
+    sw.lap("setup");
     let maps_len = grid.len() + passes * occluder_grid.len();
     let out = with_error_scopes(g, || {
-        let shading = match (s.method, &smoothies) {
-            (_, Some(p)) => Stage::Smoothies(SmoothieShading::new(
-                g,
-                p,
-                grid.len() as u32,
-                Receivers::Map {
-                    grid: &grid,
-                    offset: 0,
-                },
-            )),
-            (Method::Exact { samples }, _) => {
-                let t = light_space_triangles(occ_ls, occluder_faces);
-                Stage::Rays(ExactShading::new(g, &grid, t, samples, light_shape))
-            }
-            (Method::Pcss { max_taps }, _) => Stage::Pcss(PcssShading::maps(
-                g,
-                &grid,
-                &occluder_grid,
-                light_shape,
-                max_taps,
-                grid.len() as u32,
-            )?),
-            _ if gather::needs_corners(s.method) => Stage::Quads,
-            _ => Stage::Maps(Shading::new(
-                g,
-                s.method,
-                &grid,
-                &occluder_grid,
-                light_shape,
-                layers,
-                w_max,
-                None,
-            )),
-        };
+        // None: the shading waits for the maps' corners.
+        let shading = make.map(|make| make()).transpose()?;
         let maps = storage(
             &g.device,
             "maps",
@@ -155,64 +111,45 @@ pub(crate) fn maps(
             });
         tris.record(g, &mut enc, &timer, &maps, &grid, &occluder_grid, layers);
         let mut sources = vec![(&maps, maps_len as u64 * 4)];
-        match &shading {
-            Stage::Maps(sh) => {
-                sh.record(g, &mut enc, &timer, &maps)?;
-                sources.push((&sh.vis, sh.vis_bytes));
-            }
-            Stage::Quads => {}
-            Stage::Rays(sh) => {
-                sh.record(g, &mut enc, &timer, &maps);
-                sources.push((&sh.vis, sh.vis_bytes));
-                sources.push((&sh.status, 4));
-            }
-            Stage::Smoothies(sh) => {
-                sh.record(g, &mut enc, &timer, &maps);
-                sources.push((&sh.vis, sh.vis_bytes));
-            }
-            Stage::Pcss(sh) => {
-                sh.record(g, &mut enc, &timer, &maps);
-                sources.push((&sh.vis, sh.vis_bytes));
-            }
+        if let Some(sh) = &shading {
+            sh.record(g, &mut enc, &timer, &maps)?;
+            sources.extend(sh.outputs());
         }
         let mut out = submit_and_read(g, enc, &timer, &sources, sw)?;
-        if let Stage::Quads = shading {
-            // The corners from the maps read back, then the shading.
-            let m = words(&out.buffers[0]);
-            let occ: &[f32] = bytemuck::cast_slice(&m[grid.len()..]);
-            let layer_maps: Vec<&[f32]> = occ.chunks_exact(occluder_grid.len()).collect();
-            let corners = gather::layer_corners(&layer_maps, &occluder_grid);
-            sw.lap("corners");
-            let sh = Shading::new(
-                g,
-                s.method,
-                &grid,
-                &occluder_grid,
-                light_shape,
-                layers,
-                w_max,
-                Some(&corners),
-            );
-            sw.lap("upload");
-            let timer = StageTimer::new(g, 2);
-            let mut enc = g
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("softshadow quads"),
-                });
-            sh.record(g, &mut enc, &timer, &maps)?;
-            let shaded = submit_and_read(g, enc, &timer, &[(&sh.vis, sh.vis_bytes)], sw)?;
-            out.buffers.extend(shaded.buffers);
-            out.device_timings.extend(shaded.device_timings);
-        }
+        let shading = match shading {
+            Some(sh) => sh,
+            None => {
+                // The corners from the maps read back, then the shading.
+                let m = words(&out.buffers[0]);
+                let occ: &[f32] = bytemuck::cast_slice(&m[grid.len()..]);
+                let layer_maps: Vec<&[f32]> = occ.chunks_exact(occluder_grid.len()).collect();
+                let corners = gather::layer_corners(&layer_maps, &occluder_grid);
+                sw.lap("corners");
+                let with_corners = LightViewInputs {
+                    corners: Some(&corners),
+                    ..inputs
+                };
+                let make = kernel
+                    .light_view(g, s.method, with_corners)?
+                    .ok_or_else(still_waits)?;
+                let sh = make()?;
+                sw.lap("upload");
+                let timer = StageTimer::new(g, 2);
+                let mut enc = g
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("softshadow quads"),
+                    });
+                sh.record(g, &mut enc, &timer, &maps)?;
+                let shaded = submit_and_read(g, enc, &timer, &sh.outputs(), sw)?;
+                out.buffers.extend(shaded.buffers);
+                out.device_timings.extend(shaded.device_timings);
+                sh
+            }
+        };
+        shading.check(&out.buffers[2..])?;
         Ok(out)
     })?;
-    if out.buffers.get(2).is_some_and(|b| words(b)[0] != 0) {
-        return Err(Error::gpu(
-            "a ray visited more BVH nodes than one invocation may (lavapipe stops an \
-             invocation after 65535 loop iterations); use backend=\"cpu\" for this scene",
-        ));
-    }
     let maps = words(&out.buffers[0]);
     let visibility = visibility(&out.buffers[1])?;
     let rec_len = grid.len();

@@ -6,12 +6,13 @@
 //! and the biased points with their tangent-plane bounds
 //! (`maps::shading_points`). On the device, in one submission: the front
 //! layer rasterized by raster.wgsl at offset 0 of the maps buffer, then the
-//! method's own kernel (`AfterFront`), one readback of the layer and the
-//! visibility. Then `maps::finish` (each point cut to its bound) and the
-//! layer in the user's depth, as the CPU's `EyeMaps` hold it.
+//! method's own `Stage`, one readback of the layer and the visibility.
+//! Then `maps::finish` (each point cut to its bound) and the layer in the
+//! user's depth, as the CPU's `EyeMaps` hold it.
 
 use super::context::Gpu;
 use super::dispatch::storage;
+use super::method_kernel::Stage;
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::timing::StageTimer;
@@ -22,20 +23,6 @@ use crate::geom::light::MapGrid;
 use crate::raster::setup_triangles;
 use crate::timing::{Stopwatch, Timings};
 use rayon::prelude::*;
-
-/// A method's kernel recorded after the front layer: it reads the layer at
-/// the offset it was made with and leaves one visibility per point.
-pub(super) trait AfterFront {
-    fn record(
-        &self,
-        g: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        timer: &StageTimer,
-        maps: &wgpu::Buffer,
-    );
-    /// The visibility buffer and its bytes.
-    fn visibility(&self) -> (&wgpu::Buffer, u64);
-}
 
 /// The CPU's part: the grid, its front layer's triangles and the points.
 pub(super) struct FrontLayer {
@@ -89,11 +76,11 @@ impl FrontLayer {
         })
     }
 
-    /// The device's part: the layer, then the kernel `make` builds (inside
+    /// The device's part: the layer, then the stage `make` builds (inside
     /// the error scopes, so a failed allocation is an error, not a panic),
-    /// `stages` timed stages in all; the visibility per point, the maps
-    /// and the device's stage times.
-    pub fn shade<S: AfterFront>(
+    /// reading the layer at offset 0; `stages` timed stages in all; the
+    /// visibility per point, the maps and the device's stage times.
+    pub fn shade<S: Stage>(
         self,
         g: &Gpu,
         f: &Framed,
@@ -113,9 +100,12 @@ impl FrontLayer {
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
             raster.record_occluders(g, &mut enc, &timer, &maps_buf, 0, &self.grid, 1);
-            kernel.record(g, &mut enc, &timer, &maps_buf);
-            let (vis, vis_bytes) = kernel.visibility();
-            submit_and_read(g, enc, &timer, &[(&maps_buf, bytes), (vis, vis_bytes)], sw)
+            kernel.record(g, &mut enc, &timer, &maps_buf)?;
+            let mut sources = vec![(&maps_buf, bytes)];
+            sources.extend(kernel.outputs());
+            let out = submit_and_read(g, enc, &timer, &sources, sw)?;
+            kernel.check(&out.buffers[2..])?;
+            Ok(out)
         })?;
         let mut v = visibility(&out.buffers[1])?;
         maps::finish(&mut v, &self.points.bound);

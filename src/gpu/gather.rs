@@ -328,12 +328,9 @@ fn variant(method: Method) -> Result<Variant> {
     }
 }
 
-/// Refuses a method the GPU cannot run, before any GPU work.
+/// Refuses options of a gather method the GPU has no module for, before
+/// any GPU work.
 pub fn check_method(method: Method) -> Result<()> {
-    // Smoothies have their own kernels (smoothies.rs).
-    if matches!(method, Method::Smoothies { .. }) {
-        return Ok(());
-    }
     variant(method).map(|_| ())
 }
 

@@ -14,8 +14,8 @@
 //!   through the camera BVH; twin `Bvh::nearest` (`eye::gbuffer`).
 //! * `eye_rays.wgsl` (`eye.rs`): the eye view's `exact`, shadow rays from
 //!   the visible points; twin `crate::eye::rays`.
-//! * `gather.wgsl`'s points mode (`gather.rs`, `eye.rs`): the eye view's
-//!   map methods at arbitrary points; twin `methods::gather`'s
+//! * `gather.wgsl`'s points mode (`gather.rs`, `gather_points.rs`): the eye
+//!   view's map methods at arbitrary points; twin `methods::gather`'s
 //!   `visibility_points`.
 //! * `smoothies.wgsl` (`smoothies.rs`): Smoothies' buffer (the smoothies
 //!   built on the CPU, binned to tiles, rasterized per texel with min
@@ -30,25 +30,35 @@
 //! * `u64.wgsl`: 64-bit integer helpers, placed before `raster.wgsl`,
 //!   `shadow_mapping.wgsl` and `exact.wgsl` (and the eye modules, which append to `exact.wgsl`).
 //!
-//! What the orchestrators (`crate::pipeline`) run: `GpuLightView` (the
-//! light view's stages: the mesh maps and their shading in one submission,
-//! `from_meshes.rs`; the user's depth maps shaded, `from_depth.rs`) and
-//! `GpuEye` (the eye view's stages, `eye.rs`); this module never runs a
-//! sequence of its own. Device, queue and pipelines are made once per
-//! process (`context.rs`).
+//! Each method's module implements one interface, `GpuKernel`
+//! (`method_kernel.rs`: its options' check, its light view's shading
+//! stage, its eye view's map shading), and `kernel` below is the one place
+//! that picks a method's: the stages run any method through it. A new GPU
+//! method is its own module (and `.wgsl`), a `mod` line and an arm of
+//! `kernel`.
+//!
+//! What the orchestrators (`crate::pipeline`) run: `light_view::GpuLightView`
+//! (the light view's stages: the mesh maps and their shading in one
+//! submission, `from_meshes.rs`; the user's depth maps shaded,
+//! `from_depth.rs`) and `eye::GpuEye` (the eye view's stages, `eye.rs`);
+//! this module never runs a sequence of its own. (They are not re-exported
+//! here: they call `kernel`, and the files import one another one way.)
+//! Device, queue and pipelines are made once per process (`context.rs`).
 
 mod context;
 #[cfg(test)]
 mod device_tests;
 mod dispatch;
 mod exact;
-mod eye;
+pub(crate) mod eye;
 mod from_depth;
 mod from_meshes;
 mod front_layer;
 mod gather;
+mod gather_points;
 mod light;
-mod light_view;
+pub(crate) mod light_view;
+mod method_kernel;
 mod pcss;
 mod raster;
 mod readback;
@@ -61,10 +71,23 @@ mod smoothies;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};
-pub use eye::GpuEye;
-pub use light_view::GpuLightView;
 
 use crate::error::Result;
+use crate::methods::Method;
+use method_kernel::GpuKernel;
+
+/// The GPU kernel of `method`: the only place in the backend that tells
+/// the methods apart.
+fn kernel(method: Method) -> &'static dyn GpuKernel {
+    match method {
+        Method::Ssm { .. } | Method::Bitmask { .. } => &gather_points::GatherKernel,
+        Method::Exact { .. } => &exact::ExactKernel,
+        Method::Smoothies { .. } => &smoothies::SmoothiesKernel,
+        Method::Pcss { .. } => &pcss::PcssKernel,
+        // Its eye view is a stage of its own (`EyeStages::shadow_mapping`).
+        Method::ShadowMapping(_) => &method_kernel::NoKernel,
+    }
+}
 
 /// The adapter the GPU backend uses, opening it if needed;
 /// `Error::GpuUnavailable` when there is none.

@@ -10,23 +10,24 @@
 //!   biased points made on the CPU (`maps::shading_points`), shaded in
 //!   points mode, then `maps::finish` (`shade_points`).
 //!
-//! One compute pass ("shadow"): z_near, the search's chunks, the filter's
-//! chunks, the resolve. The CPU does in f64 what sets every point up: the
-//! pixel coordinates (split into texel + fraction, see pcss.wgsl) and the
-//! half-widths per unit of 1/depth (`methods::pcss::half_per_w`).
+//! Both run as `PcssKernel` (its `GpuKernel`). One compute pass ("shadow"):
+//! z_near, the search's chunks, the filter's chunks, the resolve. The CPU
+//! does in f64 what sets every point up: the pixel coordinates (split into
+//! texel + fraction, see pcss.wgsl) and the half-widths per unit of 1/depth
+//! (`methods::pcss::half_per_w`).
 
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, upload};
-use super::front_layer::{AfterFront, FrontLayer};
+use super::front_layer::FrontLayer;
+use super::method_kernel::{mismatch, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::maps::LightTriangles;
-use crate::eye::{Bias, EyeMaps, Framed};
+use crate::eye::EyeMaps;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::plane_gradient::{split, Plane};
 use crate::methods::pcss::{half_per_w, MAX_TAPS};
-use crate::methods::LightPoint;
+use crate::methods::{LightPoint, Method};
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
@@ -380,18 +381,15 @@ impl PcssShading {
 }
 
 /// The eye view's PCSS (`maps::shade` with `Method::Pcss` on the device):
-/// the visibility per visible point of `f`, the front layer (user depth),
+/// the visibility per visible point of `e.f`, the front layer (user depth),
 /// and the device's stage times.
-pub(crate) fn shade_points(
+fn shade_points(
     g: &Gpu,
-    f: &Framed,
-    tris: &LightTriangles,
-    grid: MapGrid,
+    e: &EyeInputs,
     max_taps: u32,
-    bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let mut front = FrontLayer::new(g, f, tris, grid, bias, true)?;
+    let mut front = FrontLayer::new(g, e.f, e.tris, e.grid, e.bias, true)?;
     sw.lap("setup");
     // The points and planes are the kernel's alone (`shade` reads their
     // bounds only).
@@ -400,25 +398,67 @@ pub(crate) fn shade_points(
     let planes = std::mem::take(&mut front.points.planes);
     front.shade(
         g,
-        f,
+        e.f,
         "softshadow eye pcss",
         2,
-        || PcssShading::points(g, &grid, f.light_shape, max_taps, 0, &points, &planes),
+        || PcssShading::points(g, &grid, e.f.light_shape, max_taps, 0, &points, &planes),
         sw,
     )
 }
 
-impl AfterFront for PcssShading {
+impl Stage for PcssShading {
     fn record(
         &self,
         g: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         timer: &StageTimer,
         maps: &wgpu::Buffer,
-    ) {
-        PcssShading::record(self, g, enc, timer, maps)
+    ) -> Result<()> {
+        PcssShading::record(self, g, enc, timer, maps);
+        Ok(())
     }
-    fn visibility(&self) -> (&wgpu::Buffer, u64) {
-        (&self.vis, self.vis_bytes)
+
+    fn outputs(&self) -> Vec<(&wgpu::Buffer, u64)> {
+        vec![(&self.vis, self.vis_bytes)]
+    }
+}
+
+/// PCSS's kernel: the front layer, in the maps of the light view (after the
+/// receiver map) or rasterized for the eye view's points.
+pub(super) struct PcssKernel;
+
+impl GpuKernel for PcssKernel {
+    fn check(&self, _method: Method) -> Result<()> {
+        Ok(())
+    }
+
+    fn light_view<'a>(
+        &self,
+        g: &'a Gpu,
+        method: Method,
+        i: LightViewInputs<'a>,
+    ) -> Result<Option<MakeStage<'a>>> {
+        let Method::Pcss { max_taps } = method else {
+            return Err(mismatch(method));
+        };
+        Ok(Some(Box::new(move || {
+            // The front layer follows the receiver map.
+            let front = i.grid.len() as u32;
+            let sh = PcssShading::maps(g, i.grid, i.occluder_grid, i.light_shape, max_taps, front)?;
+            Ok(Box::new(sh) as Box<dyn Stage>)
+        })))
+    }
+
+    fn eye(
+        &self,
+        g: &Gpu,
+        method: Method,
+        inputs: &EyeInputs,
+        sw: &mut Stopwatch,
+    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+        let Method::Pcss { max_taps } = method else {
+            return Err(mismatch(method));
+        };
+        shade_points(g, inputs, max_taps, sw)
     }
 }

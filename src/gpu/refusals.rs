@@ -1,9 +1,10 @@
 //! What the GPU backend refuses before any device work, shared by its
-//! stages: a method it has no kernel for, maps larger than its fixed-point
-//! coordinates allow, and point lights, which have no GPU kernel.
+//! stages: maps larger than its fixed-point coordinates allow, buffers
+//! larger than one binding, and point lights, which have no GPU kernel.
+//! (A method's options: its kernel's `GpuKernel::check`.)
 
+use super::context::Gpu;
 use crate::error::{Error, Result};
-use crate::methods::Method;
 
 /// The largest map side on the GPU (`crate::backend::GPU_MAX_SIDE`).
 pub(crate) const MAX_SIDE: usize = crate::backend::GPU_MAX_SIDE;
@@ -30,13 +31,17 @@ pub(crate) fn point_light_on_gpu(arg: &str) -> Error {
     )
 }
 
-/// Refuses a method the GPU has no kernel for. `exact` (exact.rs), PCSS
-/// (pcss.rs) and Smoothies (smoothies.rs) have kernels of their own; the
-/// gather methods are refused by the variant they would run
-/// (`gather::check_method`).
-pub(crate) fn check_method(method: Method) -> Result<()> {
-    if method.traces() || matches!(method, Method::Pcss { .. }) {
-        return Ok(());
+/// Refuses a buffer of the eye view that one binding cannot hold.
+pub(super) fn fits(g: &Gpu, arg: &str, bytes: u64) -> Result<()> {
+    if bytes > g.max_storage_binding {
+        return Err(Error::too_large(
+            arg,
+            format!(
+                "the eye view needs {bytes} bytes in one GPU buffer; the device binds at most {}; \
+                 use backend=\"cpu\"",
+                g.max_storage_binding
+            ),
+        ));
     }
-    super::gather::check_method(method)
+    Ok(())
 }

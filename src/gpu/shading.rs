@@ -1,4 +1,5 @@
-//! The shading stage on the GPU, shared by both entry points (meshes, depth
+//! The gather methods' shading stage on the GPU (`GatherKernel`'s light
+//! view, `gather_points.rs`), shared by both entry points (meshes, depth
 //! maps): from occluder and receiver maps already in a `maps` buffer
 //! (receiver at 0, then the occluder layers) to the visibility, in two passes
 //! ("row_stats", "shadow"). Bitmask with closed gaps also reads the layers'
@@ -8,6 +9,7 @@ use super::context::Gpu;
 use super::dispatch::{storage, upload};
 use super::gather::{self, GatherBuffers, GatherParams};
 use super::light;
+use super::method_kernel::Stage;
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
@@ -106,8 +108,8 @@ pub struct Shading {
     axes: wgpu::Buffer,
     tables: Option<wgpu::Buffer>,
     corners: Option<wgpu::Buffer>,
-    pub vis: wgpu::Buffer,
-    pub vis_bytes: u64,
+    vis: wgpu::Buffer,
+    vis_bytes: u64,
 }
 
 impl Shading {
@@ -168,9 +170,11 @@ impl Shading {
             vis_bytes,
         }
     }
+}
 
+impl Stage for Shading {
     /// Records the passes "row_stats" and "shadow" reading `maps`.
-    pub fn record(
+    fn record(
         &self,
         g: &Gpu,
         enc: &mut wgpu::CommandEncoder,
@@ -203,5 +207,9 @@ impl Shading {
             &self.params,
             self.chunks,
         )
+    }
+
+    fn outputs(&self) -> Vec<(&wgpu::Buffer, u64)> {
+        vec![(&self.vis, self.vis_bytes)]
     }
 }

@@ -11,7 +11,7 @@
 //! and never the binning), and the q coordinates of the map's texel centres
 //! (computed in f64 as buffer.rs computes them). The front occluder layer
 //! (the shadow map) is rasterized on the device by `raster.wgsl`, bit for bit
-//! the CPU's.
+//! the CPU's. Both views run as `SmoothiesKernel` (its `GpuKernel`).
 //!
 //! Work bound: one invocation per shadow-map texel reads the smoothies of its
 //! tile, at most `PER_CHUNK` a dispatch (lavapipe stops an invocation after
@@ -26,14 +26,16 @@
 
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
-use super::front_layer::{AfterFront, FrontLayer};
+use super::front_layer::FrontLayer;
+use super::method_kernel::{
+    mismatch, needs_triangles, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage,
+};
 use super::raster::NONE;
 #[cfg(test)]
 use super::readback::{submit_and_read, with_error_scopes};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::maps::LightTriangles;
-use crate::eye::{Bias, EyeMaps, Framed};
+use crate::eye::EyeMaps;
 use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -591,20 +593,20 @@ impl SmoothieShading {
     }
 }
 
-/// The smoothies' options of `method`, None for another method.
-pub fn options(method: Method) -> Option<Smoothies> {
+/// The smoothies' options of `method`.
+fn options(method: Method) -> Result<Smoothies> {
     match method {
-        Method::Smoothies { width, falloff } => Some(Smoothies {
+        Method::Smoothies { width, falloff } => Ok(Smoothies {
             width: width.0,
             falloff,
         }),
-        _ => None,
+        _ => Err(mismatch(method)),
     }
 }
 
 /// The light view's steps 2-3: the occluders as `method.rs` hands them to
 /// the CPU method (f32 light-space triangles, a soup the silhouette welds).
-pub fn prepare_light_view(
+fn prepare_light_view(
     g: &Gpu,
     s: &Smoothies,
     og: &MapGrid,
@@ -620,19 +622,17 @@ pub fn prepare_light_view(
 }
 
 /// The eye view's Smoothies on the device (`maps::shade`'s Smoothies arm):
-/// the front layer of every mesh on `grid` (raster.wgsl), the smoothies of
-/// the scene's silhouette (CPU), the buffer and the lookup at the biased
+/// the front layer of every mesh on `e.grid` (raster.wgsl), the smoothies
+/// of the scene's silhouette (CPU), the buffer and the lookup at the biased
 /// points; the visibility per point, the maps, the device's stage times.
-pub(super) fn shade_eye(
+fn shade_eye(
     g: &Gpu,
-    f: &Framed,
-    tris: &LightTriangles,
-    grid: MapGrid,
+    e: &EyeInputs,
     s: &Smoothies,
-    bias: &Bias,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let front = FrontLayer::new(g, f, tris, grid, bias, true)?;
+    let (f, tris, grid) = (e.f, e.tris, e.grid);
+    let front = FrontLayer::new(g, f, tris, grid, e.bias, true)?;
     // Every mesh is an occluder: the silhouette straight from the mesh.
     let prepared = Prepared::new(s, &grid, f.light_shape, &tris.verts, tris.faces, PER_CHUNK);
     prepared.check_fits(g)?;
@@ -655,18 +655,61 @@ pub(super) fn shade_eye(
     )
 }
 
-impl AfterFront for SmoothieShading {
+impl Stage for SmoothieShading {
     fn record(
         &self,
         g: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         timer: &StageTimer,
         maps: &wgpu::Buffer,
-    ) {
-        SmoothieShading::record(self, g, enc, timer, maps)
+    ) -> Result<()> {
+        SmoothieShading::record(self, g, enc, timer, maps);
+        Ok(())
     }
-    fn visibility(&self) -> (&wgpu::Buffer, u64) {
-        (&self.vis, self.vis_bytes)
+
+    fn outputs(&self) -> Vec<(&wgpu::Buffer, u64)> {
+        vec![(&self.vis, self.vis_bytes)]
+    }
+}
+
+/// Smoothies' kernel: steps 2-3 on the CPU, the buffer and the lookup on
+/// the device, over the front layer (the light view's after the receiver
+/// map, or rasterized for the eye view's points).
+pub(super) struct SmoothiesKernel;
+
+impl GpuKernel for SmoothiesKernel {
+    fn check(&self, _method: Method) -> Result<()> {
+        Ok(())
+    }
+
+    fn light_view<'a>(
+        &self,
+        g: &'a Gpu,
+        method: Method,
+        i: LightViewInputs<'a>,
+    ) -> Result<Option<MakeStage<'a>>> {
+        let s = options(method)?;
+        let (verts, faces) = i.occluders.ok_or_else(|| needs_triangles(method))?;
+        let p = prepare_light_view(g, &s, i.occluder_grid, i.light_shape, verts, faces)?;
+        Ok(Some(Box::new(move || {
+            let receivers = Receivers::Map {
+                grid: i.grid,
+                offset: 0,
+            };
+            // The front layer follows the receiver map.
+            let sh = SmoothieShading::new(g, &p, i.grid.len() as u32, receivers);
+            Ok(Box::new(sh) as Box<dyn Stage>)
+        })))
+    }
+
+    fn eye(
+        &self,
+        g: &Gpu,
+        method: Method,
+        inputs: &EyeInputs,
+        sw: &mut Stopwatch,
+    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+        shade_eye(g, inputs, &options(method)?, sw)
     }
 }
 

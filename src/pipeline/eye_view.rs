@@ -1,6 +1,6 @@
 //! The eye view's one orchestrator: the same sequence of stages on the CPU
-//! (`eye::CpuEye`) or the GPU (`gpu::GpuEye`), so that both backends frame,
-//! focus and shade alike and a new stage is added once.
+//! (`eye::CpuEye`) or the GPU (`gpu::eye::GpuEye`), so that both backends
+//! frame, focus and shade alike and a new stage is added once.
 //!
 //! first hits (the G-buffer) -> `transform` (the visible points' light
 //! space, `eye::framing`) -> per method: `exact`'s shadow rays from each
@@ -36,7 +36,7 @@ pub fn render(call: &EyeCall, backend: Backend) -> Result<(EyeImage, MethodConfi
     match backend {
         Backend::Cpu => render_with(&mut CpuEye, call),
         #[cfg(feature = "gpu")]
-        Backend::Gpu => render_with(&mut crate::gpu::GpuEye::default(), call),
+        Backend::Gpu => render_with(&mut crate::gpu::eye::GpuEye::default(), call),
         #[cfg(not(feature = "gpu"))]
         Backend::Gpu => Err(crate::backend::not_built()),
     }

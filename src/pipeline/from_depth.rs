@@ -33,7 +33,11 @@ pub fn from_depth(
     match backend {
         Backend::Cpu => from_depth_with(&mut CpuLightView, maps, method),
         #[cfg(feature = "gpu")]
-        Backend::Gpu => from_depth_with(&mut crate::gpu::GpuLightView::default(), maps, method),
+        Backend::Gpu => from_depth_with(
+            &mut crate::gpu::light_view::GpuLightView::default(),
+            maps,
+            method,
+        ),
         #[cfg(not(feature = "gpu"))]
         Backend::Gpu => Err(crate::backend::not_built()),
     }

@@ -24,7 +24,7 @@ pub fn from_meshes(
         Backend::Cpu => from_meshes_with(&mut CpuLightView, occluders, receivers, light, s),
         #[cfg(feature = "gpu")]
         Backend::Gpu => from_meshes_with(
-            &mut crate::gpu::GpuLightView::default(),
+            &mut crate::gpu::light_view::GpuLightView::default(),
             occluders,
             receivers,
             light,
