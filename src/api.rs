@@ -443,13 +443,17 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         MethodConfig::Auto(a) => a.target.error.map(|e| e.0),
         _ => None,
     };
-    let run = |m: &MethodConfig| {
-        pipeline::eye_view::render(
+    // `exact` runs of the call share their first hits, framing and BVH:
+    // a pilot or a refinement pays for its rays and its estimate only.
+    let mut traced = None;
+    let mut run = |m: &MethodConfig| {
+        pipeline::eye_view::render_reusing(
             &EyeCall {
                 method: *m,
                 ..planned
             },
             backend,
+            &mut traced,
         )
     };
     let mut refinements = vec![];
@@ -468,7 +472,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
             (first, seconds),
             &mut refinements,
             |img: &EyeImage| img.estimate,
-            run,
+            &mut run,
         )?;
         Ok(((image, method), replaced))
     })?;

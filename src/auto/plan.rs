@@ -560,11 +560,12 @@ pub const EYE_EXACT: f64 = 0.12;
 /// penumbrae are narrow (the sun, small lights) at a fraction of the law's
 /// count, which is fitted to the widest; the others run the law's count
 /// after it (`refine.rs` grows an `exact` run below the law's count to at
-/// most that count). Measured on the calibration scenes at 320x240:
-/// spheres_sun_high and stairs_low_sun met 0.005 at 16 samples (the
-/// estimate's upper end 0.0017) where the law runs 576, 3.6-25x less time;
-/// the six area-light scenes missed (0.024-0.035) and then ran the law's
-/// count, the pilot adding 10-20% to their time.
+/// most that count); the runs share their first hits, framing and BVH
+/// (`pipeline::eye_view::Traced`). Measured on the calibration scenes at
+/// 320x240: spheres_sun_high and stairs_low_sun met 0.005 at 16 samples
+/// (the estimate's upper end 0.0017) where the law runs 576, 3-25x less
+/// time; the six area-light scenes missed (0.024-0.035) and then ran the
+/// law's count, the pilot adding up to 21% to their time (docs/methods/auto.md).
 pub const EYE_PILOT: u32 = 16;
 
 /// The most samples a refinement gives `exact` (its estimate traces four

@@ -86,7 +86,7 @@ pub fn estimate(
     estimate_with(
         f,
         size,
-        triangles,
+        Occluders::Triangles(triangles),
         visibility,
         samples,
         (units, budget),
@@ -94,12 +94,44 @@ pub fn estimate(
     )
 }
 
+/// `estimate`, its rays through `bvh` (`exact`'s own tree of the same
+/// triangles: nothing to cull or build).
+pub fn estimate_in(
+    f: &Framed,
+    size: (usize, usize),
+    bvh: &Bvh,
+    visibility: &[f32],
+    samples: u32,
+    (how, spent): (Draw, f64),
+) -> ErrorEstimate {
+    let (units, budget) = match how {
+        Draw::Timed => (MAX_UNITS, SHARE * spent),
+        Draw::Fixed => (PLANNED_UNITS, f64::INFINITY),
+    };
+    estimate_with(
+        f,
+        size,
+        Occluders::Tree(bvh),
+        visibility,
+        samples,
+        (units, budget),
+        true,
+    )
+}
+
+/// What the estimate's rays meet: a tree already built, or the triangles,
+/// culled to each batch's shafts (`in_shaft`) or built into one tree.
+enum Occluders<'a> {
+    Tree(&'a Bvh),
+    Triangles(Vec<[Vec3; 3]>),
+}
+
 /// `estimate`; `cull` false traces every batch through one BVH of the
 /// whole scene (the tests hold that culling changes no ray).
 fn estimate_with(
     f: &Framed,
     (width, height): (usize, usize),
-    triangles: Vec<[Vec3; 3]>,
+    occluders: Occluders,
     visibility: &[f32],
     samples: u32,
     (most, budget): (usize, f64),
@@ -117,6 +149,10 @@ fn estimate_with(
     });
     let total = units.len().min(most);
     let order = strata_order((&shadow, &lit), total, SHADOW_SHARE);
+    let (given, triangles) = match occluders {
+        Occluders::Tree(bvh) => (Some(bvh), vec![]),
+        Occluders::Triangles(t) => (None, t),
+    };
     let boxes: Vec<(Vec3, Vec3)> = triangles
         .par_iter()
         .map(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])))
@@ -126,7 +162,8 @@ fn estimate_with(
     strata[0].population = shadow.len();
     strata[1].population = lit.len();
     let (mut traced, mut culled, mut cull_seconds) = (0, 0usize, 0f64);
-    let mut whole: Option<Bvh> = (!cull).then(|| Bvh::build_fast(triangles.clone()));
+    let mut whole: Option<Bvh> =
+        (!cull && given.is_none()).then(|| Bvh::build_fast(triangles.clone()));
     for batch in order.chunks(BATCH) {
         let elapsed = t0.elapsed().as_secs_f64();
         if traced > 0 && elapsed > budget {
@@ -134,7 +171,7 @@ fn estimate_with(
         }
         // Culling tests every triangle once a tile: past TESTS_PER_BUILD
         // tiles one BVH of the scene costs less, if it fits the budget.
-        if whole.is_none() && culled >= TESTS_PER_BUILD {
+        if given.is_none() && whole.is_none() && culled >= TESTS_PER_BUILD {
             let build = cull_seconds / culled as f64 * TESTS_PER_BUILD as f64;
             if elapsed + build <= budget {
                 whole = Some(Bvh::build_fast(triangles.clone()));
@@ -152,7 +189,7 @@ fn estimate_with(
         // image's.
         let key = |j: usize| f.hits[pixels[j]] as u64;
         let identity: Vec<usize> = (0..pixels.len()).collect();
-        let exact = match &whole {
+        let exact = match given.or(whole.as_ref()) {
             Some(bvh) => rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples),
             None => {
                 let t = Instant::now();
@@ -296,13 +333,27 @@ mod tests {
         let tris = traced_triangles(&f, &scene);
         let size = (camera.width, camera.height);
         // A budget no batch reaches: every unit is traced both ways.
-        let a = estimate_with(&f, size, tris.clone(), &v, 64, (MAX_UNITS, 1e9), true);
-        let b = estimate_with(&f, size, tris, &v, 64, (MAX_UNITS, 1e9), false);
-        assert!(a.shadowed > 0 && a.traced == b.traced);
-        assert_eq!(
-            (a.error, a.low, a.high, a.shadowed),
-            (b.error, b.low, b.high, b.shadowed)
+        let whole = |t: &Vec<[Vec3; 3]>| Occluders::Triangles(t.clone());
+        let a = estimate_with(&f, size, whole(&tris), &v, 64, (MAX_UNITS, 1e9), true);
+        let b = estimate_with(&f, size, whole(&tris), &v, 64, (MAX_UNITS, 1e9), false);
+        // Through `exact`'s own tree (its SAH build) too.
+        let bvh = Bvh::build(tris.clone());
+        let c = estimate_with(
+            &f,
+            size,
+            Occluders::Tree(&bvh),
+            &v,
+            64,
+            (MAX_UNITS, 1e9),
+            true,
         );
+        assert!(a.shadowed > 0 && a.traced == b.traced && a.traced == c.traced);
+        for e in [&b, &c] {
+            assert_eq!(
+                (a.error, a.low, a.high, a.shadowed),
+                (e.error, e.low, e.high, e.shadowed)
+            );
+        }
         // A fixed draw: PLANNED_UNITS units (96 x 72 has more), the same
         // estimate whatever the call has spent.
         let tris = traced_triangles(&f, &scene);

@@ -13,10 +13,10 @@ use crate::backend::Backend;
 use crate::error::Result;
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
+use crate::methods::exact::Bvh;
 use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::MethodConfig;
 use crate::timing::{Stopwatch, Timings};
-use glam::Vec3;
 
 /// The stages of the eye view on one backend. Each returns what the next
 /// reads; stage times go to `sw` (the device's own, where it has them, are
@@ -43,11 +43,13 @@ pub trait EyeStages {
     ) -> Result<Vec<f32>>;
 
     /// `exact`: the visibility of each visible point of `f` from `samples`
-    /// stratified shadow rays through the triangles `tris`.
+    /// stratified shadow rays through `bvh` (the triangles that can shadow
+    /// a visible point, built once a call: the error estimate and `Auto`'s
+    /// further runs trace it too).
     fn trace(
         &mut self,
         f: &Framed,
-        tris: Vec<[Vec3; 3]>,
+        bvh: &Bvh,
         camera: &Camera,
         samples: u32,
         sw: &mut Stopwatch,
@@ -97,7 +99,7 @@ impl EyeStages for CpuEye {
     fn trace(
         &mut self,
         f: &Framed,
-        tris: Vec<[Vec3; 3]>,
+        bvh: &Bvh,
         camera: &Camera,
         samples: u32,
         _sw: &mut Stopwatch,
@@ -105,9 +107,9 @@ impl EyeStages for CpuEye {
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
         let order = rays::tiled(&f.hits, camera.width, camera.height);
         // Each point's jitter key is its pixel (as on the GPU).
-        Ok(rays::visibility(
+        Ok(rays::visibility_in(
+            bvh,
             f.light_shape,
-            tris,
             &starts,
             |k| f.hits[k] as u64,
             &order,

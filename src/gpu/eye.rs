@@ -54,7 +54,6 @@ use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::MethodConfig;
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -189,7 +188,7 @@ impl EyeStages for GpuEye {
     fn trace(
         &mut self,
         f: &Framed,
-        tris: Vec<[Vec3; 3]>,
+        bvh: &Bvh,
         _camera: &Camera,
         samples: u32,
         sw: &mut Stopwatch,
@@ -200,7 +199,7 @@ impl EyeStages for GpuEye {
             .zip(&f.hits)
             .map(|(s, &pixel)| GpuRayStart::new(s, pixel))
             .collect();
-        let (v, t) = exact_visibility(gpu()?, tris, &starts, samples, f.light_shape, sw)?;
+        let (v, t) = exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
         Ok(v)
     }
@@ -381,7 +380,7 @@ impl GpuRayStart {
 /// light space) on the device; and the device's stage times.
 fn exact_visibility(
     g: &Gpu,
-    tris: Vec<[Vec3; 3]>,
+    bvh: &Bvh,
     starts: &[GpuRayStart],
     samples: u32,
     light_shape: LightShape,
@@ -392,8 +391,7 @@ fn exact_visibility(
         return Ok((vec![], vec![]));
     }
     fits(g, "resolution", n as u64 * size_of::<GpuRayStart>() as u64)?;
-    let has_tris = !tris.is_empty();
-    let bvh = Bvh::build(tris);
+    let has_tris = !bvh.is_empty();
     let mut params = ExactParams {
         rec_w: n as u32,
         rec_h: 1,

@@ -13,13 +13,15 @@ use crate::backend::Backend;
 use crate::error::Result;
 use crate::error_estimate::Draw;
 use crate::eye::estimate::{self, REFERENCE_SAMPLES};
+use crate::eye::framing::Framed;
 use crate::eye::framing::{
     casting_faces, exact_samples, frame, light_triangles, map_grid, resolve_at_camera,
     traced_triangles,
 };
-use crate::eye::gbuffer::SceneTriangles;
+use crate::eye::gbuffer::{GBuffer, SceneTriangles};
 use crate::eye::{shadow_mapping, CpuEye, EyeCall, EyeImage, EyeStages};
 use crate::methods::config::MAX_SAMPLES;
+use crate::methods::exact::Bvh;
 use crate::methods::MethodConfig;
 use crate::timing::Stopwatch;
 use glam::Vec3;
@@ -30,22 +32,51 @@ fn elapsed(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
 }
 
+/// What an `exact` run of a call built that another `exact` run of the same
+/// call (other samples: `Auto`'s pilot and refinements, `auto/refine.rs`)
+/// reads again: the first hits, the framing and the BVH of the triangles
+/// the rays meet. A run that reuses them times none of those stages (the
+/// run that built them did).
+pub struct Traced {
+    g: GBuffer,
+    f: Framed,
+    bvh: Bvh,
+}
+
 /// Renders the visibility image of `call` on `backend`; returns the config
 /// that ran (resolved for that backend).
 pub fn render(call: &EyeCall, backend: Backend) -> Result<(EyeImage, MethodConfig)> {
     match backend {
-        Backend::Cpu => render_with(&mut CpuEye, call),
+        Backend::Cpu => render_with(&mut CpuEye, call, None),
         #[cfg(feature = "gpu")]
-        Backend::Gpu => render_with(&mut crate::gpu::eye::GpuEye::default(), call),
+        Backend::Gpu => render_with(&mut crate::gpu::eye::GpuEye::default(), call, None),
         #[cfg(not(feature = "gpu"))]
         Backend::Gpu => Err(crate::backend::not_built()),
     }
 }
 
-/// The stages of `call` in order, on `stages`' backend.
+/// `render`, an `exact` run reusing `reuse` (taken from a run of the same
+/// call) or leaving there what it built.
+pub fn render_reusing(
+    call: &EyeCall,
+    backend: Backend,
+    reuse: &mut Option<Traced>,
+) -> Result<(EyeImage, MethodConfig)> {
+    match backend {
+        Backend::Cpu => render_with(&mut CpuEye, call, Some(reuse)),
+        #[cfg(feature = "gpu")]
+        Backend::Gpu => render_with(&mut crate::gpu::eye::GpuEye::default(), call, Some(reuse)),
+        #[cfg(not(feature = "gpu"))]
+        Backend::Gpu => Err(crate::backend::not_built()),
+    }
+}
+
+/// The stages of `call` in order, on `stages`' backend; an `exact` run
+/// reuses what `reuse` holds, or leaves its own there.
 pub fn render_with<S: EyeStages>(
     stages: &mut S,
     call: &EyeCall,
+    reuse: Option<&mut Option<Traced>>,
 ) -> Result<(EyeImage, MethodConfig)> {
     let start = Instant::now();
     let size = (call.camera.width, call.camera.height);
@@ -81,6 +112,9 @@ pub fn render_with<S: EyeStages>(
         return Ok((image, method));
     }
     stages.check(call)?;
+    if call.method.kernel().traces() {
+        return render_traced(stages, call, reuse, start);
+    }
     let mut sw = Stopwatch::new();
     let scene = SceneTriangles::new(call.meshes)?;
     let g = stages.first_hits(call.camera, &scene)?;
@@ -92,32 +126,7 @@ pub fn render_with<S: EyeStages>(
     let mut maps = None;
     let mut estimate = None;
     let method;
-    if call.method.kernel().traces() {
-        method = resolve_at_camera(call, S::BACKEND)?;
-        let samples = exact_samples(call, &method);
-        let tris = traced_triangles(&f, &scene);
-        sw.lap("triangles");
-        let again = call.estimate_error.map(|how| (how, tris.clone()));
-        let v = stages.trace(&f, tris, call.camera, samples, &mut sw)?;
-        sw.lap("shadow");
-        // `exact` against itself with four times its samples: its own
-        // sampling error.
-        if let Some((how, tris)) = again {
-            let more = samples.saturating_mul(4).min(MAX_SAMPLES);
-            estimate = Some(estimate::estimate(
-                &f,
-                size,
-                tris,
-                &v,
-                more,
-                (how, elapsed(start)),
-            ));
-            sw.lap("estimate");
-        }
-        for (&k, v) in f.hits.iter().zip(v) {
-            visibility[k] = v;
-        }
-    } else if !f.points.is_empty() {
+    if !f.points.is_empty() {
         let casting = casting_faces(call, &scene, &f);
         let (grid, m) = map_grid(call, &g, &f, &casting, S::BACKEND)?;
         method = m;
@@ -166,4 +175,66 @@ pub fn render_with<S: EyeStages>(
         },
         method,
     ))
+}
+
+/// `exact`: shadow rays from each visible point (`EyeStages::trace`) through
+/// one BVH, which the error estimate traces too; the first hits, framing
+/// and BVH from `reuse` where a run of the same call left them.
+fn render_traced<S: EyeStages>(
+    stages: &mut S,
+    call: &EyeCall,
+    mut reuse: Option<&mut Option<Traced>>,
+    start: Instant,
+) -> Result<(EyeImage, MethodConfig)> {
+    let size = (call.camera.width, call.camera.height);
+    let method = resolve_at_camera(call, S::BACKEND)?;
+    let samples = exact_samples(call, &method);
+    let mut sw = Stopwatch::new();
+    let Traced { g, f, bvh } = match reuse.as_mut().and_then(|r| r.take()) {
+        Some(t) => t,
+        None => {
+            let scene = SceneTriangles::new(call.meshes)?;
+            let g = stages.first_hits(call.camera, &scene)?;
+            sw.lap("first_hits");
+            let f = frame(call, &scene, &g)?;
+            sw.lap("transform");
+            let tris = traced_triangles(&f, &scene);
+            sw.lap("triangles");
+            let bvh = Bvh::build(tris);
+            sw.lap("bvh");
+            Traced { g, f, bvh }
+        }
+    };
+    let v = stages.trace(&f, &bvh, call.camera, samples, &mut sw)?;
+    sw.lap("shadow");
+    // `exact` against itself with four times its samples, through the same
+    // tree: its own sampling error.
+    let estimate = call.estimate_error.map(|how| {
+        let more = samples.saturating_mul(4).min(MAX_SAMPLES);
+        let e = estimate::estimate_in(&f, size, &bvh, &v, more, (how, elapsed(start)));
+        sw.lap("estimate");
+        e
+    });
+    let mut visibility = vec![1f32; g.len()];
+    for (&k, v) in f.hits.iter().zip(v) {
+        visibility[k] = v;
+    }
+    let timings = stages.timings(sw.timings);
+    let (gbuffer, light_space) = match reuse {
+        Some(r) => {
+            let kept = (g.clone(), f.space);
+            *r = Some(Traced { g, f, bvh });
+            kept
+        }
+        None => (g, f.space),
+    };
+    let image = EyeImage {
+        gbuffer,
+        visibility,
+        maps: None,
+        light_space,
+        timings,
+        estimate,
+    };
+    Ok((image, method))
 }
