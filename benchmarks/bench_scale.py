@@ -399,7 +399,8 @@ def main() -> None:
     intro = (
         f"Times are medians of {runs(args.repeats)} after a warm-up round, softshadow and Mitsuba "
         "alternating within each round. softshadow: the stages of `img.timings` of "
-        "`ss.render(..., method=ss.Exact(samples=n))` (its `shadow` stage builds its BVH and traces). "
+        "`ss.render(..., method=ss.Exact(samples=n))` (`first hits` builds the camera's BVH and casts; "
+        "`bvh` builds the BVH of the triangles the shadow rays meet, `shadow` traces them). "
         "Mitsuba: `ray_intersect` on the pixel-centre camera rays and `ray_test(..., coherent=False)` on "
         "the shadow rays `MitsubaEyeJob` builds, the kernels alone (the rays built and evaluated first); "
         "its whole eye-view job beside them. *Rays*: the pixels on the light's front side times the "
