@@ -239,10 +239,6 @@ impl Stage for ExactShading {
 pub(super) struct ExactKernel;
 
 impl GpuKernel for ExactKernel {
-    fn check(&self, _method: Method) -> Result<()> {
-        Ok(())
-    }
-
     fn light_view<'a>(
         &self,
         g: &'a Gpu,

@@ -80,8 +80,11 @@ pub(super) struct EyeInputs<'a> {
 /// A method on the GPU, both views. Each takes the `Method` it was picked
 /// for (`super::kernel`), for its options.
 pub(super) trait GpuKernel: Sync {
-    /// Refuses, before any GPU work, options the kernel cannot run.
-    fn check(&self, method: Method) -> Result<()>;
+    /// Refuses, before any GPU work, options the kernel cannot run (by
+    /// default none).
+    fn check(&self, _method: Method) -> Result<()> {
+        Ok(())
+    }
 
     /// The light view's shading of `inputs`: the CPU's part now (in the
     /// orchestrator's "setup" stage), the device's in the `MakeStage`;

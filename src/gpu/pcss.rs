@@ -428,10 +428,6 @@ impl Stage for PcssShading {
 pub(super) struct PcssKernel;
 
 impl GpuKernel for PcssKernel {
-    fn check(&self, _method: Method) -> Result<()> {
-        Ok(())
-    }
-
     fn light_view<'a>(
         &self,
         g: &'a Gpu,

@@ -678,10 +678,6 @@ impl Stage for SmoothieShading {
 pub(super) struct SmoothiesKernel;
 
 impl GpuKernel for SmoothiesKernel {
-    fn check(&self, _method: Method) -> Result<()> {
-        Ok(())
-    }
-
     fn light_view<'a>(
         &self,
         g: &'a Gpu,
