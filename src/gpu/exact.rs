@@ -9,7 +9,6 @@
 
 use super::context::Gpu;
 use super::dispatch::{bind, module, pipeline, storage, uniform, upload};
-use super::light;
 use super::method_kernel::{
     mismatch, needs_triangles, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage,
 };
@@ -64,6 +63,18 @@ pub struct ExactParams {
     pub ax_rec_y: u32,
     pub _pad0: u32,
     pub _pad1: u32,
+}
+
+impl ExactParams {
+    /// The ray casters' sample pattern (na, nb, size_x, size_y): `samples`
+    /// strata over `light`, the one place a light shape reaches these
+    /// uniforms (exact.wgsl and eye_rays.wgsl read them through
+    /// light_shape.wgsl).
+    pub(super) fn set_light(&mut self, light: LightShape, samples: u32) {
+        let s = light.samples(samples);
+        (self.na, self.nb) = s.grid;
+        [self.size_x, self.size_y] = s.size;
+    }
 }
 
 struct ExactPipelines {
@@ -131,8 +142,7 @@ impl ExactShading {
             ax_rec_y: grid.width as u32,
             ..Default::default()
         };
-        let r = light::ray_fields(light_shape, samples);
-        (params.na, params.nb, params.size_x, params.size_y) = (r.na, r.nb, r.size_x, r.size_y);
+        params.set_light(light_shape, samples);
         ExactShading {
             params,
             samples: params.na * params.nb,

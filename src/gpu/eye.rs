@@ -34,7 +34,6 @@
 use super::context::{gpu, Gpu};
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
 use super::exact::{budget_error, ExactParams, BUDGET, SAMPLES_PER_CHUNK};
-use super::light;
 use super::method_kernel::EyeInputs;
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::refusals::{check_side, fits, point_light_on_gpu};
@@ -402,8 +401,7 @@ fn exact_visibility(
         t1: 1.0 - RAY_EPS,
         ..Default::default()
     };
-    let r = light::ray_fields(light_shape, samples);
-    (params.na, params.nb, params.size_x, params.size_y) = (r.na, r.nb, r.size_x, r.size_y);
+    params.set_light(light_shape, samples);
     let (na, nb) = (params.na, params.nb);
     let bytes = n as u64 * 4;
     let out = with_error_scopes(g, || {

@@ -1,8 +1,8 @@
-//! The light's shape as the shaders read it: the one place that turns a
-//! `LightShape` (geom/light_shape.rs) into uniform fields. The ray casters
-//! (exact.wgsl, eye_rays.wgsl) read the sample pattern, the strata na x nb
-//! and the rectangle (size_x, size_y), which `light_shape.wgsl` maps to
-//! light points; the map kernels (gather.wgsl and its methods) clip in
+//! The light's shape as the map kernels read it: the one place that turns a
+//! `LightShape` (geom/light_shape.rs) into their uniform fields (the ray
+//! casters' are `ExactParams::set_light`, exact.rs: the strata na x nb and
+//! the rectangle (size_x, size_y), which `light_shape.wgsl` maps to light
+//! points). The map kernels (gather.wgsl and its methods) clip in
 //! half-light units, reading (2/sx, 2/sy), (sx/2, sy/2) and the column
 //! edges scaled by 2/sx. Each value is the f32 the CPU kernels hold (one
 //! rounding from f64), so both backends start from the same bits.
@@ -10,25 +10,6 @@
 use super::gather::GatherParams;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-
-/// The ray casters' fields (`ExactParams`' na, nb, size_x, size_y).
-pub(super) struct RayFields {
-    pub na: u32,
-    pub nb: u32,
-    pub size_x: f32,
-    pub size_y: f32,
-}
-
-/// The ray casters' sample pattern: `samples` strata over `light`.
-pub(super) fn ray_fields(light: LightShape, samples: u32) -> RayFields {
-    let s = light.samples(samples);
-    RayFields {
-        na: s.grid.0,
-        nb: s.grid.1,
-        size_x: s.size[0],
-        size_y: s.size[1],
-    }
-}
 
 /// Sets the map kernels' half-light scales, and `wx`, the occluder
 /// texel's width (2 hw, `hw` its half-width in tangent units) in them.

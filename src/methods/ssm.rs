@@ -469,7 +469,7 @@ mod tests {
         let g = &inputs.grid;
         let og = &inputs.occluder_grid;
         let (hw, hh) = og.half_texel();
-        let LightShape::Rect { size: [lx, ly] } = inputs.light_shape;
+        let [lx, ly] = inputs.light_shape.extent();
         let overlap = |a: f64, b: f64| (b.clamp(0.0, 1.0) - a.clamp(0.0, 1.0)).max(0.0);
         let mut out = vec![1f32; g.len()];
         for jr in 0..g.height {

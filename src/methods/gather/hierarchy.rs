@@ -5,7 +5,6 @@
 //! the penumbra is wide. Built once per call in `Kernel::new`.
 
 use super::kernel::{Group, Kernel, Layer, Level, RowSpan, BLOCK};
-use crate::geom::light_shape::LightShape;
 use crate::methods::ShadowInputs;
 use rayon::prelude::*;
 
@@ -178,7 +177,7 @@ impl Kernel {
         let (hw, hh) = g.half_texel();
         // The rectangle's clipping: half-light units (light_shape.rs).
         let light = inputs.light_shape;
-        let LightShape::Rect { size: [lx, ly] } = light;
+        let [lx, ly] = light.extent();
         let half_light = light.half_light();
         // A layer equal to one already kept changes nothing (sums merge by
         // max, masks by OR), so it is not shaded: single-sided or flat
