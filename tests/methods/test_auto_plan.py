@@ -255,6 +255,11 @@ def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
     # a fixed set of pixels, whatever the machine's speed.
     again = ss.render(scene, light, cam, method=ss.Auto(error=0.01))
     assert again.method == img.method and np.array_equal(again.visibility, img.visibility)
+    # The refinements reuse the pilot's first hits, framing and BVH: the
+    # same bits as the setting they ran, rendered afresh.
+    fresh = ss.render(scene, light, cam, method=img.method)
+    assert np.array_equal(fresh.visibility, img.visibility) and np.array_equal(fresh.mesh_id, img.mesh_id)
+    assert "first_hits" not in img.timings and "first_hits" in fresh.timings
 
 
 def test_the_eye_views_pilot_stands_where_the_penumbrae_are_narrow():
