@@ -194,16 +194,12 @@ class MitsubaKernels:
         """Seconds of ``ray_test`` over the job's shadow rays at ``samples``
         per lit pixel, in the job's batches, the rays built beforehand."""
         dr = self.job.dr
-        small = int(math.isqrt(samples))
-        while samples % small:
-            small -= 1
-        size = self.job.size
-        a, b = (samples // small, small) if size[0] >= size[1] else (small, samples // small)
+        a, b = self.job.strata(samples)
         per = max(1, BATCH_RAYS // samples)
         seconds = 0.0
         for first in range(0, len(self.lit), per):
             sel = self.lit[first : first + per]
-            ray = self._rays(self.p[sel], self.n[sel], samples, a, b, first)
+            ray = self.job.shadow_rays(self.p[sel], self.n[sel], samples, a, b, first)
             dr.eval(ray)
             dr.sync_thread()
             t = time.perf_counter()
@@ -213,26 +209,6 @@ class MitsubaKernels:
             seconds += time.perf_counter() - t
             del ray, r
         return seconds
-
-    def _rays(self, p: np.ndarray, n: np.ndarray, k: int, a: int, b: int, seed: int) -> Any:
-        """The rays ``MitsubaEyeJob._shadow`` traces (its code, up to the
-        ``ray_test``)."""
-        job = self.job
-        mi, dr = job.mi, job.dr
-        total = len(p) * k
-        j = dr.arange(mi.UInt32, total)
-        pix = j // k
-        s = j % k
-        si = mi.SurfaceInteraction3f()
-        si.p = dr.gather(mi.Point3f, mi.Point3f(np.ascontiguousarray(p.T)), pix)
-        si.n = dr.gather(mi.Normal3f, mi.Normal3f(np.ascontiguousarray(n.T)), pix)
-        si.time = dr.zeros(mi.Float, total)
-        rng = mi.PCG32(size=total, initstate=mi.UInt64(j) + seed * k)
-        x = ((mi.Float(s % a) + rng.next_float32()) / a - 0.5) * job.size[0]
-        y = ((mi.Float(s // a) + rng.next_float32()) / b - 0.5) * job.size[1]
-        u, v = mi.Vector3f(*job.u.tolist()), mi.Vector3f(*job.v.tolist())
-        target = mi.Vector3f(*np.asarray(job.center, dtype=float).tolist()) + x * u + y * v
-        return si.spawn_ray(-dr.normalize(target)) if job.sun else si.spawn_ray_to(mi.Point3f(target))
 
 
 # --------------------------------------------------------------------------

@@ -443,18 +443,20 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         MethodConfig::Auto(a) => a.target.error.map(|e| e.0),
         _ => None,
     };
-    // `exact` runs of the call share their first hits, framing and BVH:
-    // a pilot or a refinement pays for its rays and its estimate only.
+    // `exact` runs of a call with a target share their first hits, framing
+    // and BVH: a pilot or a refinement pays for its rays and its estimate
+    // only. A call without one runs once and keeps nothing (no G-buffer
+    // copy).
     let mut traced = None;
     let mut run = |m: &MethodConfig| {
-        pipeline::eye_view::render_reusing(
-            &EyeCall {
-                method: *m,
-                ..planned
-            },
-            backend,
-            &mut traced,
-        )
+        let c = EyeCall {
+            method: *m,
+            ..planned
+        };
+        match error {
+            Some(_) => pipeline::eye_view::render_reusing(&c, backend, &mut traced),
+            None => pipeline::eye_view::render(&c, backend),
+        }
     };
     let mut refinements = vec![];
     let mut first_config = None;

@@ -237,15 +237,20 @@ mod tests {
         assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 100 }));
     }
 
-    #[test]
-    fn the_loop_reruns_until_met_and_counts_what_it_replaced() {
-        let mut d = vec![];
-        let first = (
-            estimate(0.03, 0.04, 10),
-            MethodConfig::Exact(ExactConfig { samples: 16 }),
-        );
-        let mut runs = vec![];
-        let (out, ran, replaced) = refined(
+    /// The loop from `first` (its estimate and the config that ran), each
+    /// run answering `reply`: the output, config and seconds replaced, the
+    /// configs run and the decisions.
+    #[allow(clippy::type_complexity)]
+    fn looped(
+        first: (ErrorEstimate, MethodConfig),
+        reply: ErrorEstimate,
+    ) -> (
+        (ErrorEstimate, MethodConfig, f64),
+        Vec<MethodConfig>,
+        Vec<Decision>,
+    ) {
+        let (mut d, mut runs) = (vec![], vec![]);
+        let out = refined(
             0.01,
             0.1,
             (first, 1.0),
@@ -253,52 +258,49 @@ mod tests {
             |e| Some(*e),
             |cfg| {
                 runs.push(*cfg);
-                Ok((estimate(0.005, 0.008, 10), *cfg))
+                Ok((reply, *cfg))
             },
         )
         .unwrap();
-        // The pilot's estimate asks 256; the law's 100 caps it.
-        assert_eq!(
-            runs,
-            vec![MethodConfig::Exact(ExactConfig { samples: 100 })]
+        (out, runs, d)
+    }
+
+    fn samples(runs: &[MethodConfig]) -> Vec<u32> {
+        runs.iter()
+            .map(|c| match c {
+                MethodConfig::Exact(e) => e.samples,
+                _ => 0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_loop_reruns_until_met_and_counts_what_it_replaced() {
+        let pilot = MethodConfig::Exact(ExactConfig { samples: 16 });
+        let ((out, ran, replaced), runs, d) = looped(
+            (estimate(0.03, 0.04, 10), pilot),
+            estimate(0.005, 0.008, 10),
         );
+        // The pilot's estimate asks 256; the law's 100 caps it.
+        assert_eq!(samples(&runs), [100]);
         assert_eq!(ran, runs[0]);
         assert_eq!(out.high, 0.008);
         assert_eq!(replaced, 1.0);
         let names: Vec<_> = d.iter().map(|d| d.name).collect();
         assert_eq!(names, ["refine", "target"]);
         assert!(d[1].taken);
-        // Never met: bounded by MAX_REFINES, and the verdict says so.
-        let mut d = vec![];
-        let first = (
-            estimate(0.015, 0.02, 10),
-            MethodConfig::Exact(ExactConfig { samples: 16 }),
-        );
-        let mut runs = vec![];
-        refined(
-            0.01,
-            0.1,
-            (first, 1.0),
-            &mut d,
-            |e| Some(*e),
-            |cfg| {
-                runs.push(*cfg);
-                Ok((estimate(0.015, 0.02, 10), *cfg))
-            },
-        )
-        .unwrap();
-        // A pilot (16 samples, under the law's 100) gets one run more: 64,
+        // Never met: bounded by MAX_REFINES, and the verdict says so. A
+        // pilot (16 samples, under the law's 100) gets one run more: 64,
         // then the law's 100, then 400.
+        let never = estimate(0.015, 0.02, 10);
+        let (_, runs, d) = looped((never, pilot), never);
         assert_eq!(runs.len(), MAX_REFINES + 1);
-        let counts: Vec<u32> = runs
-            .iter()
-            .map(|c| match c {
-                MethodConfig::Exact(e) => e.samples,
-                _ => 0,
-            })
-            .collect();
-        assert_eq!(counts, [64, 100, 400]);
+        assert_eq!(samples(&runs), [64, 100, 400]);
         assert!(!d.last().unwrap().taken);
+        // A first run at the law's count is no pilot: MAX_REFINES runs.
+        let law = MethodConfig::Exact(ExactConfig { samples: 100 });
+        let (_, runs, _) = looped((never, law), never);
+        assert_eq!(samples(&runs), [400, 1600]);
         // At the cap nothing more is run.
         let mut d = vec![];
         let top = MethodConfig::Exact(ExactConfig {

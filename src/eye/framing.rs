@@ -40,6 +40,29 @@ pub struct Framed {
     pub verts: Vec<DVec3>,
 }
 
+impl Framed {
+    /// The visible points biased and bounded for the map kernels on `grid`
+    /// (`maps::shading_points`), with their tangent planes where `planes`.
+    pub fn shading_points(
+        &self,
+        grid: &MapGrid,
+        bias: &maps::Bias,
+        planes: bool,
+    ) -> maps::ShadingPoints {
+        maps::shading_points(
+            &self.space,
+            self.unit,
+            self.light_shape,
+            grid,
+            &self.points,
+            &self.pts_ls,
+            &self.normals,
+            bias,
+            planes,
+        )
+    }
+}
+
 /// The light space, depth unit and light-space triangles of an image whose
 /// G-buffer is `g`.
 pub fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Framed> {

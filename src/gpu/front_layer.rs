@@ -58,17 +58,7 @@ impl FrontLayer {
             .iter()
             .map(GpuTri::from_setup)
             .collect();
-        let points = maps::shading_points(
-            &f.space,
-            f.unit,
-            f.light_shape,
-            &grid,
-            &f.points,
-            &f.pts_ls,
-            &f.normals,
-            bias,
-            planes,
-        );
+        let points = f.shading_points(&grid, bias, planes);
         Ok(FrontLayer {
             grid,
             occ_tris,

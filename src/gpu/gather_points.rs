@@ -203,17 +203,7 @@ fn shade_points(
         .iter()
         .fold(0f64, |m, q| m.max(1.0 / q.z.max(near)));
     // maps::shade's points: biased, `None` shaded as empty then 0.
-    let sp = maps::shading_points(
-        &f.space,
-        f.unit,
-        f.light_shape,
-        &grid,
-        &f.points,
-        &f.pts_ls,
-        &f.normals,
-        bias,
-        false,
-    );
+    let sp = f.shading_points(&grid, bias, false);
     let valid = &sp.points;
     let order = point_order(&grid, valid);
     let sorted: Vec<LightPoint> = order.iter().map(|&n| valid[n as usize]).collect();

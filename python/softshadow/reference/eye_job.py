@@ -67,10 +67,7 @@ class MitsubaEyeJob:
         else:
             lit = (p - self.center) @ self.n > 0
         vis = np.zeros(len(p), dtype=np.float32)
-        small = int(math.isqrt(samples))
-        while samples % small:
-            small -= 1
-        a, b = (samples // small, small) if self.size[0] >= self.size[1] else (small, samples // small)
+        a, b = self.strata(samples)
         chosen = np.flatnonzero(lit)
         per = max(1, BATCH_RAYS // samples)
         for first in range(0, len(chosen), per):
@@ -80,7 +77,17 @@ class MitsubaEyeJob:
         out[hit] = vis
         return out.reshape(h, w)
 
-    def _shadow(self, p: np.ndarray, n: np.ndarray, k: int, a: int, b: int, seed: int) -> np.ndarray:
+    def strata(self, samples: int) -> tuple[int, int]:
+        """The a x b stratification of ``samples`` over the light: the
+        largest divisor at most its square root across the shorter side."""
+        small = int(math.isqrt(samples))
+        while samples % small:
+            small -= 1
+        return (samples // small, small) if self.size[0] >= self.size[1] else (small, samples // small)
+
+    def shadow_rays(self, p: np.ndarray, n: np.ndarray, k: int, a: int, b: int, seed: int) -> Any:
+        """The ``k`` shadow rays of each point ``p`` (normal ``n``): one per
+        stratum of ``a`` x ``b``, jittered by PCG32 seeded by ``seed``."""
         mi, dr = self.mi, self.dr
         total = len(p) * k
         j = dr.arange(mi.UInt32, total)
@@ -95,7 +102,9 @@ class MitsubaEyeJob:
         y = ((mi.Float(s // a) + rng.next_float32()) / b - 0.5) * self.size[1]
         u, v = mi.Vector3f(*self.u.tolist()), mi.Vector3f(*self.v.tolist())
         target = mi.Vector3f(*np.asarray(self.center, dtype=float).tolist()) + x * u + y * v
-        ray = si.spawn_ray(-dr.normalize(target)) if self.sun else si.spawn_ray_to(mi.Point3f(target))
-        blocked = self.scene.ray_test(ray, coherent=False)
+        return si.spawn_ray(-dr.normalize(target)) if self.sun else si.spawn_ray_to(mi.Point3f(target))
+
+    def _shadow(self, p: np.ndarray, n: np.ndarray, k: int, a: int, b: int, seed: int) -> np.ndarray:
+        blocked = self.scene.ray_test(self.shadow_rays(p, n, k, a, b, seed), coherent=False)
         hits = np.asarray(blocked.numpy(), dtype=np.float32).reshape(len(p), k)
         return 1.0 - hits.mean(axis=1)
