@@ -153,7 +153,7 @@ fn configs() -> Vec<(&'static str, MethodConfig)> {
         ("bitmask256_hierarchy", bitmask(true)),
         (
             "exact64",
-            MethodConfig::Exact(ExactConfig::new(Some(64)).unwrap()),
+            MethodConfig::Exact(ExactConfig::of(64)),
         ),
     ]
 }
@@ -255,7 +255,7 @@ fn bench_kernels(c: &mut Criterion) {
                 gaps: Gaps::Closed,
             },
         ),
-        ("exact64", Method::Exact { samples: 64 }),
+        ("exact64", Method::Exact { samples: 64, probe: None }),
     ];
     let mut g = configure(c, "kernel");
     for (name, method) in kernels {

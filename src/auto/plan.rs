@@ -296,7 +296,7 @@ pub fn plan(stats: &SceneStats, target: &Target, probe_seconds: Option<f64>) -> 
                         CANDIDATES[CANDIDATES.len() - 1].worst_error
                     ),
                 });
-                MethodConfig::Exact(ExactConfig { samples })
+                MethodConfig::Exact(ExactConfig::of(samples))
             }
         }
     } else if let Some(Real(t)) = target.time {
@@ -625,7 +625,7 @@ pub fn plan_eye(target: &Target, rule: MethodConfig) -> Plan {
                 String::new()
             };
             (
-                MethodConfig::Exact(ExactConfig { samples: first }),
+                MethodConfig::Exact(ExactConfig::of(first)),
                 format!(
                     "no map setting measured within {e} in the eye view (the rule's maps: \
                      {EYE_RULE_ERROR}); exact with {n} samples a pixel (its error estimate \

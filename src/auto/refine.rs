@@ -57,7 +57,7 @@ pub fn next(
         e.error, e.high
     );
     let (samples, how) = match ran.kernel() {
-        Method::Exact { samples } => {
+        Method::Exact { samples, .. } => {
             if samples >= MAX_REFINED_SAMPLES {
                 return None;
             }
@@ -95,7 +95,7 @@ pub fn next(
             )
         }
     };
-    let cfg = MethodConfig::Exact(ExactConfig { samples });
+    let cfg = MethodConfig::Exact(ExactConfig::of(samples));
     let why = format!("{missed}: exact with {samples} samples a pixel ({how})");
     Some((
         cfg,
@@ -147,7 +147,7 @@ pub fn refined<T>(
     let (mut out, mut ran) = first;
     let (mut replaced, mut last) = (0.0, first_seconds);
     let pilot =
-        matches!(ran.kernel(), Method::Exact { samples } if samples < exact_samples(law, target));
+        matches!(ran.kernel(), Method::Exact { samples, .. } if samples < exact_samples(law, target));
     for _ in 0..MAX_REFINES + pilot as usize {
         let Some(e) = estimate_of(&out) else { break };
         if met(target, &e) {
@@ -193,27 +193,21 @@ mod tests {
 
     #[test]
     fn exact_grows_by_the_square_of_the_miss_and_stops_at_the_cap() {
-        let ran = MethodConfig::Exact(ExactConfig { samples: 100 });
+        let ran = MethodConfig::Exact(ExactConfig::of(100));
         let (cfg, d) = next(0.01, &ran, &estimate(0.015, 0.02, 10), 0.1).unwrap();
-        assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 400 }));
+        assert_eq!(cfg, MethodConfig::Exact(ExactConfig::of(400)));
         assert_eq!(d.name, "refine");
         // A miss by a hair still adds samples.
         let (cfg, _) = next(0.01, &ran, &estimate(0.01, 0.010_000_1, 10), 0.1).unwrap();
-        assert!(matches!(cfg, MethodConfig::Exact(ExactConfig { samples }) if samples > 100));
-        let big = MethodConfig::Exact(ExactConfig {
-            samples: MAX_REFINED_SAMPLES / 2,
-        });
+        assert!(matches!(cfg, MethodConfig::Exact(ExactConfig { samples, .. }) if samples > 100));
+        let big = MethodConfig::Exact(ExactConfig::of(MAX_REFINED_SAMPLES / 2));
         // (A law of 1.0 asks for the cap at 0.001: no pilot's bound.)
         let (cfg, _) = next(0.001, &big, &estimate(0.5, 0.6, 10), 1.0).unwrap();
         assert_eq!(
             cfg,
-            MethodConfig::Exact(ExactConfig {
-                samples: MAX_REFINED_SAMPLES
-            })
+            MethodConfig::Exact(ExactConfig::of(MAX_REFINED_SAMPLES))
         );
-        let top = MethodConfig::Exact(ExactConfig {
-            samples: MAX_REFINED_SAMPLES,
-        });
+        let top = MethodConfig::Exact(ExactConfig::of(MAX_REFINED_SAMPLES));
         assert!(next(0.001, &top, &estimate(0.5, 0.6, 10), 0.1).is_none());
     }
 
@@ -221,20 +215,20 @@ mod tests {
     fn a_pilot_grows_to_at_most_the_law_count() {
         // The law asks 100 for 0.01; a 16-sample pilot missing by 4x would
         // grow to 256 by its own estimate, and stops at 100.
-        let pilot = MethodConfig::Exact(ExactConfig { samples: 16 });
+        let pilot = MethodConfig::Exact(ExactConfig::of(16));
         let (cfg, _) = next(0.01, &pilot, &estimate(0.03, 0.04, 10), 0.1).unwrap();
-        assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 100 }));
+        assert_eq!(cfg, MethodConfig::Exact(ExactConfig::of(100)));
         // Missing by less, it grows by its estimate: 16 (0.017 / 0.01)² = 46.2,
         // rounded up to 7 x 7.
         let (cfg, _) = next(0.01, &pilot, &estimate(0.015, 0.017, 10), 0.1).unwrap();
-        assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 49 }));
+        assert_eq!(cfg, MethodConfig::Exact(ExactConfig::of(49)));
     }
 
     #[test]
     fn maps_that_miss_go_to_exact_by_the_law() {
         let ran = MethodConfig::Ssm(Default::default());
         let (cfg, _) = next(0.01, &ran, &estimate(0.05, 0.08, 10), 0.1).unwrap();
-        assert_eq!(cfg, MethodConfig::Exact(ExactConfig { samples: 100 }));
+        assert_eq!(cfg, MethodConfig::Exact(ExactConfig::of(100)));
     }
 
     /// The loop from `first` (its estimate and the config that ran), each
@@ -276,7 +270,7 @@ mod tests {
 
     #[test]
     fn the_loop_reruns_until_met_and_counts_what_it_replaced() {
-        let pilot = MethodConfig::Exact(ExactConfig { samples: 16 });
+        let pilot = MethodConfig::Exact(ExactConfig::of(16));
         let ((out, ran, replaced), runs, d) = looped(
             (estimate(0.03, 0.04, 10), pilot),
             estimate(0.005, 0.008, 10),
@@ -298,14 +292,12 @@ mod tests {
         assert_eq!(samples(&runs), [64, 100, 400]);
         assert!(!d.last().unwrap().taken);
         // A first run at the law's count is no pilot: MAX_REFINES runs.
-        let law = MethodConfig::Exact(ExactConfig { samples: 100 });
+        let law = MethodConfig::Exact(ExactConfig::of(100));
         let (_, runs, _) = looped((never, law), never);
         assert_eq!(samples(&runs), [400, 1600]);
         // At the cap nothing more is run.
         let mut d = vec![];
-        let top = MethodConfig::Exact(ExactConfig {
-            samples: MAX_REFINED_SAMPLES,
-        });
+        let top = MethodConfig::Exact(ExactConfig::of(MAX_REFINED_SAMPLES));
         let first = (estimate(0.5, 0.6, 10), top);
         let (_, _, replaced) = refined(
             0.01,

@@ -190,7 +190,7 @@ fn estimate_with(
         let key = |j: usize| f.hits[pixels[j]] as u64;
         let identity: Vec<usize> = (0..pixels.len()).collect();
         let exact = match given.or(whole.as_ref()) {
-            Some(bvh) => rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples),
+            Some(bvh) => rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples, None),
             None => {
                 let t = Instant::now();
                 culled += batch.len();
@@ -207,7 +207,7 @@ fn estimate_with(
                     .collect();
                 cull_seconds += t.elapsed().as_secs_f64();
                 let bvh = Bvh::build_fast(kept);
-                rays::visibility_in(&bvh, f.light_shape, &starts, key, &identity, samples)
+                rays::visibility_in(&bvh, f.light_shape, &starts, key, &identity, samples, None)
             }
         };
         add_batch(&mut strata, batch, &units, visibility, &exact);
@@ -316,7 +316,7 @@ mod tests {
             meshes: &meshes,
             light: &light,
             camera: &camera,
-            method: MethodConfig::Exact(ExactConfig { samples: 16 }),
+            method: MethodConfig::Exact(ExactConfig::of(16)),
             map_resolution: None,
             bias: Bias::new(None, None).unwrap(),
             backend: BackendChoice::Cpu,

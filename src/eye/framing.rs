@@ -124,12 +124,14 @@ pub fn resolve_at_camera(call: &EyeCall, backend: Backend) -> Result<MethodConfi
     })
 }
 
-/// Light samples per pixel of `exact`: a hard light needs one ray (every
-/// sample would be the same).
-pub fn exact_samples(call: &EyeCall, method: &MethodConfig) -> u32 {
+/// Light samples per pixel of `exact`, and of its probe: a hard light
+/// needs one ray (every sample would be the same) and no probe.
+pub fn exact_samples(call: &EyeCall, method: &MethodConfig) -> (u32, Option<u32>) {
     match method.kernel() {
-        crate::methods::Method::Exact { samples } if !call.light.is_hard() => samples,
-        _ => 1,
+        crate::methods::Method::Exact { samples, probe } if !call.light.is_hard() => {
+            (samples, probe)
+        }
+        _ => (1, None),
     }
 }
 

@@ -14,6 +14,7 @@
 use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::methods::exact::Bvh;
+use crate::methods::probe::probed_visibilities;
 use crate::methods::shadow_rays::{tile_order, visibilities, RayOrigin, Sampling};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -105,7 +106,9 @@ impl RayOrigin for RayStart {
 /// (`shadow_rays::visibilities`; eye_rays.wgsl reads the same key).
 /// `order` (a permutation of the indices of `starts`) is the order to
 /// trace them in: neighbours next to each other (`tiled`), so that packets
-/// are coherent.
+/// are coherent. With a `probe` (its light samples, and the image of the
+/// keys), only the starts a first pass is unsure of trace `samples`
+/// (`methods/probe.rs`).
 pub fn visibility(
     light_shape: LightShape,
     triangles: Vec<[Vec3; 3]>,
@@ -113,6 +116,7 @@ pub fn visibility(
     key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
     samples: u32,
+    probe: Option<Probe>,
 ) -> Vec<f32> {
     visibility_in(
         &Bvh::build(triangles),
@@ -121,7 +125,16 @@ pub fn visibility(
         key,
         order,
         samples,
+        probe,
     )
+}
+
+/// A first pass of `samples` light samples at every start, whose keys are
+/// pixels (texels) of an image of `size` (width, height): `methods/probe.rs`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Probe {
+    pub samples: u32,
+    pub size: (usize, usize),
 }
 
 /// `visibility` through a BVH already built (the error estimate traces
@@ -133,12 +146,20 @@ pub fn visibility_in(
     key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
     samples: u32,
+    probe: Option<Probe>,
 ) -> Vec<f32> {
-    let s = Sampling {
-        light: light_shape.samples(samples),
+    let sampling = |n| Sampling {
+        light: light_shape.samples(n),
         t0: 0.0,
     };
-    visibilities(bvh, starts, key, order, &s, 0.0)
+    let fine = sampling(samples);
+    match probe {
+        Some(p) => {
+            let coarse = sampling(p.samples);
+            probed_visibilities(bvh, starts, key, order, &fine, &coarse, 0.0, p.size)
+        }
+        None => visibilities(bvh, starts, key, order, &fine, 0.0),
+    }
 }
 
 /// The order of `pixels` (flat indices into an image `width` wide, each

@@ -45,13 +45,15 @@ pub trait EyeStages {
     /// `exact`: the visibility of each visible point of `f` from `samples`
     /// stratified shadow rays through `bvh` (the triangles that can shadow
     /// a visible point, built once a call: the error estimate and `Auto`'s
-    /// further runs trace it too).
+    /// further runs trace it too); with a `probe` of so many samples, only
+    /// at the points a first pass is unsure of (`methods/probe.rs`).
     fn trace(
         &mut self,
         f: &Framed,
         bvh: &Bvh,
         camera: &Camera,
         samples: u32,
+        probe: Option<u32>,
         sw: &mut Stopwatch,
     ) -> Result<Vec<f32>>;
 
@@ -102,6 +104,7 @@ impl EyeStages for CpuEye {
         bvh: &Bvh,
         camera: &Camera,
         samples: u32,
+        probe: Option<u32>,
         _sw: &mut Stopwatch,
     ) -> Result<Vec<f32>> {
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
@@ -114,6 +117,10 @@ impl EyeStages for CpuEye {
             |k| f.hits[k] as u64,
             &order,
             samples,
+            probe.map(|samples| rays::Probe {
+                samples,
+                size: (camera.width, camera.height),
+            }),
         ))
     }
 

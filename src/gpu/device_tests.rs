@@ -131,7 +131,10 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
             hierarchy: false,
             gaps: crate::methods::bitmask::Gaps::Open,
         },
-        Method::Exact { samples: 16 },
+        Method::Exact {
+            samples: 16,
+            probe: None,
+        },
     ];
     for (passes, method) in [1, 2, 4].into_iter().flat_map(|p| methods.map(|m| (p, m))) {
         let c = run(false, passes, method);
@@ -422,7 +425,10 @@ fn depth_maps_cannot_be_traced() {
         back: None,
         receiver: &z,
     };
-    let e = pipeline::from_depth(&maps, Method::Exact { samples: 4 }, Backend::Gpu)
+    let e = pipeline::from_depth(&maps, Method::Exact {
+            samples: 4,
+            probe: None,
+        }, Backend::Gpu)
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("method:"), "{e}");
@@ -518,7 +524,7 @@ mod eye {
     /// that the CPU runs the same kernels.
     fn methods() -> [(&'static str, MethodConfig); 3] {
         [
-            ("exact", MethodConfig::Exact(ExactConfig { samples: 64 })),
+            ("exact", MethodConfig::Exact(ExactConfig::of(64))),
             (
                 "ssm",
                 MethodConfig::Ssm(SsmConfig {
@@ -768,7 +774,7 @@ mod eye {
         }
         let (_, light) = &lights()[0];
         let cam = camera((96, 72));
-        let exact = MethodConfig::Exact(ExactConfig { samples: 64 });
+        let exact = MethodConfig::Exact(ExactConfig::of(64));
         let plain = untidy_scene();
         let mut more = plain.clone();
         more.push(basement());
@@ -957,7 +963,7 @@ mod eye {
         )
         .unwrap()
         .into();
-        let exact = MethodConfig::Exact(ExactConfig { samples: 16 });
+        let exact = MethodConfig::Exact(ExactConfig::of(16));
         let c = render(&meshes, &point, &cam, exact, BackendChoice::Cpu).unwrap();
         let g = render(&meshes, &point, &cam, exact, BackendChoice::Gpu).unwrap();
         let differ = c

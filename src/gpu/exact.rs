@@ -255,7 +255,7 @@ impl GpuKernel for ExactKernel {
         method: Method,
         i: LightViewInputs<'a>,
     ) -> Result<Option<MakeStage<'a>>> {
-        let Method::Exact { samples } = method else {
+        let Method::Exact { samples, .. } = method else {
             return Err(mismatch(method));
         };
         let (verts, faces) = i.occluders.ok_or_else(|| needs_triangles(method))?;

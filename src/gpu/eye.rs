@@ -190,8 +190,16 @@ impl EyeStages for GpuEye {
         bvh: &Bvh,
         _camera: &Camera,
         samples: u32,
+        probe: Option<u32>,
         sw: &mut Stopwatch,
     ) -> Result<Vec<f32>> {
+        // `ExactConfig::resolve` refuses a probe on the GPU.
+        if probe.is_some() {
+            return Err(Error::invalid(
+                "probe",
+                "the GPU's exact traces every sample at every pixel; use backend=\"cpu\"",
+            ));
+        }
         // Keyed by pixel, as the CPU's (`CpuEye::trace`).
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()

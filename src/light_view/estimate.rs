@@ -51,7 +51,7 @@ pub const REFERENCE_SAMPLES: u32 = 4 * crate::eye::estimate::REFERENCE_SAMPLES;
 /// methods against `REFERENCE_SAMPLES`.
 pub fn reference_samples(method: Method) -> u32 {
     match method {
-        Method::Exact { samples } => samples.saturating_mul(4).min(MAX_SAMPLES),
+        Method::Exact { samples, .. } => samples.saturating_mul(4).min(MAX_SAMPLES),
         _ => REFERENCE_SAMPLES,
     }
 }
@@ -198,7 +198,7 @@ mod tests {
             .space_for(floor.iter().map(|p| glam::DVec3::from_array(*p)))
             .unwrap();
         let n = 16;
-        let cfg = MethodConfig::Exact(ExactConfig { samples: n });
+        let cfg = MethodConfig::Exact(ExactConfig::of(n));
         let mut s = MapSettings::new(96, 64, None, &cfg);
         let map = crate::pipeline::from_meshes(occ, rec, &space, &s, Backend::Cpu).unwrap();
         assert!(map.estimate.is_none());

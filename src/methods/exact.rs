@@ -24,6 +24,7 @@ use super::config::{
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
 pub(crate) use super::shadow_rays::RAY_EPS;
+use super::probe::probed_visibilities;
 use super::shadow_rays::{tile_order, visibilities, Sampling};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
@@ -33,9 +34,12 @@ use crate::geom::light::MapGrid;
 use crate::geom::light_shape::{LightSamples, LightShape};
 use glam::Vec3;
 
-/// The exact method with `samples` light samples per receiver.
+/// The exact method with `samples` light samples per receiver; with a
+/// `probe`, receivers whose first `probe` samples (and their neighbours')
+/// agree keep that answer (`probe.rs`).
 pub struct Exact {
     pub samples: u32,
+    pub probe: Option<u32>,
 }
 
 /// The light point (x, y) that `exact`'s ray of sample (sa, sb) of the
@@ -58,19 +62,39 @@ pub fn sample_grid(samples: u32, size: [f64; 2]) -> (u32, u32) {
 impl Exact {
     /// The visibility of receivers `pts` (light-space points; `None`: lit;
     /// the jitter key is the index: a map's texel, as exact.wgsl's), traced
-    /// in `order`.
-    fn shade(&self, inputs: &ShadowInputs, pts: &[Option<Vec3>], order: &[usize]) -> Vec<f32> {
+    /// in `order`; `grid` the map they are the texels of (None for points,
+    /// which have no neighbours for a probe).
+    fn shade(
+        &self,
+        inputs: &ShadowInputs,
+        pts: &[Option<Vec3>],
+        order: &[usize],
+        grid: Option<&MapGrid>,
+    ) -> Vec<f32> {
         let Some(tris) = inputs.occluder_triangles else {
             // Nothing to occlude with: callers check before (the pipeline
             // refuses exact without meshes), so this is all-lit by definition.
             return vec![1.0; pts.len()];
         };
         let bvh = Bvh::build(tris.to_vec());
-        let s = Sampling {
-            light: inputs.light_shape.samples(self.samples),
+        let sampling = |n| Sampling {
+            light: inputs.light_shape.samples(n),
             t0: RAY_EPS,
         };
-        visibilities(&bvh, pts, |k| k as u64, order, &s, 1.0)
+        let fine = sampling(self.samples);
+        match (self.probe, grid) {
+            (Some(p), Some(g)) => probed_visibilities(
+                &bvh,
+                pts,
+                |k| k as u64,
+                order,
+                &fine,
+                &sampling(p),
+                1.0,
+                (g.width, g.height),
+            ),
+            _ => visibilities(&bvh, pts, |k| k as u64, order, &fine, 1.0),
+        }
     }
 }
 
@@ -99,13 +123,13 @@ impl ShadowMethod for Exact {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         let g = &inputs.grid;
         let pts = receiver_points(g, inputs.receiver);
-        self.shade(inputs, &pts, &tile_order(g.width, g.height))
+        self.shade(inputs, &pts, &tile_order(g.width, g.height), Some(g))
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
         let pts: Vec<Option<Vec3>> = points.iter().map(light_point).collect();
         let order: Vec<usize> = (0..pts.len()).collect();
-        self.shade(inputs, &pts, &order)
+        self.shade(inputs, &pts, &order, None)
     }
 }
 
@@ -113,6 +137,9 @@ impl ShadowMethod for Exact {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ExactConfig {
     pub samples: u32,
+    /// Light samples of a first pass at every receiver (`probe.rs`); None:
+    /// every receiver traces `samples`.
+    pub probe: Option<u32>,
 }
 
 /// Light samples of `exact`: 1 to MAX_SAMPLES.
@@ -128,21 +155,40 @@ pub fn check_exact_samples(n: i64) -> Result<u32> {
 }
 
 impl ExactConfig {
-    pub fn new(samples: Option<i64>) -> Result<Self> {
-        Ok(ExactConfig {
-            samples: samples
-                .map(check_exact_samples)
-                .transpose()?
-                .unwrap_or(DEFAULT_SAMPLES),
-        })
+    pub fn new(samples: Option<i64>, probe: Option<i64>) -> Result<Self> {
+        let samples = samples
+            .map(check_exact_samples)
+            .transpose()?
+            .unwrap_or(DEFAULT_SAMPLES);
+        let probe = probe.map(|p| check_probe(p, samples)).transpose()?;
+        Ok(ExactConfig { samples, probe })
+    }
+
+    /// `samples` light samples at every receiver, no probe.
+    pub const fn of(samples: u32) -> Self {
+        ExactConfig {
+            samples,
+            probe: None,
+        }
+    }
+}
+
+/// A probe's light samples: at least 1, fewer than `samples` (a probe of
+/// as many would trace every ray twice).
+pub fn check_probe(p: i64, samples: u32) -> Result<u32> {
+    if (1..samples as i64).contains(&p) {
+        Ok(p as u32)
+    } else {
+        Err(Error::invalid(
+            "probe",
+            format!("must be in [1, samples - 1] = [1, {}], got {p}", samples - 1),
+        ))
     }
 }
 
 impl Default for ExactConfig {
     fn default() -> Self {
-        ExactConfig {
-            samples: DEFAULT_SAMPLES,
-        }
+        ExactConfig::of(DEFAULT_SAMPLES)
     }
 }
 
@@ -168,7 +214,7 @@ impl MethodSpec for ExactConfig {
         if o.precision.is_some() {
             return Err(refuse("precision", PRECISION_SSM_ONLY));
         }
-        ExactConfig::new(o.samples)
+        ExactConfig::new(o.samples, None)
     }
     type Resolved = Self;
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
@@ -177,6 +223,13 @@ impl MethodSpec for ExactConfig {
                 "method",
                 "\"exact\" traces the occluder triangles, which depth maps do not have; \
                  use soft_shadow_map with meshes",
+            ));
+        }
+        if self.probe.is_some() && ctx.backend == Backend::Gpu {
+            return Err(Error::invalid(
+                "probe",
+                "the GPU's exact traces every sample at every receiver; use backend=\"cpu\" \
+                 or leave probe unset",
             ));
         }
         Ok(self)
@@ -190,17 +243,34 @@ impl MethodSpec for ExactConfig {
                       samples, jittered deterministically: converges to the true visibility",
             reads: vec![Input::OccluderTriangles],
             backends: Backend::built().to_vec(),
-            options: vec![OptionInfo {
-                name: "samples",
-                kind: Kind::Int {
-                    min: 1,
-                    max: MAX_SAMPLES as i64,
+            options: vec![
+                OptionInfo {
+                    name: "samples",
+                    kind: Kind::Int {
+                        min: 1,
+                        max: MAX_SAMPLES as i64,
+                    },
+                    default: Value::Int(DEFAULT_SAMPLES as i64),
+                    default_doc: "256 (a 16x16 stratification)",
+                    doc: "light samples per receiver",
+                    restricted_on: vec![],
                 },
-                default: Value::Int(DEFAULT_SAMPLES as i64),
-                default_doc: "256 (a 16x16 stratification)",
-                doc: "light samples per receiver",
-                restricted_on: vec![],
-            }],
+                OptionInfo {
+                    name: "probe",
+                    kind: Kind::Int {
+                        min: 1,
+                        max: MAX_SAMPLES as i64 - 1,
+                    },
+                    default: Value::Resolved,
+                    default_doc: "None: every receiver traces `samples`",
+                    doc: "light samples of a first pass at every receiver (pixel, texel); one \
+                          whose probe and whose 3x3 neighbours' probes all see the whole light \
+                          or none of it keeps that answer, the others trace `samples` (fewer \
+                          than `samples`; points given as arrays have no neighbours and trace \
+                          every sample; the CPU only)",
+                    restricted_on: vec![(Backend::Gpu, vec![])],
+                },
+            ],
         }
     }
 }
@@ -241,7 +311,7 @@ mod tests {
             occluder_triangles: Some(&tris),
         };
         let samples = 1024;
-        let v = Exact { samples }.visibility_map(&inputs);
+        let v = Exact { samples, probe: None }.visibility_map(&inputs);
         let k = zr * zo / (zr - zo);
         let ov = |lo: f64, hi: f64, c: f64| {
             ((k * (hi - c) + 0.5).clamp(0.0, 1.0) - (k * (lo - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
@@ -283,13 +353,13 @@ mod tests {
             occluder_layers: vec![],
             occluder_triangles: t,
         };
-        let a = Exact { samples: 64 }.visibility_points(&mk(Some(&tris)), &pts);
-        let b = Exact { samples: 64 }.visibility_points(&mk(Some(&tris)), &pts);
+        let a = Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&tris)), &pts);
+        let b = Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&tris)), &pts);
         assert_eq!(a, b);
         assert!(a[0] < 1.0 && a[1] == 1.0);
         let empty: Vec<[Vec3; 3]> = vec![];
         assert_eq!(
-            Exact { samples: 64 }.visibility_points(&mk(Some(&empty)), &pts),
+            Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&empty)), &pts),
             vec![1.0, 1.0]
         );
     }

@@ -27,6 +27,7 @@ pub(crate) mod packet;
 pub mod pcf;
 pub mod pcss;
 pub mod point_light;
+pub(crate) mod probe;
 mod registry;
 pub mod shadow_mapping;
 pub(crate) mod shadow_rays;
@@ -71,8 +72,9 @@ pub enum Method {
         hierarchy: bool,
         precision: ssm::Precision,
     },
-    /// Ray casting against the occluder triangles with stratified light samples.
-    Exact { samples: u32 },
+    /// Ray casting against the occluder triangles with stratified light
+    /// samples; with a probe, only where a first pass is unsure (`probe.rs`).
+    Exact { samples: u32, probe: Option<u32> },
     /// Micro-patches marking light samples in a bit mask per receiver (OR);
     /// `hierarchy` as for Ssm (on by default); `gaps` how neighbouring
     /// micro-patches meet (closed: connected micro-quads).
@@ -183,7 +185,7 @@ impl Method {
                 hierarchy: hierarchy.then_some(HIERARCHY),
                 precision,
             }),
-            Method::Exact { samples } => Box::new(exact::Exact { samples }),
+            Method::Exact { samples, probe } => Box::new(exact::Exact { samples, probe }),
             Method::Bitmask {
                 samples,
                 hierarchy,
@@ -217,7 +219,10 @@ impl MethodConfig {
                 hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
                 gaps: c.gaps,
             },
-            MethodConfig::Exact(c) => Method::Exact { samples: c.samples },
+            MethodConfig::Exact(c) => Method::Exact {
+                samples: c.samples,
+                probe: c.probe,
+            },
             MethodConfig::Pcss(c) => Method::Pcss {
                 max_taps: c.max_taps,
             },

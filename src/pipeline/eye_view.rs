@@ -188,7 +188,7 @@ fn render_traced<S: EyeStages>(
 ) -> Result<(EyeImage, MethodConfig)> {
     let size = (call.camera.width, call.camera.height);
     let method = resolve_at_camera(call, S::BACKEND)?;
-    let samples = exact_samples(call, &method);
+    let (samples, probe) = exact_samples(call, &method);
     let mut sw = Stopwatch::new();
     let Traced { g, f, bvh } = match reuse.as_mut().and_then(|r| r.take()) {
         Some(t) => t,
@@ -205,7 +205,7 @@ fn render_traced<S: EyeStages>(
             Traced { g, f, bvh }
         }
     };
-    let v = stages.trace(&f, &bvh, call.camera, samples, &mut sw)?;
+    let v = stages.trace(&f, &bvh, call.camera, samples, probe, &mut sw)?;
     sw.lap("shadow");
     // `exact` against itself with four times its samples, through the same
     // tree: its own sampling error.

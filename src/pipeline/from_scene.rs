@@ -70,9 +70,11 @@ pub fn from_scene(
         let tris: Vec<[Vec3; 3]> = light_space_triangles(&occ_ls, scene.faces);
         sw.lap("triangles");
         let starts = rays::ray_starts(light, unit, &points, &normals);
-        let samples = match s.method {
-            crate::methods::Method::Exact { samples } if !light_shape.is_point() => samples,
-            _ => 1,
+        let (samples, probe) = match s.method {
+            crate::methods::Method::Exact { samples, probe } if !light_shape.is_point() => {
+                (samples, probe)
+            }
+            _ => (1, None),
         };
         // Keys are texel indices, as the light-view exact's.
         let keyed: Vec<Option<rays::RayStart>> = {
@@ -83,7 +85,11 @@ pub fn from_scene(
             all
         };
         let order = crate::methods::shadow_rays::tile_order(grid.width, grid.height);
-        let v = rays::visibility(light_shape, tris, &keyed, |k| k as u64, &order, samples);
+        let probe = probe.map(|samples| rays::Probe {
+            samples,
+            size: (grid.width, grid.height),
+        });
+        let v = rays::visibility(light_shape, tris, &keyed, |k| k as u64, &order, samples, probe);
         for &k in &texels {
             visibility[k] = v[k];
         }

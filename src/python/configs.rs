@@ -77,12 +77,19 @@ config_class! {
 config_class! {
     /// Ray casting against the occluder triangles. See `capabilities()["exact"]`.
     class PyExact(ExactConfig) as "Exact", name "exact";
-    #[pyo3(signature = (*, samples=None))]
-    fn new(samples: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
-        Ok(PyExact(ExactConfig::new(opt_int("samples", samples)?)?))
+    #[pyo3(signature = (*, samples=None, probe=None))]
+    fn new(
+        samples: Option<&Bound<'_, PyAny>>,
+        probe: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(PyExact(ExactConfig::new(
+            opt_int("samples", samples)?,
+            opt_int("probe", probe)?,
+        )?))
     }
     options {
         samples: u32 = |c, py| c.0.samples;
+        probe: Option<u32> = |c, py| c.0.probe;
     }
 }
 

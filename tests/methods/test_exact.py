@@ -72,3 +72,49 @@ def test_depth_maps_cannot_be_traced():
     rec = np.full((4, 4), 4.0, np.float32)
     with pytest.raises(ValueError, match="method.*triangles"):
         ss.soft_shadow_map_from_depth(occ, rec, light_size=1, extent=0.5, method="exact")
+
+
+def test_a_probe_keeps_exacts_answer_where_it_is_unsure_and_costs_fewer_rays():
+    # Light view: texels the 16-ray probe (and its 3x3 neighbours) saw
+    # wholly lit or wholly blocked keep 1 or 0; the others are exact's bits.
+    scene, light = scenes.bunny_floating()
+    full = ss.soft_shadow_map(scene, light, resolution=96, method=ss.Exact())
+    probed = ss.soft_shadow_map(scene, light, resolution=96, method=ss.Exact(probe=16))
+    assert probed.method == ss.Exact(samples=256, probe=16)
+    differ = probed.visibility != full.visibility
+    assert np.isin(probed.visibility[differ], (0.0, 1.0)).all()
+    shadowed = full.visibility < 1
+    assert np.abs(probed.visibility - full.visibility)[shadowed].mean() < 1e-3
+    # The umbra is kept from the probe: some texels are exactly 0 in both.
+    assert ((probed.visibility == 0) & (full.visibility == 0)).any()
+
+
+def test_a_probe_in_the_eye_view_matches_exact_on_a_closed_box_scene():
+    from softshadow.scenes import as_built
+
+    scene, light, cam = as_built.SCENES["blocks_on_table"]((96, 72))
+    full = ss.render(scene, light, cam, method=ss.Exact())
+    probed = ss.render(scene, light, cam, method=ss.Exact(probe=16))
+    differ = probed.visibility != full.visibility
+    assert np.isin(probed.visibility[differ], (0.0, 1.0)).all()
+    shadowed = full.visibility < 1
+    assert np.abs(probed.visibility - full.visibility)[shadowed].mean() < 2e-3
+    # Deterministic.
+    again = ss.render(scene, light, cam, method=ss.Exact(probe=16))
+    np.testing.assert_array_equal(again.visibility, probed.visibility)
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [(dict(probe=0), "probe"), (dict(probe=256), "probe"), (dict(samples=16, probe=16), "samples - 1")],
+)
+def test_bad_probe(kwargs, words):
+    with pytest.raises(ValueError, match=words):
+        ss.Exact(**kwargs)
+
+
+def test_the_gpu_refuses_a_probe():
+    scene, light = scenes.square_plate(side=1.0, height=2.0)
+    # Refused when the config resolves, before any adapter is asked for.
+    with pytest.raises(ValueError, match="probe: the GPU's exact traces every sample"):
+        ss.soft_shadow_map(scene, light, resolution=16, method=ss.Exact(probe=4), backend="gpu")
