@@ -51,7 +51,7 @@ def unit(h: np.ndarray) -> np.ndarray:
 
 
 def sample_grid(samples: int, size: list[float]) -> tuple[int, int]:
-    """exact.rs ``sample_grid``."""
+    """light_shape.rs ``LightShape::sample_grid`` for a rectangle."""
     a = int(np.sqrt(samples))
     while a > 1 and samples % a:
         a -= 1

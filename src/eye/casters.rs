@@ -126,16 +126,7 @@ fn least(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
 /// the light meets the plane.
 fn lit_side(light: &Light, p0: DVec3, n: DVec3, tol: f64) -> Option<DVec3> {
     match light {
-        Light::Rect(l) => {
-            let d = l.corners().map(|c| n.dot(c - p0));
-            if d.iter().all(|&x| x > tol) {
-                Some(n)
-            } else if d.iter().all(|&x| x < -tol) {
-                Some(-n)
-            } else {
-                None
-            }
-        }
+        Light::Rect(l) => l.strict_side(p0, n, tol),
         Light::Sun(s) => {
             // Directions toward the sun: -s.n within its half-angles.
             let to_sun = -s.n;
@@ -183,14 +174,16 @@ mod tests {
         )
     }
 
+    /// A unit square 4 above the ground, facing down.
     fn light() -> Light {
-        Light::Rect(RectLight {
-            center: DVec3::new(0.0, 4.0, 0.0),
-            u: DVec3::X,
-            v: DVec3::Z,
-            n: -DVec3::Y,
-            size: [1.0, 1.0],
-        })
+        RectLight::new(
+            [0.0, 4.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0],
+        )
+        .unwrap()
+        .into()
     }
 
     #[test]

@@ -15,7 +15,7 @@
 //! shape in f32); maps and kernels work in f32 once coordinates are light-relative.
 
 use crate::error::{Error, Result};
-use crate::geom::light_shape::LightShape;
+use crate::geom::light_shape::{rect_corners, LightShape, Placement};
 use glam::DVec3;
 
 /// A rectangular area light with its orthonormal frame.
@@ -76,19 +76,37 @@ impl RectLight {
     /// The rectangle's corners, counter-clockwise seen from the side it
     /// lights (−u−v, +u−v, +u+v, −u+v).
     pub fn corners(&self) -> [DVec3; 4] {
-        let hu = 0.5 * self.size[0] * self.u;
-        let hv = 0.5 * self.size[1] * self.v;
-        [
-            self.center - hu - hv,
-            self.center + hu - hv,
-            self.center + hu + hv,
-            self.center - hu + hv,
-        ]
+        rect_corners(self.size, &self.placement())
     }
 
     /// The light's shape: the rectangle `size`.
     pub fn shape(&self) -> LightShape {
         LightShape::rect(self.size)
+    }
+
+    /// Where its shape lies in the world: its centre and frame.
+    pub fn placement(&self) -> Placement {
+        Placement {
+            center: self.center,
+            u: self.u,
+            v: self.v,
+            n: self.n,
+        }
+    }
+
+    /// The unoccluded irradiance at world point `x` (unit normal `n`) from
+    /// the light of unit radiance: its shape's form factor there
+    /// (`LightShape::irradiance`; 0 at or behind its plane, or for a point
+    /// light).
+    pub fn irradiance(&self, x: DVec3, n: DVec3) -> f64 {
+        self.shape().irradiance(&self.placement(), x, n)
+    }
+
+    /// The normal `n` of the plane through `p0` turned toward the light
+    /// when the whole light lies strictly on one side of it (farther than
+    /// `tol`); None when the light meets the plane (`LightShape::strict_side`).
+    pub fn strict_side(&self, p0: DVec3, n: DVec3, tol: f64) -> Option<DVec3> {
+        self.shape().strict_side(&self.placement(), p0, n, tol)
     }
 
     /// Builds the light frame, refusing degenerate input.

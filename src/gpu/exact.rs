@@ -9,6 +9,7 @@
 
 use super::context::Gpu;
 use super::dispatch::{bind, module, pipeline, storage, uniform, upload};
+use super::light::GpuLightSamples;
 use super::method_kernel::{
     mismatch, needs_triangles, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage,
 };
@@ -49,14 +50,12 @@ pub(super) const SAMPLES_PER_CHUNK: u32 = 4;
 pub struct ExactParams {
     pub rec_w: u32,
     pub rec_h: u32,
-    pub na: u32,
-    pub nb: u32,
     pub chunk_start: u32,
     pub chunk_len: u32,
+    /// The light's sample pattern (`set_light`).
+    pub light: GpuLightSamples,
     pub budget: u32,
     pub has_tris: u32,
-    pub size_x: f32,
-    pub size_y: f32,
     pub t0: f32,
     pub t1: f32,
     pub ax_rec_x: u32,
@@ -66,14 +65,16 @@ pub struct ExactParams {
 }
 
 impl ExactParams {
-    /// The ray casters' sample pattern (na, nb, size_x, size_y): `samples`
-    /// strata over `light`, the one place a light shape reaches these
-    /// uniforms (exact.wgsl and eye_rays.wgsl read them through
-    /// light_shape.wgsl).
+    /// The ray casters' sample pattern: `samples` strata over `light`, the
+    /// one place a light shape reaches these uniforms (exact.wgsl and
+    /// eye_rays.wgsl read them through light_shape.wgsl).
     pub(super) fn set_light(&mut self, light: LightShape, samples: u32) {
-        let s = light.samples(samples);
-        (self.na, self.nb) = s.grid;
-        [self.size_x, self.size_y] = s.size;
+        self.light = GpuLightSamples::new(light.samples(samples));
+    }
+
+    /// The rays a receiver casts: na x nb.
+    pub(super) fn strata(&self) -> (u32, u32) {
+        (self.light.na, self.light.nb)
     }
 }
 
@@ -143,9 +144,10 @@ impl ExactShading {
             ..Default::default()
         };
         params.set_light(light_shape, samples);
+        let (na, nb) = params.strata();
         ExactShading {
             params,
-            samples: params.na * params.nb,
+            samples: na * nb,
             nodes: upload(device, "bvh nodes", &bvh.node_words()),
             tris: upload(device, "bvh triangles", &bvh.triangle_floats()),
             axes: upload(device, "axes", &axes),

@@ -10,19 +10,15 @@
 struct ExactParams {
     rec_w: u32,
     rec_h: u32,
-    // The stratification na x nb (exact.rs's sample_grid).
-    na: u32,
-    nb: u32,
     // Samples [chunk_start, chunk_start + chunk_len) of na * nb in this dispatch.
     chunk_start: u32,
     chunk_len: u32,
+    // The light's sample pattern: strata na x nb (light_shape.wgsl).
+    light: LightSamples,
     // Loop iterations an invocation may run before it gives up and raises
     // `status` (lavapipe stops an invocation after 65535).
     budget: u32,
     has_tris: u32,
-    // The light's rectangle (light_shape.wgsl's `size`).
-    size_x: f32,
-    size_y: f32,
     t0: f32,
     t1: f32,
     // Offsets in `axes`: receiver column x, receiver row y (tangent).
@@ -224,11 +220,11 @@ fn exact(@builtin(global_invocation_id) gid: vec3<u32>) {
     let key = vec2<u32>(idx, 0u);
     var count = 0u;
     for (var s = ep.chunk_start; s < ep.chunk_start + ep.chunk_len; s++) {
-        let sa = s % ep.na;
-        let sb = s / ep.na;
+        let sa = s % ep.light.na;
+        let sb = s / ep.light.na;
         // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
         let h = hash(key ^ hash(vec2<u32>(s << 1u, 0u)));
-        let l = light_sample(sa, sb, ep.na, ep.nb, unit(h), unit(hash(h)), vec2<f32>(ep.size_x, ep.size_y));
+        let l = light_sample(sa, sb, unit(h), unit(hash(h)), ep.light);
         let d = vec3<f32>(l.x, l.y, 0.0) - p;
         if !occluded(p, d) {
             count += 1u;
@@ -252,5 +248,5 @@ fn exact_resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
         vis[idx] = 1.0;
         return;
     }
-    vis[idx] = f32(seen[idx]) / f32(ep.na * ep.nb);
+    vis[idx] = f32(seen[idx]) / f32(ep.light.na * ep.light.nb);
 }

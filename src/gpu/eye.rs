@@ -410,7 +410,7 @@ fn exact_visibility(
         ..Default::default()
     };
     params.set_light(light_shape, samples);
-    let (na, nb) = (params.na, params.nb);
+    let (na, nb) = params.strata();
     let bytes = n as u64 * 4;
     let out = with_error_scopes(g, || {
         let device = &g.device;

@@ -61,11 +61,11 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
     let key = vec2<u32>(s.key, 0u);
     var count = 0u;
     for (var k = ep.chunk_start; k < ep.chunk_start + ep.chunk_len; k++) {
-        let sa = k % ep.na;
-        let sb = k / ep.na;
+        let sa = k % ep.light.na;
+        let sb = k / ep.light.na;
         // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
         let h = hash(key ^ hash(vec2<u32>(k << 1u, 0u)));
-        let l = light_sample(sa, sb, ep.na, ep.nb, unit(h), unit(hash(h)), vec2<f32>(ep.size_x, ep.size_y));
+        let l = light_sample(sa, sb, unit(h), unit(hash(h)), ep.light);
         let x = l.x;
         let y = l.y;
         var o = below;
@@ -95,5 +95,5 @@ fn eye_exact_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
         vis[idx] = 1.0;
         return;
     }
-    vis[idx] = f32(seen[idx]) / f32(ep.na * ep.nb);
+    vis[idx] = f32(seen[idx]) / f32(ep.light.na * ep.light.nb);
 }

@@ -14,7 +14,6 @@ use super::shadow_mapping::{GpuBlurPixel, GpuSmPoint, GpuSmTri, SmParams, SOURCE
 use super::smoothies::{
     GpuSmoothie, SmoothieChunk, SmoothieParams, TentAxis, TentPoint, SOURCE as SMOOTHIES_SOURCE,
 };
-use std::mem::{offset_of, size_of};
 
 /// Every shader module the backend builds, by name.
 fn modules() -> Vec<(String, String)> {
@@ -181,18 +180,19 @@ macro_rules! rust_layout {
     ($t:ty { $($f:ident),* $(,)? }) => {{
         let v: Vec<(String, u32, u32)> = vec![$((
             stringify!($f).to_string(),
-            offset_of!($t, $f) as u32,
+            std::mem::offset_of!($t, $f) as u32,
             {
                 // Size of the field's type, from a zeroed value.
                 let z: $t = bytemuck::Zeroable::zeroed();
                 std::mem::size_of_val(&z.$f) as u32
             },
         )),*];
-        (v, size_of::<$t>() as u32)
+        (v, std::mem::size_of::<$t>() as u32)
     }};
 }
+pub(super) use rust_layout;
 
-fn assert_same(wgsl_src: &str, name: &str, rust: (Vec<(String, u32, u32)>, u32)) {
+pub(super) fn assert_same(wgsl_src: &str, name: &str, rust: (Vec<(String, u32, u32)>, u32)) {
     let module = parse(name, wgsl_src);
     let wgsl = wgsl_layout(&module, name);
     assert_eq!(
@@ -367,14 +367,11 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
         rust_layout!(ExactParams {
             rec_w,
             rec_h,
-            na,
-            nb,
             chunk_start,
             chunk_len,
+            light,
             budget,
             has_tris,
-            size_x,
-            size_y,
             t0,
             t1,
             ax_rec_x,

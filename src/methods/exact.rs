@@ -31,7 +31,7 @@ use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
-use crate::geom::light_shape::{LightSamples, LightShape};
+use crate::geom::light_shape::LightSamples;
 use glam::Vec3;
 
 /// The exact method with `samples` light samples per receiver; with a
@@ -42,21 +42,13 @@ pub struct Exact {
     pub probe: Option<u32>,
 }
 
-/// The light point (x, y) that `exact`'s ray of sample (sa, sb) of the
-/// `grid` goes to from the receiver whose jitter key is `key` (its texel or
-/// point index), for a light of `size`: for tracing the same rays elsewhere
-/// (benchmarks/bvh_crates compares BVH crates on them).
-pub fn light_sample(key: u64, sa: u32, sb: u32, grid: (u32, u32), size: [f32; 2]) -> (f32, f32) {
-    Sampling {
-        light: LightSamples { grid, size },
-        t0: RAY_EPS,
-    }
-    .sample(key, sa, sb)
-}
-
-/// The stratification of a rectangle of full `size` (`LightShape::sample_grid`).
-pub fn sample_grid(samples: u32, size: [f64; 2]) -> (u32, u32) {
-    LightShape::rect(size).sample_grid(samples)
+/// The light point (x, y) that `exact`'s ray of stratum (sa, sb) of
+/// `light` (the light's sample pattern, `LightShape::samples`) goes to from
+/// the receiver whose jitter key is `key` (its texel or point index): for
+/// tracing the same rays elsewhere (benchmarks/bvh_crates compares BVH
+/// crates on them).
+pub fn light_sample(key: u64, sa: u32, sb: u32, light: LightSamples) -> (f32, f32) {
+    Sampling { light, t0: RAY_EPS }.sample(key, sa, sb)
 }
 
 impl Exact {
@@ -279,6 +271,7 @@ impl MethodSpec for ExactConfig {
 mod tests {
     use super::*;
     use crate::geom::light::MapGrid;
+    use crate::geom::light_shape::LightShape;
 
     fn plate(z: f32, lo: [f32; 2], hi: [f32; 2]) -> Vec<[Vec3; 3]> {
         let v = [
@@ -362,12 +355,5 @@ mod tests {
             Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&empty)), &pts),
             vec![1.0, 1.0]
         );
-    }
-
-    #[test]
-    fn sample_grids_are_near_square() {
-        assert_eq!(sample_grid(256, [1.0, 1.0]), (16, 16));
-        assert_eq!(sample_grid(12, [2.0, 1.0]), (4, 3));
-        assert_eq!(sample_grid(7, [1.0, 1.0]), (7, 1));
     }
 }

@@ -11,7 +11,8 @@ mod contenders;
 use contenders::{Contender, Obvhs, Ours, Parry, SvenstaroBvh};
 use glam::Vec3;
 use rayon::prelude::*;
-use softshadow::methods::exact::{light_sample, sample_grid, Exact};
+use softshadow::geom::light_shape::LightShape;
+use softshadow::methods::exact::{light_sample, Exact};
 use softshadow::methods::{LightPoint, ShadowInputs, ShadowMethod};
 use softshadow::MapGrid;
 use std::path::{Path, PathBuf};
@@ -39,7 +40,8 @@ struct Scene {
     /// Receiver depth per texel (inf: none).
     depth: Vec<f32>,
     grid: MapGrid,
-    light_size: [f64; 2],
+    /// The light's shape (meta.txt's `light_size`: a rectangle).
+    light_shape: LightShape,
     samples: u32,
     /// The package's own `exact` visibility of the same map.
     pipeline: Vec<f32>,
@@ -94,7 +96,7 @@ fn load(name: &str) -> Scene {
         tris,
         depth: read_f32(&dir.join("depth.f32")),
         grid,
-        light_size: [ls[0], ls[1]],
+        light_shape: LightShape::rect([ls[0], ls[1]]),
         samples: field("samples")[0] as u32,
         pipeline: read_f32(&dir.join("exact.f32")),
     }
@@ -118,7 +120,7 @@ impl Scene {
         ShadowInputs {
             grid: self.grid,
             occluder_grid: self.grid,
-            light_size: self.light_size,
+            light_shape: self.light_shape,
             receiver: &self.depth,
             occluder_layers: vec![],
             occluder_triangles: Some(&self.tris),
@@ -138,8 +140,8 @@ struct Rays {
 
 impl Rays {
     fn new(s: &Scene) -> Rays {
-        let grid = sample_grid(s.samples, s.light_size);
-        let size = [s.light_size[0] as f32, s.light_size[1] as f32];
+        let light = s.light_shape.samples(s.samples);
+        let grid = light.grid;
         let (mut keys, mut origins) = (vec![], vec![]);
         for (k, p) in s.points().iter().enumerate() {
             // exact's light_point: a receiver only at a finite, positive depth.
@@ -154,7 +156,7 @@ impl Rays {
             .flat_map_iter(|&k| {
                 (0..grid.1).flat_map(move |sb| {
                     (0..grid.0).map(move |sa| {
-                        let (x, y) = light_sample(k as u64, sa, sb, grid, size);
+                        let (x, y) = light_sample(k as u64, sa, sb, light);
                         [x, y]
                     })
                 })
