@@ -151,10 +151,7 @@ fn configs() -> Vec<(&'static str, MethodConfig)> {
         ("ssm", MethodConfig::Ssm(SsmConfig::default())),
         ("bitmask256", bitmask(false)),
         ("bitmask256_hierarchy", bitmask(true)),
-        (
-            "exact64",
-            MethodConfig::Exact(ExactConfig::of(64)),
-        ),
+        ("exact64", MethodConfig::Exact(ExactConfig::of(64))),
     ]
 }
 
@@ -255,7 +252,13 @@ fn bench_kernels(c: &mut Criterion) {
                 gaps: Gaps::Closed,
             },
         ),
-        ("exact64", Method::Exact { samples: 64, probe: None }),
+        (
+            "exact64",
+            Method::Exact {
+                samples: 64,
+                probe: None,
+            },
+        ),
     ];
     let mut g = configure(c, "kernel");
     for (name, method) in kernels {

@@ -30,13 +30,14 @@ from softshadow.metrics import compare_images
 from softshadow.reference.cache import cached_reference_image
 from softshadow.scenes.as_built import CALIBRATION, HELD_OUT, SCENES
 
-#: The calls measured, by label: the default call (no method given) and
-#: every method family with its defaults.
+#: The calls measured, by label: the default call (no method given),
+#: every method family with its defaults, and ``exact`` behind a probe.
 METHODS: dict[str, Any] = {
     "default": None,
     "ssm": ss.Ssm(),
     "bitmask": ss.Bitmask(),
     "exact": ss.Exact(),
+    "exact+probe": ss.Exact(probe=16),
     "PCSS": ss.PCSS(),
     "Smoothies": ss.Smoothies(),
     "ShadowMapping+PCF3": ss.ShadowMapping(filter=ss.PCF(size=3)),

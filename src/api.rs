@@ -409,6 +409,16 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         gpu,
         hard_ok || !call.light.is_hard(),
     );
+    // The default call (`Auto`, nothing given) traces (`eye_default`).
+    let default = MethodConfig::Auto(AutoConfig::default());
+    let call = &EyeCall {
+        method: if call.method == default {
+            MethodConfig::Exact(crate::methods::auto_config::eye_default(backend))
+        } else {
+            call.method
+        },
+        ..*call
+    };
     // A target plans the setting (`auto/plan.rs`, `plan_eye`); the
     // planned config then runs as if the user had given it.
     let t0 = std::time::Instant::now();

@@ -358,10 +358,14 @@ def render(
     method
         A config or name, as for :func:`soft_shadow_map`. ``exact`` traces
         stratified shadow rays from each pixel's surface point, offset off
-        the surface as Mitsuba's ``spawn_ray_to`` does. The map methods
-        (``ssm``, ``bitmask``, ``auto``) rasterize light-view occluder layers
-        of every mesh, focused on what the camera sees, and shade each pixel
-        at its own point. ``Auto(error=e)`` plans for the eye view's error
+        the surface as Mitsuba's ``spawn_ray_to`` does. The default
+        (``"auto"``, ``Auto()``) runs ``Exact(samples=256, probe=16)`` on the
+        CPU (only the pixels a 16-sample probe is unsure of trace all 256)
+        and ``Exact(samples=256)`` on the GPU (docs/methods/auto.md). The map
+        methods (``ssm``, ``bitmask``, ``auto`` with ``ssm``'s options)
+        rasterize light-view occluder layers of every mesh, focused on what
+        the camera sees, and shade each pixel at its own point.
+        ``Auto(error=e)`` plans for the eye view's error
         (mean |V - V_ref| over the pixels, :func:`softshadow.metrics.compare_images`):
         the rule's maps where their measured error is within ``e``, else
         ``exact`` with the samples its measured error law asks for;

@@ -146,8 +146,7 @@ pub fn refined<T>(
 ) -> Result<(T, MethodConfig, f64)> {
     let (mut out, mut ran) = first;
     let (mut replaced, mut last) = (0.0, first_seconds);
-    let pilot =
-        matches!(ran.kernel(), Method::Exact { samples, .. } if samples < exact_samples(law, target));
+    let pilot = matches!(ran.kernel(), Method::Exact { samples, .. } if samples < exact_samples(law, target));
     for _ in 0..MAX_REFINES + pilot as usize {
         let Some(e) = estimate_of(&out) else { break };
         if met(target, &e) {

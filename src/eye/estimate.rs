@@ -190,7 +190,9 @@ fn estimate_with(
         let key = |j: usize| f.hits[pixels[j]] as u64;
         let identity: Vec<usize> = (0..pixels.len()).collect();
         let exact = match given.or(whole.as_ref()) {
-            Some(bvh) => rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples, None),
+            Some(bvh) => {
+                rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples, None)
+            }
             None => {
                 let t = Instant::now();
                 culled += batch.len();

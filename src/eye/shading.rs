@@ -7,7 +7,7 @@
 //!
 //! * Area light of radiance L, emitting on its n_l side only: `E = L · F`,
 //!   F its unoccluded form factor at x for normal n (`RectLight::irradiance`;
-//!   each shape's formula is in geom/light_shape.rs, for a rectangle
+//!   each shape's formula is in geom/light_shape/, for a rectangle
 //!   Lambert's polygon formula after horizon clipping). E = 0 when x is at
 //!   or behind the light's plane, and a point light (size 0) has no area.
 //! * Sun of irradiance E_sun (on a surface facing it): `E = E_sun · max(0,

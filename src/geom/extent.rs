@@ -1,6 +1,6 @@
 //! Fitting the light-view map to where shadows can fall (`extent=None`).
 //!
-//! A light point at tangent offset X_L (|X_L| <= hx, the half-extent of the light's shape, light_shape.rs)
+//! A light point at tangent offset X_L (|X_L| <= hx, the half-extent of the light's shape, geom/light_shape/)
 //! and an occluder point at tangent x_O, depth Z_O cast a shadow on depth z_R
 //! at tangent  x_O + X_L (1/z_R - 1/Z_O)  (seen from the light's center). So
 //! every shadow point lies within  |x| <= |x_O| + hx (1/Z_O - 1/z_far)  where

@@ -425,12 +425,16 @@ fn depth_maps_cannot_be_traced() {
         back: None,
         receiver: &z,
     };
-    let e = pipeline::from_depth(&maps, Method::Exact {
+    let e = pipeline::from_depth(
+        &maps,
+        Method::Exact {
             samples: 4,
             probe: None,
-        }, Backend::Gpu)
-        .unwrap_err()
-        .to_string();
+        },
+        Backend::Gpu,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.starts_with("method:"), "{e}");
 }
 

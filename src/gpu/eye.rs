@@ -197,7 +197,7 @@ impl EyeStages for GpuEye {
         if probe.is_some() {
             return Err(Error::invalid(
                 "probe",
-                "the GPU's exact traces every sample at every pixel; use backend=\"cpu\"",
+                "the GPU backend traces every sample at every pixel (it has no probe); use backend=\"cpu\"",
             ));
         }
         // Keyed by pixel, as the CPU's (`CpuEye::trace`).

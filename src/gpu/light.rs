@@ -1,5 +1,5 @@
 //! The light's shape as the kernels read it: the one place that turns a
-//! `LightShape` (geom/light_shape.rs) into their uniform fields. The ray
+//! `LightShape` (geom/light_shape/) into their uniform fields. The ray
 //! casters' are one uniform member, `GpuLightSamples` (the strata na x nb
 //! and the rectangle (size_x, size_y), which `light_shape.wgsl`, its WGSL
 //! twin, maps to light points), set by `ExactParams::set_light` (exact.rs).
@@ -14,7 +14,7 @@ use crate::geom::light_shape::{LightSamples, LightShape};
 use bytemuck::{Pod, Zeroable};
 
 /// `LightSamples` of light_shape.wgsl: the ray casters' sample pattern
-/// (`LightSamples`, geom/light_shape.rs), a member of their uniforms.
+/// (`LightSamples`, geom/light_shape/), a member of their uniforms.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct GpuLightSamples {

@@ -1,4 +1,4 @@
-// The light's shape on the device: the twin of src/geom/light_shape.rs,
+// The light's shape on the device: the twin of src/geom/light_shape/,
 // prepended to every module that samples the light (exact.wgsl and the
 // eye view's rays). The light is the rectangle [-sx/2, sx/2] x [-sy/2, sy/2]
 // at Z = 0; the sample of stratum (sa, sb) of na x nb, jittered by (ja, jb)

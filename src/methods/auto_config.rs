@@ -30,6 +30,28 @@ pub fn auto_rule(resolution: (usize, usize)) -> SsmConfig {
     }
 }
 
+/// What the eye view's default call (`ss.Auto()`, nothing given, no
+/// target) runs on `backend`: `exact`'s 256 samples, on the CPU behind a
+/// probe of 16 (`probe.rs`: only the pixels it is unsure of trace all 256).
+///
+/// Issue 28 measured the map rule (`auto_rule`) on scenes built as users
+/// build them (closed boxes, real assets): 0.02-0.22 over the shadowed
+/// pixels with acne and leaks, where `Exact(probe=16)` stays within 1e-4 of
+/// `Exact()`'s error (0.0002-0.014 at 320x240) at 1.0-4.4x less time
+/// (docs/benchmarks/scenes_320x240.md). The GPU traces every ray of every
+/// pixel (it has no probe) and is fast enough to.
+pub fn eye_default(backend: Backend) -> super::ExactConfig {
+    super::ExactConfig {
+        samples: super::config::DEFAULT_SAMPLES,
+        probe: (backend == Backend::Cpu).then_some(EYE_PROBE),
+    }
+}
+
+/// The probe's light samples of the eye view's default call: a 4 x 4
+/// stratification, a sliver of penumbra it misses is under a quarter of
+/// the light's width (`probe.rs`).
+pub const EYE_PROBE: u32 = 16;
+
 /// What `ss.Auto` holds: the options given beside `method="auto"` (they
 /// override the rule's: `ss.Auto()` holds none) and the target. Without a
 /// target a rule that resolves to `Ssm`; with one (`ss.Auto(error=...)`) a

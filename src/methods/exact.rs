@@ -11,7 +11,7 @@
 //!
 //! Geometry is in light space (relative to the light's center, computed in
 //! f64 and then stored in f32), so a scene far from the world origin keeps its
-//! precision. The light is its shape at Z = 0 (geom/light_shape.rs: where the
+//! precision. The light is its shape at Z = 0 (geom/light_shape/: where the
 //! samples lie).
 //!
 //! Its config (`ExactConfig`, its checks and its `MethodSpec`: name, string
@@ -23,8 +23,8 @@ use super::config::{
     PRECISION_SSM_ONLY,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
-pub(crate) use super::shadow_rays::RAY_EPS;
 use super::probe::probed_visibilities;
+pub(crate) use super::shadow_rays::RAY_EPS;
 use super::shadow_rays::{tile_order, visibilities, Sampling};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
@@ -152,7 +152,7 @@ impl ExactConfig {
             .map(check_exact_samples)
             .transpose()?
             .unwrap_or(DEFAULT_SAMPLES);
-        let probe = probe.map(|p| check_probe(p, samples)).transpose()?;
+        let probe = probe.map(check_probe).transpose()?;
         Ok(ExactConfig { samples, probe })
     }
 
@@ -165,15 +165,15 @@ impl ExactConfig {
     }
 }
 
-/// A probe's light samples: at least 1, fewer than `samples` (a probe of
-/// as many would trace every ray twice).
-pub fn check_probe(p: i64, samples: u32) -> Result<u32> {
-    if (1..samples as i64).contains(&p) {
+/// A probe's light samples: 1 to MAX_SAMPLES (it saves time only when
+/// fewer than `samples`, but is right with any).
+pub fn check_probe(p: i64) -> Result<u32> {
+    if (1..=MAX_SAMPLES as i64).contains(&p) {
         Ok(p as u32)
     } else {
         Err(Error::invalid(
             "probe",
-            format!("must be in [1, samples - 1] = [1, {}], got {p}", samples - 1),
+            format!("must be in [1, {MAX_SAMPLES}], got {p}"),
         ))
     }
 }
@@ -220,8 +220,8 @@ impl MethodSpec for ExactConfig {
         if self.probe.is_some() && ctx.backend == Backend::Gpu {
             return Err(Error::invalid(
                 "probe",
-                "the GPU's exact traces every sample at every receiver; use backend=\"cpu\" \
-                 or leave probe unset",
+                "the GPU backend traces every sample at every receiver (it has no probe); \
+                 use backend=\"cpu\" or leave probe unset",
             ));
         }
         Ok(self)
@@ -251,16 +251,16 @@ impl MethodSpec for ExactConfig {
                     name: "probe",
                     kind: Kind::Int {
                         min: 1,
-                        max: MAX_SAMPLES as i64 - 1,
+                        max: MAX_SAMPLES as i64,
                     },
                     default: Value::Resolved,
                     default_doc: "None: every receiver traces `samples`",
                     doc: "light samples of a first pass at every receiver (pixel, texel); one \
                           whose probe and whose 3x3 neighbours' probes all see the whole light \
-                          or none of it keeps that answer, the others trace `samples` (fewer \
-                          than `samples`; points given as arrays have no neighbours and trace \
-                          every sample; the CPU only)",
-                    restricted_on: vec![(Backend::Gpu, vec![])],
+                          or none of it keeps that answer, the others trace `samples` (it saves \
+                          time when fewer than `samples`; points given as arrays have no \
+                          neighbours and trace every sample; the CPU only)",
+                    restricted_on: vec![(Backend::Gpu, vec![Value::Resolved])],
                 },
             ],
         }
@@ -304,7 +304,11 @@ mod tests {
             occluder_triangles: Some(&tris),
         };
         let samples = 1024;
-        let v = Exact { samples, probe: None }.visibility_map(&inputs);
+        let v = Exact {
+            samples,
+            probe: None,
+        }
+        .visibility_map(&inputs);
         let k = zr * zo / (zr - zo);
         let ov = |lo: f64, hi: f64, c: f64| {
             ((k * (hi - c) + 0.5).clamp(0.0, 1.0) - (k * (lo - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
@@ -346,13 +350,25 @@ mod tests {
             occluder_layers: vec![],
             occluder_triangles: t,
         };
-        let a = Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&tris)), &pts);
-        let b = Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&tris)), &pts);
+        let a = Exact {
+            samples: 64,
+            probe: None,
+        }
+        .visibility_points(&mk(Some(&tris)), &pts);
+        let b = Exact {
+            samples: 64,
+            probe: None,
+        }
+        .visibility_points(&mk(Some(&tris)), &pts);
         assert_eq!(a, b);
         assert!(a[0] < 1.0 && a[1] == 1.0);
         let empty: Vec<[Vec3; 3]> = vec![];
         assert_eq!(
-            Exact { samples: 64, probe: None }.visibility_points(&mk(Some(&empty)), &pts),
+            Exact {
+                samples: 64,
+                probe: None
+            }
+            .visibility_points(&mk(Some(&empty)), &pts),
             vec![1.0, 1.0]
         );
     }

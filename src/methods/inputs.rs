@@ -14,7 +14,7 @@ pub struct ShadowInputs<'a> {
     /// The occluder maps' grid: the same extent, its own resolution (coarser
     /// occluder maps cost less; the paper notes large lights need fewer texels).
     pub occluder_grid: MapGrid,
-    /// The light's shape in its plane (geom/light_shape.rs), in depth units.
+    /// The light's shape in its plane (geom/light_shape/), in depth units.
     pub light_shape: LightShape,
     /// Receiver planar depth per texel, `inf` where there is no receiver.
     pub receiver: &'a [f32],

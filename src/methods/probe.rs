@@ -158,7 +158,11 @@ mod tests {
         // Measured: 1476 of 2304 certain, one receiver off by 1/256.
         assert!(kept > n * n / 2, "{kept} certain");
         assert!(worst <= 1.0 / 16.0, "worst {worst}");
-        assert!(off / (shadowed as f64) < 1e-3, "mean {}", off / shadowed as f64);
+        assert!(
+            off / (shadowed as f64) < 1e-3,
+            "mean {}",
+            off / shadowed as f64
+        );
     }
 
     #[test]

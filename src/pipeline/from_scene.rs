@@ -89,7 +89,15 @@ pub fn from_scene(
             samples,
             size: (grid.width, grid.height),
         });
-        let v = rays::visibility(light_shape, tris, &keyed, |k| k as u64, &order, samples, probe);
+        let v = rays::visibility(
+            light_shape,
+            tris,
+            &keyed,
+            |k| k as u64,
+            &order,
+            samples,
+            probe,
+        );
         for &k in &texels {
             visibility[k] = v[k];
         }

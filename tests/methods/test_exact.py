@@ -106,7 +106,7 @@ def test_a_probe_in_the_eye_view_matches_exact_on_a_closed_box_scene():
 
 @pytest.mark.parametrize(
     "kwargs, words",
-    [(dict(probe=0), "probe"), (dict(probe=256), "probe"), (dict(samples=16, probe=16), "samples - 1")],
+    [(dict(probe=0), "probe: must be in"), (dict(probe=1 << 20), "probe: must be in")],
 )
 def test_bad_probe(kwargs, words):
     with pytest.raises(ValueError, match=words):
@@ -116,5 +116,5 @@ def test_bad_probe(kwargs, words):
 def test_the_gpu_refuses_a_probe():
     scene, light = scenes.square_plate(side=1.0, height=2.0)
     # Refused when the config resolves, before any adapter is asked for.
-    with pytest.raises(ValueError, match="probe: the GPU's exact traces every sample"):
+    with pytest.raises(ValueError, match="^probe: the GPU backend traces every sample"):
         ss.soft_shadow_map(scene, light, resolution=16, method=ss.Exact(probe=4), backend="gpu")

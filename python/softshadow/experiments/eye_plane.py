@@ -51,7 +51,7 @@ from .points import Point, mitsuba_seconds_at
 MITSUBA_SAMPLES = (1, 4, 16, 64, 256)
 #: (family, label, method): the family groups the study's plot.
 CALLS: list[tuple[str, str, Any]] = [
-    ("auto", "auto", "auto"),
+    ("auto", "default (exact 256, probe 16)", "auto"),
     ("ssm", "ssm", "ssm"),
     ("bitmask", "bitmask 64", Bitmask(samples=64)),
     ("bitmask", "bitmask 256", Bitmask(samples=256)),

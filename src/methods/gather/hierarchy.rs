@@ -175,7 +175,7 @@ impl Kernel {
         let g = &inputs.occluder_grid;
         let r = &inputs.grid;
         let (hw, hh) = g.half_texel();
-        // The rectangle's clipping: half-light units (light_shape.rs).
+        // The rectangle's clipping: half-light units (geom/light_shape/).
         let light = inputs.light_shape;
         let [lx, ly] = light.extent();
         let half_light = light.half_light();
