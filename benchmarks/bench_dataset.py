@@ -40,9 +40,10 @@ from _report import DOCS, ROOT, Report, add_output_arguments, command_line
 from softshadow import render
 from softshadow.dataset import load_spec, run
 from softshadow.dataset.build import build_camera, build_light, build_scene
+from softshadow.dataset.item import method_call
 from softshadow.dataset.runner import default_threads
 from softshadow.dataset.sampling import item_seed, sample_item
-from softshadow.dataset.spec import Spec, make_config
+from softshadow.dataset.spec import Spec
 from softshadow.metrics import compare_images
 
 TEACHER_SAMPLES = (1, 4, 16, 64, 256)
@@ -87,7 +88,8 @@ def errors(specs: dict[str, Spec], teacher: Spec, items: int, reference_samples:
         ref = render_visibility(scene, light, camera, reference_samples, seed=item_seed(teacher.seed, k) + 1)
         for name, spec in specs.items():
             m = spec.method
-            img = render(scene, light, camera, make_config(m), map_resolution=m.map_resolution, threads=threads)
+            config, loose = method_call(spec)
+            img = render(scene, light, camera, config, map_resolution=m.map_resolution, threads=threads, **loose)
             sums.setdefault(name, []).append(compare_images(img, ref).mean_abs)
         for s in TEACHER_SAMPLES:
             img = render_visibility(scene, light, camera, s, seed=item_seed(teacher.seed, k))

@@ -460,7 +460,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
     let mut traced = None;
     let mut run = |m: &MethodConfig| {
         let c = EyeCall {
-            method: *m,
+            method: probed(*m, error.is_some(), backend),
             ..planned
         };
         match error {
@@ -510,6 +510,25 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         threads,
         plan,
     })
+}
+
+/// The `exact` runs an error target plans on the CPU trace behind the
+/// default call's probe (`auto_config::eye_default`) where they have more
+/// samples than it: only the pixels it is unsure of trace them all. A
+/// config the user gave runs as given.
+fn probed(m: MethodConfig, planned: bool, backend: Backend) -> MethodConfig {
+    use crate::methods::auto_config::EYE_PROBE;
+    match m {
+        MethodConfig::Exact(c)
+            if planned && backend == Backend::Cpu && c.probe.is_none() && c.samples > EYE_PROBE =>
+        {
+            MethodConfig::Exact(crate::methods::ExactConfig {
+                probe: Some(EYE_PROBE),
+                ..c
+            })
+        }
+        _ => m,
+    }
 }
 
 /// `render`, then the direct lighting of every pixel under `lighting`

@@ -37,8 +37,8 @@ pub fn auto_rule(resolution: (usize, usize)) -> SsmConfig {
 /// Issue 28 measured the map rule (`auto_rule`) on scenes built as users
 /// build them (closed boxes, real assets): 0.02-0.22 over the shadowed
 /// pixels with acne and leaks, where `Exact(probe=16)` stays within 1e-4 of
-/// `Exact()`'s error (0.0002-0.014 at 320x240) at 1.0-4.4x less time
-/// (docs/benchmarks/scenes_320x240.md). The GPU traces every ray of every
+/// `Exact()`'s error (0.0001-0.014) at 0.9-5.2x less time
+/// (docs/benchmarks/scenes_320x240.md, scenes_640x480.md). The GPU traces every ray of every
 /// pixel (it has no probe) and is fast enough to.
 pub fn eye_default(backend: Backend) -> super::ExactConfig {
     super::ExactConfig {

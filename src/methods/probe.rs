@@ -25,6 +25,7 @@
 
 use super::bvh::Bvh;
 use super::shadow_rays::{visibilities, RayOrigin, Sampling};
+use rayon::prelude::*;
 
 /// The visibility of each receiver of `receivers`, as
 /// `shadow_rays::visibilities` with `fine` gives it, except that a
@@ -61,9 +62,9 @@ pub(crate) fn probed_visibilities<R: RayOrigin + Copy>(
 /// Which receivers are certain: a probe of 0 or 1 that every neighbour
 /// with a receiver shares (a receiver without one, or with a key outside
 /// the image, is never certain).
-fn certain<R>(
+fn certain<R: Sync>(
     receivers: &[Option<R>],
-    key: impl Fn(usize) -> u64,
+    key: impl Fn(usize) -> u64 + Sync,
     probe: &[f32],
     (width, height): (usize, usize),
 ) -> Vec<bool> {
@@ -76,6 +77,7 @@ fn certain<R>(
         }
     }
     (0..receivers.len())
+        .into_par_iter()
         .map(|k| {
             let (Some(_), Some(p)) = (&receivers[k], pixel(k)) else {
                 return false;

@@ -137,6 +137,22 @@ def test_record_rebuilds_the_item_and_files_hold_the_channels(tmp_path):
     assert int(channels["mesh_id"].max()) == len(record["objects"])
 
 
+def test_auto_with_light_maps_runs_its_map_rule_and_auto_without_traces(tmp_path):
+    # The eye view's default call traces rays (no maps): a spec that writes
+    # the light-view maps with name = "auto" runs auto's map rule instead.
+    text = SMALL.replace('name = "ssm"\nmap_resolution = 64', 'name = "auto"')
+    spec = load_spec(write_spec(tmp_path, text))
+    assert run(spec, tmp_path / "maps", count=1, progress=False).done == 1
+    base = tmp_path / "maps" / "items" / "00000" / "00000000"
+    record = json.loads(base.with_suffix(".json").read_text())
+    assert record["method"]["config"].startswith("Ssm(passes=2")
+    assert sorted(io.read_exr(Path(str(base) + ".maps.exr"))) == ["layer0", "layer1"]
+    spec = load_spec(write_spec(tmp_path / "rays", text.replace("light_maps = true\n", "")))
+    assert run(spec, tmp_path / "rays" / "out", count=1, progress=False).done == 1
+    record = json.loads((tmp_path / "rays" / "out" / "items" / "00000" / "00000000.json").read_text())
+    assert record["method"]["config"] == "Exact(samples=256, probe=16)"
+
+
 def test_zstd_items_hold_the_zip_items_pixels_and_only_that_spec_hash_changes(tmp_path):
     zip_spec = load_spec(write_spec(tmp_path, name="zip.toml"))
     zstd_spec = load_spec(

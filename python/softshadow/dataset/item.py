@@ -114,15 +114,15 @@ def render_item(
         record["method"] = {"name": REFERENCE, "samples": ref.samples, "jitter_seed": jitter_seed}
     else:
         from ..api import render
-        from .spec import make_config
 
         shading = shading_available()
         light = build_light(params["light"], shading=shading)
         extra: dict[str, Any] = {"albedo": [tuple(float(c) for c in a) for a in albedo]} if shading else {}
+        config, loose = method_call(spec)
         img = render(
-            scene, light, camera, make_config(m),
+            scene, light, camera, config,
             map_resolution=m.map_resolution, normal_offset=m.normal_offset, depth_bias=m.depth_bias,
-            backend=m.backend, threads=threads, **extra,
+            backend=m.backend, threads=threads, **extra, **loose,
         )  # fmt: skip
         channels = img.channels()
         maps = list(img.shadow_maps)
@@ -136,6 +136,21 @@ def render_item(
             }
     record["shading"] = {"albedo": "per mesh, scene order", "applied": m.name != REFERENCE and shading_available()}
     return channels, maps, record
+
+
+def method_call(spec: Spec) -> tuple[Any, dict[str, Any]]:
+    """The method an item renders with, and the options given beside it.
+    The eye view's default (``name = "auto"`` without a target) traces rays
+    and makes no maps: items that write the light-view maps run auto's map
+    rule instead (``ssm``'s options given beside ``"auto"`` select it; two
+    passes is its own)."""
+    from .._core import Auto
+    from .spec import make_config
+
+    config = make_config(spec.method)
+    if spec.outputs.light_maps and config == Auto():
+        return "auto", {"passes": 2}
+    return config, {}
 
 
 def make_item(spec: Spec, out: str, k: int, threads: int | None = None) -> dict[str, Any]:

@@ -126,6 +126,8 @@ def describe(img: Any) -> str:
     parts = [c.name]
     if getattr(c, "samples", None) and c.name in ("exact", "bitmask"):
         parts.append(f"{c.samples} samples")
+    if getattr(c, "probe", None):
+        parts.append(f"probe {c.probe}")
     occ = getattr(c, "occluder_resolution", None)
     if occ is not None:
         parts.append(f"maps {occ[0]}×{occ[1]}")

@@ -56,11 +56,13 @@
 //! Each quantity is computed here in the order the kernels always did (in
 //! f64, rounded once to f32), so moving it here changed no bit.
 
+mod placement;
 mod rect;
 
 use crate::error::{Error, Result};
 use crate::geom::units::{MAX_RELATIVE_SIZE, MIN_RELATIVE_SIZE};
 use glam::DVec3;
+pub use placement::Placement;
 pub(crate) use rect::rect_corners;
 
 /// The shape of a light in its plane (see the module doc).
@@ -228,16 +230,6 @@ impl LightShape {
             LightShape::Rect { .. } => rect::front_fraction(side, self.half_extent()),
         }
     }
-}
-
-/// Where a light's shape lies in the world: its centre and light.rs's
-/// frame (u, v along its plane, n from the light into the scene).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Placement {
-    pub center: DVec3,
-    pub u: DVec3,
-    pub v: DVec3,
-    pub n: DVec3,
 }
 
 /// Where the rays of a receiver go on the light, in f32 (the ray casters'

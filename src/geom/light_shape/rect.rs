@@ -12,7 +12,7 @@
 //! (integrating along the axis with the larger coefficient), an integral of
 //! a clamped linear function, in closed form.
 
-use super::Placement;
+use super::placement::Placement;
 use glam::DVec3;
 
 /// The corners of the rectangle of full `size` placed at `at`,
