@@ -8,11 +8,10 @@
 use super::context::gpu;
 use super::dispatch::upload;
 use super::gather;
-use super::method_kernel::{still_waits, LightViewInputs};
-use super::readback::{submit_and_read, visibility, with_error_scopes};
+use super::method_kernel::{run_stage, still_waits, LightViewInputs};
+use super::readback::{visibility, with_error_scopes};
 use super::refusals::{check_side, point_light_on_gpu};
 use super::shading::check_size;
-use super::timing::StageTimer;
 use crate::error::Result;
 use crate::frame::DepthInUnit;
 use crate::geom::light::MapGrid;
@@ -100,14 +99,7 @@ pub(crate) fn shade(
         let maps = upload(&g.device, "maps", &words);
         let shading = make()?;
         sw.lap("upload");
-        let timer = StageTimer::new(g, 2);
-        let mut enc = g
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("softshadow from depth"),
-            });
-        shading.record(g, &mut enc, &timer, &maps)?;
-        let out = submit_and_read(g, enc, &timer, &shading.outputs(), sw)?;
+        let out = run_stage(g, shading.as_ref(), &maps, "softshadow from depth", sw)?;
         shading.check(&out.buffers[1..])?;
         Ok(out)
     })?;

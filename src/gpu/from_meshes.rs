@@ -17,7 +17,7 @@
 use super::context::gpu;
 use super::dispatch::storage;
 use super::gather;
-use super::method_kernel::{still_waits, LightViewInputs};
+use super::method_kernel::{run_stage, still_waits, LightViewInputs};
 use super::raster::{GpuTri, RasterInput};
 use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::refusals::check_side;
@@ -134,14 +134,7 @@ pub(crate) fn maps(
                     .ok_or_else(still_waits)?;
                 let sh = make()?;
                 sw.lap("upload");
-                let timer = StageTimer::new(g, 2);
-                let mut enc = g
-                    .device
-                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                        label: Some("softshadow quads"),
-                    });
-                sh.record(g, &mut enc, &timer, &maps)?;
-                let shaded = submit_and_read(g, enc, &timer, &sh.outputs(), sw)?;
+                let shaded = run_stage(g, sh.as_ref(), &maps, "softshadow quads", sw)?;
                 out.buffers.extend(shaded.buffers);
                 out.device_timings.extend(shaded.device_timings);
                 sh

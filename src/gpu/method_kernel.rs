@@ -6,6 +6,7 @@
 
 use super::context::Gpu;
 use super::gather::LayerCorners;
+use super::readback::{submit_and_read, ReadBack};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::eye::maps::LightTriangles;
@@ -39,6 +40,24 @@ pub(super) trait Stage {
     fn check(&self, _status: &[Vec<u8>]) -> Result<()> {
         Ok(())
     }
+}
+
+/// `stage` alone, recorded on the maps in `maps` (already on the device)
+/// and its outputs read back: a shading whose maps were made by an earlier
+/// submission or uploaded by the caller.
+pub(super) fn run_stage(
+    g: &Gpu,
+    stage: &dyn Stage,
+    maps: &wgpu::Buffer,
+    label: &str,
+    sw: &mut Stopwatch,
+) -> Result<ReadBack> {
+    let timer = StageTimer::new(g, 2);
+    let mut enc = g
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    stage.record(g, &mut enc, &timer, maps)?;
+    submit_and_read(g, enc, &timer, &stage.outputs(), sw)
 }
 
 /// What the light view's shading reads, from meshes or from the user's

@@ -134,13 +134,15 @@ pub struct ExactConfig {
     pub probe: Option<u32>,
 }
 
-/// Light samples of `exact`: 1 to MAX_SAMPLES.
-pub fn check_exact_samples(n: i64) -> Result<u32> {
+/// Light samples of the option `arg` (`samples`, and a `probe`, which saves
+/// time only when fewer than `samples` but is right with any): 1 to
+/// MAX_SAMPLES.
+pub fn check_exact_samples(arg: &str, n: i64) -> Result<u32> {
     if (1..=MAX_SAMPLES as i64).contains(&n) {
         Ok(n as u32)
     } else {
         Err(Error::invalid(
-            "samples",
+            arg,
             format!("must be in [1, {MAX_SAMPLES}], got {n}"),
         ))
     }
@@ -149,10 +151,10 @@ pub fn check_exact_samples(n: i64) -> Result<u32> {
 impl ExactConfig {
     pub fn new(samples: Option<i64>, probe: Option<i64>) -> Result<Self> {
         let samples = samples
-            .map(check_exact_samples)
+            .map(|n| check_exact_samples("samples", n))
             .transpose()?
             .unwrap_or(DEFAULT_SAMPLES);
-        let probe = probe.map(check_probe).transpose()?;
+        let probe = probe.map(|p| check_exact_samples("probe", p)).transpose()?;
         Ok(ExactConfig { samples, probe })
     }
 
@@ -162,19 +164,6 @@ impl ExactConfig {
             samples,
             probe: None,
         }
-    }
-}
-
-/// A probe's light samples: 1 to MAX_SAMPLES (it saves time only when
-/// fewer than `samples`, but is right with any).
-pub fn check_probe(p: i64) -> Result<u32> {
-    if (1..=MAX_SAMPLES as i64).contains(&p) {
-        Ok(p as u32)
-    } else {
-        Err(Error::invalid(
-            "probe",
-            format!("must be in [1, {MAX_SAMPLES}], got {p}"),
-        ))
     }
 }
 
