@@ -33,6 +33,7 @@ use super::gather::{
     self, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -708,6 +709,27 @@ impl Default for BitmaskConfig {
             hierarchy: None,
             gaps: Default::default(),
         }
+    }
+}
+
+impl KeywordForm for BitmaskConfig {
+    fn from_keywords(k: &Keywords) -> Result<Self> {
+        BitmaskConfig::new(
+            k.int("samples")?,
+            k.int("passes")?,
+            k.resolution("occluder_resolution")?,
+            k.bool("hierarchy")?,
+            k.str("gaps")?,
+        )
+    }
+    fn keywords(&self) -> Vec<(&'static str, Value)> {
+        vec![
+            ("samples", count(Some(self.samples))),
+            ("passes", count(self.passes)),
+            ("occluder_resolution", resolution(self.occluder_resolution)),
+            ("hierarchy", flag(self.hierarchy)),
+            ("gaps", Value::Str(self.gaps.name())),
+        ]
     }
 }
 

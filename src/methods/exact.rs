@@ -23,6 +23,7 @@ use super::config::{
     PRECISION_SSM_ONLY,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::keywords::{count, KeywordForm, Keywords};
 use super::probe::probed_visibilities;
 pub(crate) use super::shadow_rays::RAY_EPS;
 use super::shadow_rays::{tile_order, visibilities, Sampling};
@@ -170,6 +171,18 @@ impl ExactConfig {
 impl Default for ExactConfig {
     fn default() -> Self {
         ExactConfig::of(DEFAULT_SAMPLES)
+    }
+}
+
+impl KeywordForm for ExactConfig {
+    fn from_keywords(k: &Keywords) -> Result<Self> {
+        ExactConfig::new(k.int("samples")?, k.int("probe")?)
+    }
+    fn keywords(&self) -> Vec<(&'static str, Value)> {
+        vec![
+            ("samples", count(Some(self.samples))),
+            ("probe", count(self.probe)),
+        ]
     }
 }
 

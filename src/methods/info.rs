@@ -14,6 +14,8 @@ pub enum Value {
     Bool(bool),
     Str(&'static str),
     Float(f64),
+    /// A (W, H) resolution.
+    Pair(i64, i64),
 }
 
 /// What values an option takes.

@@ -10,7 +10,9 @@
 //! variant, its name, the dispatch and its capabilities row:
 //! `registry.rs`) and its kernel (`Method`: the options that change what it
 //! computes, what it reads, its implementation). The configs' modules never
-//! name this file, so the registry imports them without a circle.
+//! name this file, so the registry imports them without a circle. A line
+//! marked `keywords` is a config with a keyword form (`keywords.rs`): the
+//! bindings make its Python class from it, with no code of the method's.
 
 pub mod auto_config;
 pub mod bitmask;
@@ -23,6 +25,7 @@ pub mod exact;
 pub(crate) mod gather;
 pub mod info;
 pub mod inputs;
+pub mod keywords;
 pub(crate) mod packet;
 pub mod pcf;
 pub mod pcss;
@@ -47,13 +50,13 @@ pub use smoothies::config::SmoothiesConfig;
 pub use ssm::{SsmConfig, HIERARCHY_DEFAULT_SSM};
 
 registry::methods! {
-    Ssm(SsmConfig),
-    Bitmask(BitmaskConfig),
-    Exact(ExactConfig),
+    Ssm(SsmConfig, keywords),
+    Bitmask(BitmaskConfig, keywords),
+    Exact(ExactConfig, keywords),
     /// Fernando 2005's percentage-closer soft shadows (`pcss.rs`).
-    Pcss(PcssConfig),
+    Pcss(PcssConfig, keywords),
     /// Chan & Durand 2003's smoothies (`smoothies/`).
-    Smoothies(SmoothiesConfig),
+    Smoothies(SmoothiesConfig, keywords),
     /// Scherzer 2005's practical shadow mapping (hard shadows from the
     /// light's centre or direction; `shadow_mapping/`).
     ShadowMapping(ShadowMappingConfig),

@@ -87,6 +87,7 @@ use super::config::{
     MethodSpec,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::keywords::{count, resolution, KeywordForm, Keywords};
 use super::pcf::{self, occludes, Axis, Border};
 use super::Input;
 use super::{point_light, LightPoint, ShadowInputs, ShadowMethod};
@@ -320,6 +321,18 @@ impl Default for PcssConfig {
             max_taps: DEFAULT_MAX_TAPS,
             occluder_resolution: None,
         }
+    }
+}
+
+impl KeywordForm for PcssConfig {
+    fn from_keywords(k: &Keywords) -> Result<Self> {
+        PcssConfig::new(k.int("max_taps")?, k.resolution("occluder_resolution")?)
+    }
+    fn keywords(&self) -> Vec<(&'static str, Value)> {
+        vec![
+            ("max_taps", count(Some(self.max_taps))),
+            ("occluder_resolution", resolution(self.occluder_resolution)),
+        ]
     }
 }
 

@@ -13,7 +13,7 @@
 /// The registry of method configs; see the module's doc. Invoked once, in
 /// `mod.rs`, where each method's module is declared.
 macro_rules! methods {
-    ($($(#[doc = $doc:literal])* $variant:ident($config:ty),)*) => {
+    ($($(#[doc = $doc:literal])* $variant:ident($config:ty $(, $kw:ident)?),)*) => {
         /// What a user picks: a method with its options, or `Auto` (see
         /// `AutoConfig`).
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -105,6 +105,56 @@ macro_rules! methods {
                 }
             }
 
+            /// The config named `name` from its keyword form (`Bitmask(samples=64)`,
+            /// `keywords.rs`): each option given must be the method's.
+            pub fn from_keywords(
+                name: &str,
+                k: &$crate::methods::keywords::Keywords,
+            ) -> $crate::error::Result<Self> {
+                #[allow(unused_imports)]
+                use $crate::methods::config::MethodSpec;
+                #[allow(unused_imports)]
+                use $crate::methods::keywords::KeywordForm;
+                $($crate::methods::registry::with_keywords!($($kw)? ; {
+                    if name == <$config as MethodSpec>::NAME {
+                        k.check_names(&<$config as MethodSpec>::info())?;
+                        return Ok(MethodConfig::$variant(<$config>::from_keywords(k)?));
+                    }
+                } ; {});)*
+                Err($crate::error::Error::invalid(
+                    "method",
+                    format!("{name:?} has no keyword form (its class is the bindings' own)"),
+                ))
+            }
+
+            /// The config's options as its keyword form takes them, in its
+            /// table's order; `None` for a config without a keyword form.
+            pub fn keywords(
+                &self,
+            ) -> Option<Vec<(&'static str, $crate::methods::info::Value)>> {
+                #[allow(unused_imports)]
+                use $crate::methods::keywords::KeywordForm;
+                match self {
+                    $(#[allow(unused_variables)] MethodConfig::$variant(c) => {
+                        $crate::methods::registry::with_keywords!($($kw)? ; {
+                            Some(c.keywords())
+                        } ; { None })
+                    })*
+                }
+            }
+
+            /// The names of the methods whose config has a keyword form.
+            pub fn keyword_forms() -> Vec<&'static str> {
+                let marked = [$($crate::methods::registry::with_keywords!($($kw)? ; {
+                    true
+                } ; { false })),*];
+                METHOD_NAMES
+                    .iter()
+                    .zip(marked)
+                    .filter_map(|(name, k)| k.then_some(*name))
+                    .collect()
+            }
+
             /// Every method's row of `capabilities()`, in the registry's order.
             pub fn infos() -> Vec<$crate::methods::info::MethodInfo> {
                 use $crate::methods::config::MethodSpec;
@@ -115,6 +165,19 @@ macro_rules! methods {
 }
 
 pub(crate) use methods;
+
+/// `with_keywords!(keywords ; { then } ; { otherwise })`: `then` for a
+/// registry line marked `keywords`, `otherwise` for one that is not.
+macro_rules! with_keywords {
+    (keywords ; { $($then:tt)* } ; { $($otherwise:tt)* }) => {
+        $($then)*
+    };
+    (; { $($then:tt)* } ; { $($otherwise:tt)* }) => {
+        $($otherwise)*
+    };
+}
+
+pub(crate) use with_keywords;
 
 #[cfg(test)]
 mod tests {
@@ -179,6 +242,54 @@ mod tests {
         assert!(
             matches!(three.resolve(&depth), Err(Error::InvalidArgument { ref arg, .. }) if arg == "passes")
         );
+    }
+
+    #[test]
+    fn a_keyword_form_names_its_table_s_options_in_order_and_reads_back() {
+        use crate::methods::keywords::{Given, Keywords};
+        let forms = MethodConfig::keyword_forms();
+        assert!(forms.contains(&"bitmask") && !forms.contains(&"auto"));
+        for info in MethodConfig::infos() {
+            let Ok(c) = MethodConfig::from_keywords(info.name, &Keywords::default()) else {
+                assert!(!forms.contains(&info.name), "{}", info.name);
+                assert!(MethodConfig::Auto(AutoConfig::default())
+                    .keywords()
+                    .is_none());
+                continue;
+            };
+            let values = c.keywords().unwrap();
+            let names: Vec<&str> = values.iter().map(|(n, _)| *n).collect();
+            let table: Vec<&str> = info.options.iter().map(|o| o.name).collect();
+            assert_eq!(names, table, "{}", info.name);
+            let again = MethodConfig::from_keywords(info.name, &Keywords::of(&values)).unwrap();
+            assert_eq!(again, c, "{}", info.name);
+        }
+        let given = Keywords(vec![
+            ("samples".into(), Given::Int(64)),
+            ("occluder_resolution".into(), Given::Resolution((32, 16))),
+            ("gaps".into(), Given::Str("open".into())),
+        ]);
+        let c = MethodConfig::from_keywords("bitmask", &given).unwrap();
+        assert_eq!(
+            MethodConfig::from_keywords("bitmask", &Keywords::of(&c.keywords().unwrap())).unwrap(),
+            c
+        );
+        let MethodConfig::Bitmask(b) = c else {
+            panic!("{c:?}")
+        };
+        assert_eq!((b.samples, b.occluder_resolution), (64, Some((32, 16))));
+        let e = MethodConfig::from_keywords(
+            "exact",
+            &Keywords(vec![("gaps".into(), Given::Str("open".into()))]),
+        )
+        .unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument { ref arg, .. } if arg == "gaps"));
+        let e = MethodConfig::from_keywords(
+            "exact",
+            &Keywords(vec![("samples".into(), Given::Str("x".into()))]),
+        )
+        .unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument { ref arg, .. } if arg == "samples"));
     }
 
     #[test]

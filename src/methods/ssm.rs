@@ -29,6 +29,7 @@ use super::gather::{
     self, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -387,6 +388,25 @@ impl SsmConfig {
                 .transpose()?
                 .unwrap_or_default(),
         })
+    }
+}
+
+impl KeywordForm for SsmConfig {
+    fn from_keywords(k: &Keywords) -> Result<Self> {
+        SsmConfig::new(
+            k.int("passes")?,
+            k.resolution("occluder_resolution")?,
+            k.bool("hierarchy")?,
+            k.str("precision")?,
+        )
+    }
+    fn keywords(&self) -> Vec<(&'static str, Value)> {
+        vec![
+            ("passes", count(self.passes)),
+            ("occluder_resolution", resolution(self.occluder_resolution)),
+            ("hierarchy", flag(self.hierarchy)),
+            ("precision", Value::Str(self.precision.name())),
+        ]
     }
 }
 

@@ -5,13 +5,15 @@ use crate::methods::capabilities::{self as caps, Kind, Value};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-fn value(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
+/// An option's value as Python's.
+pub fn value(py: Python<'_>, v: &Value) -> PyResult<Py<PyAny>> {
     Ok(match v {
         Value::Resolved => py.None(),
         Value::Int(n) => n.into_pyobject(py)?.into_any().unbind(),
         Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any().unbind(),
         Value::Str(s) => s.into_pyobject(py)?.into_any().unbind(),
         Value::Float(x) => x.into_pyobject(py)?.into_any().unbind(),
+        Value::Pair(w, h) => (w, h).into_pyobject(py)?.into_any().unbind(),
     })
 }
 

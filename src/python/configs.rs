@@ -1,97 +1,23 @@
-//! The method configs as Python classes: `Ssm`, `Bitmask`, `Exact`, `Auto`
-//! here, and the list of every method's class (`method_classes!`: the
-//! conversions to and from `MethodConfig`, the registration), the string
-//! form.
+//! The method configs as Python classes: `Auto` here, `ShadowMapping` in
+//! `shadow_configs.rs` (their options are a target and configs), every
+//! other method's class made from its keyword form (`keyword_class.rs`);
+//! the conversions between them and `MethodConfig`, and the string form.
 //! Frozen, keyword-only, compared and hashed by value, picklable (pickle
 //! calls the keyword-only constructor again through `__getnewargs_ex__`).
 //! The values are checked by the core's constructors (each in its method's module);
 //! `None` means "resolved when the config runs".
 
-use super::config_class::{config_class, newargs};
+use super::config_class::newargs;
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string, string};
-use super::shadow_configs::{PyPcss, PyShadowMapping, PySmoothies};
+use super::keyword_class::{self, PyKeywordConfig};
+use super::shadow_configs::PyShadowMapping;
 use crate::methods::config::{check_resolution, LooseOptions};
 use crate::methods::target::Target;
 use crate::methods::{auto_rule, AutoConfig};
-use crate::methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
+use crate::methods::{MethodConfig, SsmConfig};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-
-config_class! {
-    /// Soft shadow maps as published (Atty et al. 2005). See `capabilities()["ssm"]`.
-    class PySsm(SsmConfig) as "Ssm", name "ssm";
-    #[pyo3(signature = (*, passes=None, occluder_resolution=None, hierarchy=None, precision=None))]
-    fn new(
-        passes: Option<&Bound<'_, PyAny>>,
-        occluder_resolution: Option<&Bound<'_, PyAny>>,
-        hierarchy: Option<&Bound<'_, PyAny>>,
-        precision: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        let precision = opt_string("precision", precision)?;
-        Ok(PySsm(SsmConfig::new(
-            opt_int("passes", passes)?,
-            opt_resolution("occluder_resolution", occluder_resolution)?,
-            opt_bool("hierarchy", hierarchy)?,
-            precision.as_deref(),
-        )?))
-    }
-    options {
-        passes: Option<u32> = |c, py| c.0.passes;
-        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
-        hierarchy: Option<bool> = |c, py| c.0.hierarchy;
-        precision: &'static str = |c, py| c.0.precision.name();
-    }
-}
-
-config_class! {
-    /// Micro-patches marking light samples in a bit mask per receiver. See
-    /// `capabilities()["bitmask"]`.
-    class PyBitmask(BitmaskConfig) as "Bitmask", name "bitmask";
-    #[pyo3(signature = (*, samples=None, passes=None, occluder_resolution=None, hierarchy=None, gaps=None))]
-    fn new(
-        samples: Option<&Bound<'_, PyAny>>,
-        passes: Option<&Bound<'_, PyAny>>,
-        occluder_resolution: Option<&Bound<'_, PyAny>>,
-        hierarchy: Option<&Bound<'_, PyAny>>,
-        gaps: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        let gaps = opt_string("gaps", gaps)?;
-        Ok(PyBitmask(BitmaskConfig::new(
-            opt_int("samples", samples)?,
-            opt_int("passes", passes)?,
-            opt_resolution("occluder_resolution", occluder_resolution)?,
-            opt_bool("hierarchy", hierarchy)?,
-            gaps.as_deref(),
-        )?))
-    }
-    options {
-        samples: u32 = |c, py| c.0.samples;
-        passes: Option<u32> = |c, py| c.0.passes;
-        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
-        hierarchy: Option<bool> = |c, py| c.0.hierarchy;
-        gaps: &'static str = |c, py| c.0.gaps.name();
-    }
-}
-
-config_class! {
-    /// Ray casting against the occluder triangles. See `capabilities()["exact"]`.
-    class PyExact(ExactConfig) as "Exact", name "exact";
-    #[pyo3(signature = (*, samples=None, probe=None))]
-    fn new(
-        samples: Option<&Bound<'_, PyAny>>,
-        probe: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        Ok(PyExact(ExactConfig::new(
-            opt_int("samples", samples)?,
-            opt_int("probe", probe)?,
-        )?))
-    }
-    options {
-        samples: u32 = |c, py| c.0.samples;
-        probe: Option<u32> = |c, py| c.0.probe;
-    }
-}
 
 impl From<AutoConfig> for PyAuto {
     // The options given beside `method="auto"` are the string form's; the
@@ -150,12 +76,12 @@ impl PyAuto {
     }
     /// The ``Ssm`` the rule picks for an output ``resolution`` (an int or
     /// (W, H)) from meshes.
-    fn rule(&self, resolution: &Bound<'_, PyAny>) -> PyResult<PySsm> {
+    fn rule(&self, py: Python<'_>, resolution: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
         let r = check_resolution(
             "resolution",
             super::convert::resolution("resolution", resolution)?,
         )?;
-        Ok(PySsm(auto_rule(r)))
+        to_py(py, &MethodConfig::Ssm(auto_rule(r)))
     }
     fn __getnewargs_ex__<'py>(
         &self,
@@ -216,22 +142,24 @@ pub fn method_arg(method: &Bound<'_, PyAny>, loose: &Loose<'_>) -> PyResult<Meth
     if method.extract::<String>().is_err() {
         return Err(PyTypeError::new_err(format!(
             "method: must be a method name or a config ({}), got {}",
-            class_names(method.py())?,
+            class_names(),
             method.get_type().name()?
         )));
     }
     Ok(MethodConfig::from_name(&string("method", method)?, &o)?)
 }
 
-/// The method config classes, each with the `MethodConfig` variant it
+/// The classes written here, each with the `MethodConfig` variant it
 /// holds: one line a class makes its conversion both ways (`config_of`,
-/// `to_py`), its registration in `_core` and its name in `method=`'s
-/// TypeError. A class converts through `From` (made by `config_class!` for
-/// a class over its core config; `Auto`'s below).
-macro_rules! method_classes {
+/// `to_py`) and its registration in `_core`; the keyword-form classes
+/// (`keyword_class.rs`) are converted and registered from the core's table.
+macro_rules! hand_written_classes {
     ($($class:ty => $variant:ident,)*) => {
         /// The core config of a config object, if it is one.
         fn config_of(v: &Bound<'_, PyAny>) -> Option<MethodConfig> {
+            if let Ok(c) = v.cast::<PyKeywordConfig>() {
+                return Some(c.get().0);
+            }
             $(if let Ok(c) = v.cast::<$class>() {
                 return Some(MethodConfig::$variant(c.get().into()));
             })*
@@ -240,31 +168,30 @@ macro_rules! method_classes {
 
         /// A method config as its Python object.
         pub fn to_py(py: Python<'_>, c: &MethodConfig) -> PyResult<Py<PyAny>> {
+            if let Some(o) = keyword_class::to_py(py, c)? {
+                return Ok(o);
+            }
             Ok(match *c {
                 $(MethodConfig::$variant(c) => Py::new(py, <$class>::from(c))?.into_any(),)*
+                _ => unreachable!("every config has a keyword form or a class written here"),
             })
         }
 
-        /// The config classes' Python names, in the list's order.
-        fn class_names(py: Python<'_>) -> PyResult<String> {
-            let names: Vec<String> =
-                vec![$(<$class as pyo3::PyTypeInfo>::type_object(py).name()?.to_string()),*];
-            Ok(names.join(", "))
-        }
-
         pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+            keyword_class::register(m)?;
             $(m.add_class::<$class>()?;)*
             Ok(())
         }
     };
 }
 
-method_classes! {
-    PySsm => Ssm,
-    PyBitmask => Bitmask,
-    PyExact => Exact,
+hand_written_classes! {
     PyAuto => Auto,
-    PyPcss => Pcss,
-    PySmoothies => Smoothies,
     PyShadowMapping => ShadowMapping,
+}
+
+/// The config classes' Python names, in the table's order.
+fn class_names() -> String {
+    let names: Vec<&str> = MethodConfig::infos().iter().map(|i| i.config).collect();
+    names.join(", ")
 }

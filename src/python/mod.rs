@@ -4,11 +4,13 @@
 //! the backend dispatch live in the core; Python reads them from here.
 //!
 //! * `convert.rs`: Python values to core values (TypeError naming the argument).
-//! * `config_class.rs`: the macro that makes a config class from one
-//!   description of its options; `configs.rs` (`Ssm`, `Bitmask`, `Exact`,
-//!   `Auto`, the string form, and the list of every method's class:
-//!   `method_classes!`) and `shadow_configs.rs` (ShadowMapping and
-//!   its parts, PCSS, Smoothies) describe them.
+//! * `keyword_class.rs`: the class of every config with a keyword form
+//!   (`Ssm`, `Bitmask`, `Exact`, `PCSS`, `Smoothies`, and a new method's),
+//!   made at import from the core's table; nothing here names them.
+//! * `config_class.rs`: the macro that makes a class from one description
+//!   of its options, for the configs written by hand: `configs.rs` (`Auto`,
+//!   the conversions of every config, the string form) and
+//!   `shadow_configs.rs` (ShadowMapping and its parts).
 //! * `camera.rs`: the eye view's `Camera`; `lights.rs`: `RectLight`,
 //!   `DirectionalLight`.
 //! * `entry.rs`: the entry points.
@@ -28,6 +30,7 @@ mod errors;
 mod estimate;
 mod eye;
 mod gpu;
+mod keyword_class;
 mod lights;
 mod results;
 mod shadow_configs;

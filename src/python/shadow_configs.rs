@@ -1,16 +1,14 @@
-//! The ShadowMapping config and its parts, PCSS and Smoothies as Python
-//! classes (frozen, keyword-only, compared by value, picklable: see
-//! `config_class.rs`); the values are checked by the core
-//! (`methods/shadow_mapping/config.rs`, `methods/pcss.rs`,
-//! `methods/smoothies/config.rs`). The method classes are registered by the
-//! list of `configs.rs`; this file registers the parts.
+//! The ShadowMapping config and its parts as Python classes (frozen,
+//! keyword-only, compared by value, picklable: see `config_class.rs`); the
+//! values are checked by the core (`methods/shadow_mapping/config.rs`).
+//! ShadowMapping is registered by the list of `configs.rs`; this file
+//! registers the parts.
 
 use super::config_class::config_class;
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string};
 use crate::methods::shadow_mapping::config::{
     check_pcf, DepthBias, EyeSpaceBlur, LiSPSM, Pcf, ShadowMappingConfig,
 };
-use crate::methods::{PcssConfig, SmoothiesConfig};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
@@ -238,52 +236,6 @@ config_class! {
         focus: bool = |c, py| c.0.focus;
         blur: Option<Py<PyEyeSpaceBlur>> =
             |c, py| c.0.blur.map(|b| Py::new(py, PyEyeSpaceBlur(b))).transpose()?;
-    }
-}
-
-config_class! {
-    /// Smoothies (Chan & Durand 2003). See ``capabilities()["smoothies"]``.
-    class PySmoothies(SmoothiesConfig) as "Smoothies", name "smoothies";
-    #[pyo3(signature = (*, width=None, falloff=None, filter=None, occluder_resolution=None))]
-    fn new(
-        width: Option<&Bound<'_, PyAny>>,
-        falloff: Option<&Bound<'_, PyAny>>,
-        filter: Option<&Bound<'_, PyAny>>,
-        occluder_resolution: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        let falloff = opt_string("falloff", falloff)?;
-        let filter = opt_string("filter", filter)?;
-        Ok(PySmoothies(SmoothiesConfig::new(
-            opt_float("width", width)?,
-            falloff.as_deref(),
-            filter.as_deref(),
-            opt_resolution("occluder_resolution", occluder_resolution)?,
-        )?))
-    }
-    options {
-        width: f64 = |c, py| c.0.width.0;
-        falloff: &'static str = |c, py| c.0.falloff.name();
-        filter: &'static str = |c, py| "bilinear";
-        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
-    }
-}
-
-config_class! {
-    /// PCSS (Fernando 2005). See ``capabilities()["pcss"]``.
-    class PyPcss(PcssConfig) as "PCSS", name "pcss";
-    #[pyo3(signature = (*, max_taps=None, occluder_resolution=None))]
-    fn new(
-        max_taps: Option<&Bound<'_, PyAny>>,
-        occluder_resolution: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        Ok(PyPcss(PcssConfig::new(
-            opt_int("max_taps", max_taps)?,
-            opt_resolution("occluder_resolution", occluder_resolution)?,
-        )?))
-    }
-    options {
-        max_taps: u32 = |c, py| c.0.max_taps;
-        occluder_resolution: Option<(usize, usize)> = |c, py| c.0.occluder_resolution;
     }
 }
 

@@ -8,6 +8,7 @@ checked against what the core accepts and refuses.
 from __future__ import annotations
 
 import copy
+import inspect
 import pickle
 from pathlib import Path
 
@@ -148,6 +149,32 @@ def test_configs_are_frozen_keyword_only_comparable_and_picklable():
         ss.Exact(samples=2.5)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="^hierarchy: must be a bool"):
         ss.Ssm(hierarchy=1)  # type: ignore[arg-type]
+
+
+def test_every_config_class_takes_its_table_s_options_by_keyword_and_reads_them_back():
+    # Most classes are made from the core's table when the module is
+    # imported (a new method adds none here): each must behave as the
+    # classes written by hand do.
+    for name, info in CAPS.items():
+        cls = info.config
+        params = inspect.signature(cls).parameters
+        assert list(params) == list(info.options), name
+        assert all(p.kind is inspect.Parameter.KEYWORD_ONLY and p.default is None for p in params.values()), name
+        c = cls()
+        assert c.to_dict().keys() == info.options.keys(), name
+        for opt in info.options:
+            assert getattr(c, opt) == c.to_dict()[opt], (name, opt)
+        back = pickle.loads(pickle.dumps(c))
+        assert back == c and type(back) is cls and hash(back) == hash(c) and repr(back) == repr(c), name
+        assert repr(c).startswith(f"{cls.__name__}("), name
+        with pytest.raises(TypeError, match="unexpected keyword argument 'not_an_option'"):
+            cls(not_an_option=1)
+        with pytest.raises(TypeError, match="positional"):
+            cls(1)
+        with pytest.raises(TypeError):
+            type("Derived", (cls,), {})
+        with pytest.raises(AttributeError):
+            c.anything = 1  # type: ignore[attr-defined]
 
 
 def test_the_limits_are_the_cores():

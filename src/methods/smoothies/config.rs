@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::methods::config::{check_resolution, occluder_resolution_option};
 use crate::methods::config::{CallContext, LooseOptions, MethodSpec};
 use crate::methods::info::{Kind, MethodInfo, OptionInfo, Value};
+use crate::methods::keywords::{resolution, KeywordForm, Keywords};
 use crate::methods::shadow_mapping::config::{check_real, Real};
 use crate::methods::Input;
 
@@ -91,6 +92,25 @@ impl Default for SmoothiesConfig {
             falloff: Falloff::Linear,
             occluder_resolution: None,
         }
+    }
+}
+
+impl KeywordForm for SmoothiesConfig {
+    fn from_keywords(k: &Keywords) -> Result<Self> {
+        SmoothiesConfig::new(
+            k.float("width")?,
+            k.str("falloff")?,
+            k.str("filter")?,
+            k.resolution("occluder_resolution")?,
+        )
+    }
+    fn keywords(&self) -> Vec<(&'static str, Value)> {
+        vec![
+            ("width", Value::Float(self.width.0)),
+            ("falloff", Value::Str(self.falloff.name())),
+            ("filter", Value::Str(SMOOTHIE_FILTERS[0])),
+            ("occluder_resolution", resolution(self.occluder_resolution)),
+        ]
     }
 }
 
