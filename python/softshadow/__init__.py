@@ -20,14 +20,15 @@ metrics in :mod:`softshadow.metrics`, Mitsuba references in
 """
 
 from . import methods
+
+# The method configs and their parts: the core's `__all__`, made from its
+# table (a new method's class needs no line here; mypy reads the stub's
+# list). `methods.__all__` adds their table and limits to it.
+from ._core import *  # noqa: F403
 from ._core import __version__
 from .api import gpu_available, gpu_info, render, soft_shadow_map, soft_shadow_map_from_depth
 from .errors import GpuUnavailableError, TooLargeError
 from .lights import DirectionalLight, RectLight
-
-# The configs, their table and limits: `methods.__all__` lists them once (a
-# new method's class is added there only); mypy and stubtest follow both the
-# star import and the `__all__ +=` below.
 from .methods import *  # noqa: F403
 from .results import Decision, ErrorEstimate, Image, Plan, ShadowMap
 from .scene import Camera, Scene

@@ -15,14 +15,18 @@ import numpy as np
 import numpy.typing as npt
 from typing_extensions import disjoint_base
 
+# What `from softshadow._core import *` gives (the module's `__all__`, made
+# from the core's table): the method configs, in the table's order, and
+# their parts. `softshadow.methods` exports them; a new method's class goes
+# here, in `_Ran` and its class below.
 __all__ = [
     "Ssm",
     "Bitmask",
     "Exact",
-    "Auto",
     "PCSS",
     "Smoothies",
     "ShadowMapping",
+    "Auto",
     "ConstantBias",
     "SlopeScaleBias",
     "LinearDepthBias",
@@ -31,34 +35,6 @@ __all__ = [
     "PCF",
     "LiSPSM",
     "EyeSpaceBlur",
-    "Camera",
-    "RectLight",
-    "DirectionalLight",
-    "MeshShadowResult",
-    "DepthShadowResult",
-    "MethodInfo",
-    "OptionInfo",
-    "capabilities",
-    "limits",
-    "light_frame",
-    "render",
-    "light_emission",
-    "irradiance",
-    "EyeResult",
-    "ErrorEstimate",
-    "check_mesh",
-    "shadow_map_from_meshes",
-    "shadow_map_from_depth",
-    "shadow_map_from_scene",
-    "sample_points",
-    "receiver_points",
-    "gpu_available",
-    "gpu_info",
-    "GpuUnavailableError",
-    "TooLargeError",
-    "_panic_for_tests",
-    "__version__",
-    "ENV_THREADS",
 ]
 
 __version__: str

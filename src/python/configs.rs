@@ -177,10 +177,12 @@ macro_rules! hand_written_classes {
             })
         }
 
-        pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+        /// Registers every method's config class; their names, in the
+        /// table's order.
+        pub fn register(m: &Bound<'_, PyModule>) -> PyResult<Vec<String>> {
             keyword_class::register(m)?;
             $(m.add_class::<$class>()?;)*
-            Ok(())
+            Ok(MethodConfig::infos().iter().map(|i| i.config.to_string()).collect())
         }
     };
 }

@@ -45,8 +45,8 @@ static ALLOCATOR: crate::block_cache::BlockCache = crate::block_cache::BlockCach
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     ALLOCATOR.configure_from_env();
-    configs::register(m)?;
-    shadow_configs::register(m)?;
+    let mut configs = configs::register(m)?;
+    configs.extend(shadow_configs::register(m)?);
     m.add_class::<camera::PyCamera>()?;
     m.add_class::<lights::PyRectLight>()?;
     m.add_class::<lights::PyDirectionalLight>()?;
@@ -78,5 +78,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entry::_panic_for_tests, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("ENV_THREADS", crate::threads::ENV_THREADS)?;
+    // `from softshadow._core import *` gives the method configs and their
+    // parts, and nothing else (pyo3's `add` listed every name): the
+    // package's `methods` exports them from here, so a new method's class
+    // needs no line there.
+    m.setattr("__all__", configs)?;
     Ok(())
 }

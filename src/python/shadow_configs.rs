@@ -239,14 +239,25 @@ config_class! {
     }
 }
 
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PyConstantBias>()?;
-    m.add_class::<PySlopeScaleBias>()?;
-    m.add_class::<PyLinearDepthBias>()?;
-    m.add_class::<PyBackFaces>()?;
-    m.add_class::<PyMidpointBias>()?;
-    m.add_class::<PyPcf>()?;
-    m.add_class::<PyLiSPSM>()?;
-    m.add_class::<PyEyeSpaceBlur>()?;
-    Ok(())
+/// Registers the parts; their names, for `_core.__all__`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<Vec<String>> {
+    let py = m.py();
+    let parts = [
+        py.get_type::<PyConstantBias>(),
+        py.get_type::<PySlopeScaleBias>(),
+        py.get_type::<PyLinearDepthBias>(),
+        py.get_type::<PyBackFaces>(),
+        py.get_type::<PyMidpointBias>(),
+        py.get_type::<PyPcf>(),
+        py.get_type::<PyLiSPSM>(),
+        py.get_type::<PyEyeSpaceBlur>(),
+    ];
+    parts
+        .iter()
+        .map(|t| {
+            let name = t.name()?.to_string();
+            m.add(name.as_str(), t)?;
+            Ok(name)
+        })
+        .collect()
 }
