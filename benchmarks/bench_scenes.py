@@ -10,7 +10,8 @@ samples a pixel, cached in ``.cache/references/``) and one call per method of
 scene, wall clock; speed lives in ``bench_eye.py``). Per call,
 ``softshadow.metrics.compare_images``: ``shadow_error`` (mean |V - V_ref|
 over the matched pixels the reference shadows), ``mean_abs`` (over every
-matched pixel), ``acne`` and ``leak`` (fractions of the matched pixels);
+matched pixel), ``acne`` and ``leak`` (fractions of the matched pixels),
+``grain`` (per-pixel noise over the reference's own, on its penumbra);
 then the same call with ``estimate_error=True``: its ``error_estimate``
 against the measured error, and its share of the call's time.
 Writes ``docs/benchmarks/scenes_<W>x<H>.md``; the summary gives each method's
@@ -82,17 +83,17 @@ def main() -> None:
         )
         report.line()
         report.line(
-            "| call | error over shadowed pixels | over all pixels | acne | leaks | time (ms) | ran "
+            "| call | error over shadowed pixels | over all pixels | acne | leaks | grain | time (ms) | ran "
             "| estimate (95% interval) | estimate / error | its share of the call |"
         )
-        report.line("|---|---|---|---|---|---|---|---|---|---|")
+        report.line("|---|---|---|---|---|---|---|---|---|---|---|")
         for label in args.methods:
             try:
                 t = time.perf_counter()
                 img = call(METHODS[label], scene, light, cam)
                 ms = (time.perf_counter() - t) * 1e3
             except (ValueError, RuntimeError) as e:  # a method the scene's light does not take
-                report.line(f"| {label} | refused: {str(e).splitlines()[0][:80]} | | | | | |")
+                report.line(f"| {label} | refused: {str(e).splitlines()[0][:80]} | | | | | | |")
                 continue
             c = compare_images(img, ref)
             ran = img.method.name if hasattr(img.method, "name") else str(img.method)
@@ -105,19 +106,20 @@ def main() -> None:
             ratio = f"{e.error / c.shadow_error:.2f}" if c.shadow_error > 0 else "–"
             report.line(
                 f"| {label} | {c.shadow_error:.4f} | {c.mean_abs:.4f} | {c.acne:.2%} | {c.leak:.2%} "
-                f"| {ms:.0f} | {ran} | {e.error:.4f} ({e.interval[0]:.4f}–{e.interval[1]:.4f}), "
+                f"| {c.grain:+.4f} | {ms:.0f} | {ran} | {e.error:.4f} ({e.interval[0]:.4f}–{e.interval[1]:.4f}), "
                 f"{e.traced} px | {ratio} | {share:.0%} |"
             )
             ratios.setdefault(label, []).append((c.shadow_error, e.error, share))
-            w = worst.setdefault((label, which), [0.0, 0.0, 0.0])
+            w = worst.setdefault((label, which), [0.0, 0.0, 0.0, 0.0])
             w[0], w[1], w[2] = max(w[0], c.shadow_error), max(w[1], c.acne), max(w[2], c.leak)
+            w[3] = max(w[3], c.grain)
         report.line()
     report.line("## Summary: each call's worst scene")
     report.line()
-    report.line("| call | set | error over shadowed pixels | acne | leaks |")
-    report.line("|---|---|---|---|---|")
-    for (label, which), (e, a, lk) in worst.items():
-        report.line(f"| {label} | {which} | {e:.4f} | {a:.2%} | {lk:.2%} |")
+    report.line("| call | set | error over shadowed pixels | acne | leaks | grain |")
+    report.line("|---|---|---|---|---|---|")
+    for (label, which), (e, a, lk, g) in worst.items():
+        report.line(f"| {label} | {which} | {e:.4f} | {a:.2%} | {lk:.2%} | {g:+.4f} |")
     report.line()
     report.line("## Summary: the error estimates")
     report.line()

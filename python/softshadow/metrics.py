@@ -287,6 +287,13 @@ class ImageComparison:
         Mean, root-mean-square, largest and 99th-percentile ``|V - V_ref|``
         over all matched pixels, lit ones included (0.0 when none is
         matched).
+    grain : float
+        Per-pixel noise the reference does not have: the mean
+        ``|V - box3x3(V)|`` over the reference's penumbra pixels (``0.02 <
+        V_ref < 0.98``) whose 3x3 block is matched, minus the reference's own
+        over the same pixels (0.0 when there are none). A method whose
+        samples change from pixel to pixel draws grain; one that follows
+        the geometry does not.
     mismatched : int
         Pixels where either image hits a surface but they are not matched.
     mask : numpy.ndarray, (H, W) bool
@@ -303,6 +310,7 @@ class ImageComparison:
     rmse: float
     max_abs: float
     p99_abs: float
+    grain: float
     mismatched: int
     mask: np.ndarray
 
@@ -311,7 +319,7 @@ class ImageComparison:
             f"ImageComparison(matched={self.matched} ({self.matched_fraction:.1%}), "
             f"shadow_error={self.shadow_error:.4g} over {self.shadowed}, acne={self.acne:.2%}, "
             f"leak={self.leak:.2%}, mean_abs={self.mean_abs:.4g}, rmse={self.rmse:.4g}, max_abs={self.max_abs:.4g}, "
-            f"p99_abs={self.p99_abs:.4g}, mismatched={self.mismatched})"
+            f"p99_abs={self.p99_abs:.4g}, grain={self.grain:.2g}, mismatched={self.mismatched})"
         )
 
 
@@ -331,6 +339,36 @@ def _image_fields(image: Any, name: str) -> dict[str, np.ndarray]:
     if fields["mask"].dtype != np.bool_:
         raise TypeError(f"{name}.mask must be boolean, got dtype {fields['mask'].dtype}")
     return fields
+
+
+def _box_deviation(v: np.ndarray, where: np.ndarray) -> float:
+    """Mean ``|v - box3x3(v)|`` over ``where`` (pixels away from the border)."""
+    h, w = v.shape
+    box = np.zeros((h - 2, w - 2))
+    for dy in range(3):
+        for dx in range(3):
+            box += v[dy : dy + h - 2, dx : dx + w - 2]
+    inner = where[1:-1, 1:-1]
+    return float(np.abs(v[1:-1, 1:-1] - box / 9.0)[inner].mean())
+
+
+def _grain(va: np.ndarray, vb: np.ndarray, matched: np.ndarray) -> float:
+    """``ImageComparison.grain`` of full (H, W) visibilities."""
+    h, w = matched.shape
+    if h < 3 or w < 3:
+        return 0.0
+    block = np.ones((h - 2, w - 2), dtype=bool)
+    for dy in range(3):
+        for dx in range(3):
+            block &= matched[dy : dy + h - 2, dx : dx + w - 2]
+    where = np.zeros_like(matched)
+    where[1:-1, 1:-1] = block
+    where &= (vb > 0.02) & (vb < 0.98)
+    if not where[1:-1, 1:-1].any():
+        return 0.0
+    va = np.where(matched, va, 0.0)
+    vb = np.where(matched, vb, 0.0)
+    return _box_deviation(va, where) - _box_deviation(vb, where)
 
 
 def compare_images(
@@ -414,6 +452,7 @@ def compare_images(
         rmse=rmse_value,
         max_abs=max_abs,
         p99_abs=p99_abs,
+        grain=_grain(a["visibility"].astype(np.float64), b["visibility"].astype(np.float64), matched),
         mismatched=either - count,
         mask=matched,
     )

@@ -15,7 +15,7 @@ use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::methods::exact::Bvh;
 use crate::methods::probe::probed_visibilities;
-use crate::methods::shadow_rays::{tile_order, visibilities, RayOrigin, Sampling};
+use crate::methods::shadow_rays::{tile_order, visibilities, Jitter, RayOrigin, Sampling};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -148,14 +148,15 @@ pub fn visibility_in(
     samples: u32,
     probe: Option<Probe>,
 ) -> Vec<f32> {
-    let sampling = |n| Sampling {
+    let sampling = |n, jitter| Sampling {
         light: light_shape.samples(n),
         t0: 0.0,
+        jitter,
     };
-    let fine = sampling(samples);
+    let fine = sampling(samples, Jitter::Shared);
     match probe {
         Some(p) => {
-            let coarse = sampling(p.samples);
+            let coarse = sampling(p.samples, Jitter::PerReceiver);
             probed_visibilities(bvh, starts, key, order, &fine, &coarse, 0.0, p.size)
         }
         None => visibilities(bvh, starts, key, order, &fine, 0.0),

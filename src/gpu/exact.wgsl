@@ -3,7 +3,8 @@
 // the BVH built on the CPU (binned SAH, bvh.rs), counting the samples that see the
 // light into `seen` (a gather: each invocation owns its receiver's count);
 // then a resolve divides by the sample count. The jitter is exact.rs's u64
-// hash, emulated with u32 pairs; the ray-triangle test is its Möller-Trumbore
+// hash of the sample (one pattern every texel shares), emulated with u32
+// pairs; the ray-triangle test is its Möller-Trumbore
 // written in the same order of operations (explicit cross and dot products).
 
 // Shared with Rust (`ExactParams` in exact.rs; a test compares layouts).
@@ -216,14 +217,13 @@ fn exact(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let p = pr.xyz;
     let idx = gid.y * ep.rec_w + gid.x;
-    // exact.rs's key: the texel index as a u64.
-    let key = vec2<u32>(idx, 0u);
     var count = 0u;
     for (var s = ep.chunk_start; s < ep.chunk_start + ep.chunk_len; s++) {
         let sa = s % ep.light.na;
         let sb = s / ep.light.na;
-        // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
-        let h = hash(key ^ hash(vec2<u32>(s << 1u, 0u)));
+        // hash(hash(sample << 1)), sample = sb * na + sa < 2^16: one
+        // pattern every texel shares (shadow_rays.rs's Jitter::Shared).
+        let h = hash(hash(vec2<u32>(s << 1u, 0u)));
         let l = light_sample(sa, sb, unit(h), unit(hash(h)), ep.light);
         let d = vec3<f32>(l.x, l.y, 0.0) - p;
         if !occluded(p, d) {

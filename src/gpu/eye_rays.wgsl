@@ -2,8 +2,8 @@
 // visible surface point, through the BVH of every triangle in kernel light
 // space (built on the CPU). The CPU twin is src/eye/rays.rs (`visibility`,
 // through methods/exact.rs's `stratified`): for light sample (x, y, 0) of
-// point k (the jitter is exact.rs's hash of k's key, its pixel, and the
-// sample, as exact.wgsl computes it for map texels), the segment starts at
+// point k (the jitter is exact.rs's hash of the sample, one pattern every
+// point shares, as exact.wgsl computes it for map texels), the segment starts at
 // the origin on the side of the surface the light point lies on,
 //     o = above  if a0 + x au + y av >= 0,  else below
 // (the point moved off its surface along the normal by Mitsuba's
@@ -32,9 +32,9 @@ struct RayStart {
     a0: f32,
     au: f32,
     av: f32,
-    // The jitter key: the point's pixel (its flat index in the image), as
-    // rays.rs's; not `idx`, its rank among the visible points, which
-    // shifts after any pixel the two backends' first hits disagree on.
+    // The point's pixel (its flat index in the image), as rays.rs's key:
+    // the probe's per-pixel jitter would read it; the samples traced here
+    // share one pattern and do not.
     key: u32,
     _pad1: u32,
 }
@@ -57,14 +57,13 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
     }
     let above = vec3<f32>(s.ax, s.ay, s.az);
     let below = vec3<f32>(s.bx, s.by, s.bz);
-    // rays.rs's key: the point's pixel as a u64.
-    let key = vec2<u32>(s.key, 0u);
     var count = 0u;
     for (var k = ep.chunk_start; k < ep.chunk_start + ep.chunk_len; k++) {
         let sa = k % ep.light.na;
         let sb = k / ep.light.na;
-        // hash(key ^ hash(sample << 1)), sample = sb * na + sa < 2^16.
-        let h = hash(key ^ hash(vec2<u32>(k << 1u, 0u)));
+        // hash(hash(sample << 1)), sample = sb * na + sa < 2^16: one
+        // pattern every point shares (shadow_rays.rs's Jitter::Shared).
+        let h = hash(hash(vec2<u32>(k << 1u, 0u)));
         let l = light_sample(sa, sb, unit(h), unit(hash(h)), ep.light);
         let x = l.x;
         let y = l.y;

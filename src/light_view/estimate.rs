@@ -34,7 +34,7 @@ use crate::frame::{light_space_triangles, FramedScene};
 use crate::geom::light_shape::LightShape;
 use crate::methods::config::MAX_SAMPLES;
 use crate::methods::exact::{receiver_points, Bvh, RAY_EPS};
-use crate::methods::shadow_rays::{tile_order, visibilities, RayOrigin, Sampling};
+use crate::methods::shadow_rays::{tile_order, visibilities, Jitter, RayOrigin, Sampling};
 use crate::methods::Method;
 
 /// Light samples of the exact rays at each drawn texel, for a result of
@@ -124,9 +124,11 @@ pub(crate) fn estimate<R: RayOrigin + Copy>(
     let mut traced = 0;
     if !order.is_empty() {
         let bvh = Bvh::build(triangles);
+        // exact's own rays (its pattern, shared by every texel).
         let s = Sampling {
             light: light_shape.samples(samples),
             t0: at.t0,
+            jitter: Jitter::Shared,
         };
         for batch in order.chunks(BATCH) {
             if traced > 0 && t0.elapsed().as_secs_f64() > budget {

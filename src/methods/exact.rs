@@ -6,7 +6,8 @@
 //! Not a soft shadow map: it reads the occluder triangles (not the occluder
 //! maps) and the receiver points. It converges to the true visibility as
 //! 1/sqrt(samples) (stratified: faster on smooth penumbrae), is deterministic
-//! (the jitter is a hash of the receiver's index and the sample's), and is the
+//! and free of per-pixel grain (every receiver's rays go to one jittered
+//! pattern, a hash of the sample's index: `shadow_rays::Jitter`), and is the
 //! in-package reference that needs no Mitsuba.
 //!
 //! Geometry is in light space (relative to the light's center, computed in
@@ -26,7 +27,7 @@ use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::keywords::{count, KeywordForm, Keywords};
 use super::probe::probed_visibilities;
 pub(crate) use super::shadow_rays::RAY_EPS;
-use super::shadow_rays::{tile_order, visibilities, Sampling};
+use super::shadow_rays::{tile_order, visibilities, Jitter, Sampling};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -44,12 +45,16 @@ pub struct Exact {
 }
 
 /// The light point (x, y) that `exact`'s ray of stratum (sa, sb) of
-/// `light` (the light's sample pattern, `LightShape::samples`) goes to from
-/// the receiver whose jitter key is `key` (its texel or point index): for
-/// tracing the same rays elsewhere (benchmarks/bvh_crates compares BVH
-/// crates on them).
-pub fn light_sample(key: u64, sa: u32, sb: u32, light: LightSamples) -> (f32, f32) {
-    Sampling { light, t0: RAY_EPS }.sample(key, sa, sb)
+/// `light` (the light's sample pattern, `LightShape::samples`) goes to,
+/// from any receiver (they share one pattern): for tracing the same rays
+/// elsewhere (benchmarks/bvh_crates compares BVH crates on them).
+pub fn light_sample(sa: u32, sb: u32, light: LightSamples) -> (f32, f32) {
+    Sampling {
+        light,
+        t0: RAY_EPS,
+        jitter: Jitter::Shared,
+    }
+    .sample(0, sa, sb)
 }
 
 impl Exact {
@@ -70,11 +75,12 @@ impl Exact {
             return vec![1.0; pts.len()];
         };
         let bvh = Bvh::build(tris.to_vec());
-        let sampling = |n| Sampling {
+        let sampling = |n, jitter| Sampling {
             light: inputs.light_shape.samples(n),
             t0: RAY_EPS,
+            jitter,
         };
-        let fine = sampling(self.samples);
+        let fine = sampling(self.samples, Jitter::Shared);
         match (self.probe, grid) {
             (Some(p), Some(g)) => probed_visibilities(
                 &bvh,
@@ -82,7 +88,7 @@ impl Exact {
                 |k| k as u64,
                 order,
                 &fine,
-                &sampling(p),
+                &sampling(p, Jitter::PerReceiver),
                 1.0,
                 (g.width, g.height),
             ),

@@ -101,6 +101,7 @@ fn certain<R: Sync>(
 mod tests {
     use super::*;
     use crate::geom::light_shape::LightShape;
+    use crate::methods::shadow_rays::Jitter;
     use glam::Vec3;
 
     /// A plate of half-width `h` at depth 1 over receivers at depth 2, a
@@ -125,10 +126,11 @@ mod tests {
             .collect()
     }
 
-    fn sampling(light: LightShape, samples: u32) -> Sampling {
+    fn sampling(light: LightShape, samples: u32, jitter: Jitter) -> Sampling {
         Sampling {
             light: light.samples(samples),
             t0: 1e-5,
+            jitter,
         }
     }
 
@@ -139,7 +141,10 @@ mod tests {
         let r = receivers(n);
         let order: Vec<usize> = (0..r.len()).collect();
         let light = LightShape::rect([1.0, 1.0]);
-        let (fine, coarse) = (sampling(light, 256), sampling(light, 16));
+        let (fine, coarse) = (
+            sampling(light, 256, Jitter::Shared),
+            sampling(light, 16, Jitter::PerReceiver),
+        );
         let key = |k: usize| k as u64;
         let all = visibilities(&bvh, &r, key, &order, &fine, 1.0);
         let got = probed_visibilities(&bvh, &r, key, &order, &fine, &coarse, 1.0, (n, n));

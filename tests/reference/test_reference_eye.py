@@ -502,6 +502,23 @@ def test_compare_errors_and_matching():
     assert metrics.compare_images(image, reference_image, position_tol=1e-3).matched == 31
 
 
+def test_grain_is_the_per_pixel_noise_the_reference_has_not():
+    # A smooth ramp of penumbra over a 12 x 16 floor; the image adds +-0.02
+    # in a checkerboard (what per-pixel sample patterns draw) on the rows
+    # whose 3x3 blocks are all floor.
+    reference_image, image = synthetic_image(12, 16), synthetic_image(12, 16)
+    assert metrics.compare_images(image, reference_image).grain == pytest.approx(0.0, abs=1e-12)
+    image.visibility = image.visibility.copy()
+    checker = np.where((np.arange(12)[:, None] + np.arange(16)) % 2 == 0, 0.02, -0.02)
+    image.visibility += checker.astype(np.float32) * image.mask
+    g = metrics.compare_images(image, reference_image).grain
+    # |c - box(c)| of a +-0.02 checkerboard inside: 0.02 - 0.02 / 9.
+    assert g == pytest.approx(0.02 * 8 / 9, rel=1e-3)
+    # A uniform offset is error, not grain.
+    image.visibility = reference_image.visibility + 0.03 * reference_image.mask
+    assert metrics.compare_images(image, reference_image).grain == pytest.approx(0.0, abs=1e-6)
+
+
 def test_compare_images_reports_the_shadowed_pixels_acne_and_leaks():
     # The reference: 32 floor pixels with V_ref from 0 to 1; 0 is umbra, the
     # last one (1.0) fully lit.

@@ -153,10 +153,10 @@ impl Rays {
         let per = (grid.0 * grid.1) as usize;
         let targets = keys
             .par_iter()
-            .flat_map_iter(|&k| {
+            .flat_map_iter(|_| {
                 (0..grid.1).flat_map(move |sb| {
                     (0..grid.0).map(move |sa| {
-                        let (x, y) = light_sample(k as u64, sa, sb, light);
+                        let (x, y) = light_sample(sa, sb, light);
                         [x, y]
                     })
                 })
