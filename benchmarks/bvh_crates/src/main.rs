@@ -316,7 +316,10 @@ fn bench(
     let rays = Rays::new(s);
     let inputs = s.inputs();
     let points = s.points();
-    let exact = Exact { samples: s.samples };
+    let exact = Exact {
+        samples: s.samples,
+        probe: None,
+    };
     let (mut ours, mut sven, mut ob, mut parry) = (None, None, None, None);
     let (mut map, mut pts) = ([vec![], vec![]], [vec![], vec![]]);
     let (mut v_map, mut v_pts) = (vec![], vec![]);
