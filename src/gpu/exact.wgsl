@@ -2,9 +2,9 @@
 // per receiver texel casts its chunk of the stratified light samples through
 // the BVH built on the CPU (binned SAH, bvh.rs), counting the samples that see the
 // light into `seen` (a gather: each invocation owns its receiver's count);
-// then a resolve divides by the sample count. The jitter is exact.rs's u64
-// hash of the sample (one pattern every texel shares), emulated with u32
-// pairs; the ray-triangle test is its Möller-Trumbore
+// then a resolve divides by the sample count. The jitter is
+// shadow_rays.rs's multi-jittered pattern, one every texel shares (its u64
+// hash emulated with u32 pairs); the ray-triangle test is its Möller-Trumbore
 // written in the same order of operations (explicit cross and dot products).
 
 // Shared with Rust (`ExactParams` in exact.rs; a test compares layouts).
@@ -68,6 +68,46 @@ fn hash(x0: vec2<u32>) -> vec2<u32> {
 // exact.rs's unit: the top 24 bits in [0, 1).
 fn unit(h: vec2<u32>) -> f32 {
     return f32(h.y >> 8u) * (1.0 / 16777216.0);
+}
+
+// shadow_rays.rs's `permute`: a permutation of [0, l) keyed by `seed`
+// (masked bijections of [0, 2^k), walked while the value is l or more).
+fn permute(i0: u32, l: u32, seed: u32) -> u32 {
+    // 2^k - 1, with 2^k the power of two at or above l.
+    var w = l - 1u;
+    w |= w >> 1u;
+    w |= w >> 2u;
+    w |= w >> 4u;
+    w |= w >> 8u;
+    w |= w >> 16u;
+    var i = i0;
+    loop {
+        i = (i ^ seed) & w;
+        i = (i * 0x9E3779B1u) & w;
+        i ^= i >> 1u;
+        i = (i + (seed >> 8u)) & w;
+        i = (i * 0x85EBCA6Bu) & w;
+        i ^= i >> 2u;
+        if i < l {
+            break;
+        }
+    }
+    return i;
+}
+
+// The largest f32 below 1: a jitter stays inside its stratum.
+const BELOW_ONE: f32 = 0.99999994;
+
+// shadow_rays.rs's `multi_jitter`: the jitter of stratum (sa, sb) of
+// na x nb in the pattern every receiver shares, sample s = sb * na + sa
+// (< 2^16), in the same operations.
+fn multi_jitter(sa: u32, sb: u32, na: u32, nb: u32, s: u32) -> vec2<f32> {
+    let column = permute(sb, nb, hash(vec2<u32>(sa ^ 0x51u, 0u)).x);
+    let row = permute(sa, na, hash(vec2<u32>(sb ^ 0xA7u, 0u)).x);
+    let h = hash(hash(vec2<u32>(s << 1u, 0u)));
+    let ja = (f32(column) + unit(h)) / f32(nb);
+    let jb = (f32(row) + unit(hash(h))) / f32(na);
+    return vec2<f32>(min(ja, BELOW_ONE), min(jb, BELOW_ONE));
 }
 
 fn node(k: u32) -> Node {
@@ -221,10 +261,9 @@ fn exact(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var s = ep.chunk_start; s < ep.chunk_start + ep.chunk_len; s++) {
         let sa = s % ep.light.na;
         let sb = s / ep.light.na;
-        // hash(hash(sample << 1)), sample = sb * na + sa < 2^16: one
-        // pattern every texel shares (shadow_rays.rs's Jitter::Shared).
-        let h = hash(hash(vec2<u32>(s << 1u, 0u)));
-        let l = light_sample(sa, sb, unit(h), unit(hash(h)), ep.light);
+        // One pattern every texel shares (shadow_rays.rs's Jitter::Shared).
+        let j = multi_jitter(sa, sb, ep.light.na, ep.light.nb, s);
+        let l = light_sample(sa, sb, j.x, j.y, ep.light);
         let d = vec3<f32>(l.x, l.y, 0.0) - p;
         if !occluded(p, d) {
             count += 1u;

@@ -61,10 +61,9 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
     for (var k = ep.chunk_start; k < ep.chunk_start + ep.chunk_len; k++) {
         let sa = k % ep.light.na;
         let sb = k / ep.light.na;
-        // hash(hash(sample << 1)), sample = sb * na + sa < 2^16: one
-        // pattern every point shares (shadow_rays.rs's Jitter::Shared).
-        let h = hash(hash(vec2<u32>(k << 1u, 0u)));
-        let l = light_sample(sa, sb, unit(h), unit(hash(h)), ep.light);
+        // One pattern every point shares (shadow_rays.rs's Jitter::Shared).
+        let j = multi_jitter(sa, sb, ep.light.na, ep.light.nb, k);
+        let l = light_sample(sa, sb, j.x, j.y, ep.light);
         let x = l.x;
         let y = l.y;
         var o = below;

@@ -245,7 +245,8 @@ def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
     ref = ss.render(scene, light, cam, method=ss.Exact(samples=1024))
     names = [d.name for d in img.plan.decisions]
     assert "refine" in names and img.plan.decisions[-1].name == "target" and img.plan.decisions[-1].taken
-    assert isinstance(img.method, ss.Exact) and img.method.samples > 144, img.plan
+    # At least the law's count (144): the 16-sample pilot missed.
+    assert isinstance(img.method, ss.Exact) and img.method.samples >= 144, img.plan
     # On the CPU the refinements trace behind the default call's probe; the
     # pilot (16 samples) has none.
     assert img.method.probe == 16, img.method
