@@ -97,8 +97,8 @@ pub struct HitsParams {
 }
 
 /// `RayStart` of eye_rays.wgsl: a point's two origins (kernel light space)
-/// and the side test choosing between them; `valid` 0: visibility 0;
-/// `key`: the jitter key, the point's pixel (`rays::visibility`'s).
+/// and the side test choosing between them; `valid` 0: visibility 0. (Every
+/// point's rays go to one shared pattern: no per-point key.)
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct GpuRayStart {
@@ -112,7 +112,7 @@ pub struct GpuRayStart {
     pub a0: f32,
     pub au: f32,
     pub av: f32,
-    pub key: u32,
+    pub _pad0: u32,
     pub _pad1: u32,
 }
 
@@ -200,11 +200,9 @@ impl EyeStages for GpuEye {
                 "the GPU backend traces every sample at every pixel (it has no probe); use backend=\"cpu\"",
             ));
         }
-        // Keyed by pixel, as the CPU's (`CpuEye::trace`).
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()
-            .zip(&f.hits)
-            .map(|(s, &pixel)| GpuRayStart::new(s, pixel))
+            .map(GpuRayStart::new)
             .collect();
         let (v, t) = exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
@@ -355,16 +353,11 @@ pub(crate) fn first_hits(
 }
 
 impl GpuRayStart {
-    /// `rays::RayStart` of the point at flat index `pixel` of the image as
-    /// eye_rays.wgsl reads it; `None`: not valid.
-    pub fn new(s: &Option<RayStart>, pixel: usize) -> GpuRayStart {
-        // An image has at most MAX_TEXELS < 2^32 pixels (`check_resolution`).
-        let key = pixel as u32;
+    /// `rays::RayStart` of a point as eye_rays.wgsl reads it; `None`: not
+    /// valid.
+    pub fn new(s: &Option<RayStart>) -> GpuRayStart {
         match s {
-            None => GpuRayStart {
-                key,
-                ..Default::default()
-            },
+            None => GpuRayStart::default(),
             Some(s) => GpuRayStart {
                 ax: s.above.x,
                 ay: s.above.y,
@@ -376,7 +369,7 @@ impl GpuRayStart {
                 a0: s.side[0],
                 au: s.side[1],
                 av: s.side[2],
-                key,
+                _pad0: 0,
                 _pad1: 0,
             },
         }

@@ -32,10 +32,7 @@ struct RayStart {
     a0: f32,
     au: f32,
     av: f32,
-    // The point's pixel (its flat index in the image), as rays.rs's key:
-    // the probe's per-pixel jitter would read it; the samples traced here
-    // share one pattern and do not.
-    key: u32,
+    _pad0: u32,
     _pad1: u32,
 }
 

@@ -357,7 +357,7 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             a0,
             au,
             av,
-            key,
+            _pad0,
             _pad1
         }),
     );

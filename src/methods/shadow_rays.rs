@@ -51,7 +51,9 @@ fn hash(mut x: u64) -> u64 {
 
 /// A permutation of [0, l) keyed by `seed`: bijections of [0, 2^k) (xor,
 /// odd multiplications and xorshifts, masked), applied again while the
-/// value is l or more (at most a few times: 2^k < 2 l).
+/// value is l or more (cycle walking: under two steps on average, 2^k < 2 l,
+/// and never more than 2^k - l + 1, the values a cycle can hold at or above
+/// l in a row: bounded on the GPU too).
 #[inline]
 fn permute(mut i: u32, l: u32, seed: u32) -> u32 {
     let w = l.next_power_of_two() - 1;
@@ -118,24 +120,31 @@ pub(crate) enum Jitter {
     /// sub-column of the stratum's column and sub-row of its row (a hashed
     /// permutation per column and per row, `permute`), so the a*b samples
     /// project onto a*b distinct columns and rows of the light, and an edge
-    /// across the light uncovers them one at a time.
+    /// across the light uncovers them one at a time. (The bitmask's pattern,
+    /// `bitmask.rs`, is built the same way as tables of ranks for square
+    /// grids; here each sample is computed alone, any a x b, so the GPU
+    /// needs no table.)
     ///
-    /// Measured on the as-built calibration scenes and the eye-view scenes
-    /// at 320x240 (against 4096-sample references): with a pattern per
-    /// receiver, neighbouring penumbra pixels differ by the patterns' noise;
-    /// one jittered pattern shared halved that grain (mean |V - box3x3(V)|
-    /// on penumbra pixels over the reference's: +0.0035 to +0.0018 on
+    /// Chosen on the as-built calibration scenes and the eye-view scenes at
+    /// 320x240 (against 4096-sample references; the held-out scenes were
+    /// measured once after, docs/accuracy.md): with a pattern per receiver,
+    /// neighbouring penumbra pixels differ by the patterns' noise; one
+    /// jittered pattern shared halved that grain (mean |V - box3x3(V)| on
+    /// penumbra pixels over the reference's: +0.0035 to +0.0018 on
     /// blocks_on_table, +0.0039 to +0.0021 on room_window, 256 samples) but
     /// one draw's error is not the average draw's (64 samples on
-    /// contact_boxes: 0.0174 where per-pixel patterns gave 0.0130); the
-    /// multi-jittered one errs 15-50% less at 64 samples (contact_boxes
-    /// 0.0085, blocks_on_table 0.0126 to 0.0073) and up to 30% less at 256
-    /// (0.0044 to 0.0030; shelf_with_objects 0.0029 to 0.0031), its grain
-    /// the same or lower.
+    /// contact_boxes: 0.0174 where per-pixel patterns gave 0.0130 in
+    /// bench_eye); the multi-jittered one errs 16-51% less than the plainly
+    /// jittered one at 64 samples (contact_boxes 0.0174 to 0.0085,
+    /// blocks_on_table 0.0126 to 0.0073) and 0-32% less at 256 (0.0044 to
+    /// 0.0030; shelf_with_objects the exception, 0.0029 to 0.0031), its
+    /// grain the same or lower.
     Shared,
     /// A pattern per receiver, hashed with its key: the probe's, whose nine
     /// neighbours' 16 samples then test 144 light points, not 16 (with a
-    /// shared probe the default call's error grew by up to 0.0004).
+    /// shared probe the default call erred up to 0.0005 more than `exact`
+    /// alone on the calibration scenes: blocks_on_table 0.0044 against
+    /// 0.0039).
     PerReceiver,
 }
 
@@ -326,4 +335,44 @@ pub(crate) fn tile_order(width: usize, height: usize) -> Vec<usize> {
         }
     }
     order
+}
+
+#[cfg(test)]
+mod pattern_tests {
+    use super::{multi_jitter, permute};
+    use std::collections::HashSet;
+
+    #[test]
+    fn permute_is_a_permutation_of_every_length() {
+        for l in 1..=300 {
+            for seed in [0, 1, 0x51, 0xdead_beef, u32::MAX] {
+                let got: HashSet<u32> = (0..l).map(|i| permute(i, l, seed)).collect();
+                assert_eq!(got.len(), l as usize, "l {l} seed {seed}");
+                assert!(got.iter().all(|&v| v < l));
+            }
+        }
+    }
+
+    #[test]
+    fn the_shared_pattern_is_multi_jittered_on_any_grid() {
+        for (na, nb) in [(1, 1), (4, 4), (16, 16), (8, 32), (3, 5), (1, 17)] {
+            let n = (na * nb) as f32;
+            let (mut columns, mut rows) = (HashSet::new(), HashSet::new());
+            for sb in 0..nb {
+                for sa in 0..na {
+                    let hs = super::hash(u64::from(sb * na + sa) << 1);
+                    let (ja, jb) = multi_jitter(sa, sb, (na, nb), hs);
+                    // Inside its stratum.
+                    assert!((0.0..1.0).contains(&ja) && (0.0..1.0).contains(&jb));
+                    // Its column and row of the a*b x a*b fine grid.
+                    let x = (sa as f32 + ja) / na as f32;
+                    let y = (sb as f32 + jb) / nb as f32;
+                    columns.insert((x * n) as u32);
+                    rows.insert((y * n) as u32);
+                }
+            }
+            assert_eq!(columns.len(), (na * nb) as usize, "{na} x {nb}");
+            assert_eq!(rows.len(), (na * nb) as usize, "{na} x {nb}");
+        }
+    }
 }

@@ -64,6 +64,21 @@ impl<T: PyRepr> PyRepr for Option<T> {
     }
 }
 
+/// An option's value from the core's table (`keyword_class.rs`).
+impl PyRepr for crate::methods::info::Value {
+    fn py_repr(&self, py: Python<'_>) -> PyResult<String> {
+        use crate::methods::info::Value;
+        match *self {
+            Value::Resolved => Ok("None".into()),
+            Value::Int(n) => n.py_repr(py),
+            Value::Bool(b) => b.py_repr(py),
+            Value::Str(s) => s.py_repr(py),
+            Value::Float(x) => x.py_repr(py),
+            Value::Pair(w, h) => (w, h).py_repr(py),
+        }
+    }
+}
+
 impl<T> PyRepr for Py<T> {
     fn py_repr(&self, py: Python<'_>) -> PyResult<String> {
         Ok(self.bind(py).as_any().repr()?.to_string())

@@ -14,6 +14,7 @@
 //! conversions, and TypeErrors naming the option, as every other argument).
 
 use super::capabilities::value as py_value;
+use super::config_class::PyRepr;
 use super::convert::{opt_bool, opt_float, opt_int, opt_resolution, opt_string};
 use crate::methods::info::{Kind, MethodInfo, Value};
 use crate::methods::keywords::{Given, Keywords};
@@ -57,19 +58,6 @@ fn given(kind: &Kind, name: &str, v: &Bound<'_, PyAny>) -> PyResult<Option<Given
             )))
         }
     })
-}
-
-/// A value as Python's `repr` writes it.
-fn repr(v: &Value) -> String {
-    match v {
-        Value::Resolved => "None".into(),
-        Value::Int(n) => n.to_string(),
-        Value::Bool(b) => if *b { "True" } else { "False" }.into(),
-        Value::Str(s) => format!("'{s}'"),
-        // The shortest string that reads back as the same float.
-        Value::Float(x) => format!("{x:?}"),
-        Value::Pair(w, h) => format!("({w}, {h})"),
-    }
 }
 
 impl PyKeywordConfig {
@@ -145,12 +133,12 @@ impl PyKeywordConfig {
     }
 
     fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
-        let parts: Vec<String> = slf
+        let parts = slf
             .get()
             .values()
             .iter()
-            .map(|(name, v)| format!("{name}={}", repr(v)))
-            .collect();
+            .map(|(name, v)| Ok(format!("{name}={}", v.py_repr(slf.py())?)))
+            .collect::<PyResult<Vec<String>>>()?;
         Ok(format!("{}({})", slf.get_type().name()?, parts.join(", ")))
     }
 }
