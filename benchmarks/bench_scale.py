@@ -54,6 +54,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse
 import math
+import resource
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -266,6 +267,7 @@ def main() -> None:
     _mitsuba()  # selects the variant before any timing
     pixels = res[0] * res[1]
     summary: list[str] = []
+    prepared: list[str] = []
     for name in args.scenes:
         scene, light, cam = builders[name](res)
         counts = [len(f) for _, f in scene.meshes]
@@ -275,8 +277,19 @@ def main() -> None:
         kernels = MitsubaKernels(job)
         print(f"{name}: {scene.triangle_count} triangles in {len(scene.meshes)} meshes", flush=True)
         times = {n: Times() for n in args.samples}
+        # First calls (a new Scene: nothing prepared) and following ones (the
+        # scene prepared by the warm-up round), of each method.
+        calls: dict[str, dict[str, list[float]]] = {}
+        methods: dict[str, Any] = {f"exact {n}": ss.Exact(samples=n) for n in args.samples}
+        methods["default"] = "auto"
         threads = 0
         for round_ in range(args.repeats + 1):  # round 0: the warm-up
+            for label, method in methods.items():
+                for kind, s in (("first", ss.Scene(meshes=scene.meshes)), ("following", scene)):
+                    t = time.perf_counter()
+                    ss.render(s, light, cam, method=method)
+                    if round_ > 0:
+                        calls.setdefault(label, {}).setdefault(kind, []).append(time.perf_counter() - t)
             for n in args.samples:
                 tm = times[n]
                 t = time.perf_counter()
@@ -306,8 +319,8 @@ def main() -> None:
             f"a mesh); {type(light).__name__}; {kernels.hits / pixels:.0%} of the pixels see a surface, "
             f"{len(kernels.lit) / pixels:.0%} on the light's front side (Mitsuba's first hits; softshadow's: "
             f"{times[args.samples[0]].lit_ours / pixels:.0%}). Mitsuba's scene load (its BVH build, outside "
-            f"every Mitsuba time below): {load_ms:.0f} ms; softshadow builds its own in each call "
-            f"(`{threads}` threads)."
+            f"every Mitsuba time below): {load_ms:.0f} ms; softshadow's stages below are those of a call on the "
+            f"prepared scene (its BVH refitted, not built: the next table has both; `{threads}` threads)."
         )
         report.line()
         report.line(
@@ -352,6 +365,27 @@ def main() -> None:
             + "."
         )
         report.line()
+        report.line(
+            "Prepare once, render many: the whole call on a new `ss.Scene` (nothing prepared: the triangles "
+            "gathered and checked, the shadow rays' BVH built) and on the scene the earlier rounds prepared "
+            "(the kept BVH refitted to the call's light space), beside Mitsuba's scene load and job."
+        )
+        report.line()
+        report.line(
+            "| call | first (ms) | following (ms) | following / first | Mitsuba load + job (ms) | Mitsuba job (ms) |"
+        )
+        report.line("|---|---|---|---|---|---|")
+        for label, kinds in calls.items():
+            first, following = median_ms(kinds["first"]), median_ms(kinds["following"])
+            n = int(label.split()[1]) if label.startswith("exact") else None
+            job_ms = median_ms(times[n].mitsuba["job"]) if n is not None else None
+            mitsuba = f"{load_ms + job_ms:.0f} | {job_ms:.0f}" if job_ms is not None else " | "
+            report.line(f"| {label} | {first:.0f} | {following:.0f} | {following / first:.2f} | {mitsuba} |")
+            prepared.append(f"| {name} | {label} | {first:.0f} | {following:.0f} | {following / first:.2f} |")
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+        report.line()
+        report.line(f"Peak resident memory of the benchmark process so far (Mitsuba's scenes too): {peak:.2f} GiB.")
+        report.line()
         if len(args.samples) >= 2:
             report.line(
                 "What the sample count costs: shadow-ray time = fixed + rays × slope, fitted over the sample counts."
@@ -370,13 +404,19 @@ def main() -> None:
     report.line("|---|---|---|---|---|---|")
     for row in summary:
         report.line(row)
+    report.line()
+    report.line("| scene | call | first (ms) | following (ms) | following / first |")
+    report.line("|---|---|---|---|---|")
+    for row in prepared:
+        report.line(row)
     if args.no_write:
         return
     intro = (
         f"Times are medians of {runs(args.repeats)} after a warm-up round, softshadow and Mitsuba "
         "alternating within each round. softshadow: the stages of `img.timings` of "
-        "`ss.render(..., method=ss.Exact(samples=n))` (`first hits` builds the camera's BVH and casts; "
-        "`bvh` builds the BVH of the triangles the shadow rays meet, `shadow` traces them). "
+        "`ss.render(..., method=ss.Exact(samples=n))` on a prepared scene (`first hits` rasterizes the "
+        "camera's view; `refit` fits the BVH kept from an earlier call to this call's light space, where a "
+        "first call's `bvh` builds it; `shadow` traces the rays). "
         "Mitsuba: `ray_intersect` on the pixel-centre camera rays and `ray_test(..., coherent=False)` on "
         "the shadow rays `MitsubaEyeJob` builds, the kernels alone (the rays built and evaluated first); "
         "its whole eye-view job beside them. *Rays*: the pixels on the light's front side times the "

@@ -577,11 +577,25 @@ def render(
     emission: _Color | None = None,
     albedo: _Color | list[_Color] | None = None,
     estimate_error: str | None = None,
+    prepared: Prepared | None = None,
 ) -> EyeResult:
     """The eye view: first hits, then each pixel's visibility with every mesh
     casting and receiving, then the shading (``emission`` the light's
     radiance or irradiance, ``albedo`` per mesh; the core's defaults for
-    None)."""
+    None); ``prepared`` keeps what the meshes alone make for the next call."""
+
+@final
+class Prepared:
+    """What renders of one scene built and kept for the next ones: the
+    checked triangles and the shadow rays' BVH per light orientation
+    (``softshadow.Scene`` holds one). Thread-safe."""
+
+    def __init__(self) -> None: ...
+    def clear(self) -> None:
+        """Forgets what was kept."""
+    @property
+    def held(self) -> tuple[bool, int]:
+        """Whether the triangles are kept, and how many trees."""
 
 def light_emission(arg: str, value: _Color | None = None) -> list[float]:
     """A light's emission (``arg``: "radiance" or "irradiance") checked:

@@ -427,6 +427,7 @@ def render(
         emission=light._emission(),
         albedo=check.color(albedo),
         estimate_error=draw,
+        prepared=scene.prepared,
     )
     return Image(
         visibility=r.visibility,

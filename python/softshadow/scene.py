@@ -98,6 +98,25 @@ class Scene:
         self._occ = _concat(self.occluders)
         # Every mesh casts and receives: one mesh serves as both.
         self._rec = _concat(self.receivers) if self.split else self._occ
+        self._prepared = _core.Prepared()
+
+    @property
+    def prepared(self) -> _core.Prepared:
+        """What renders of this scene built and keep for the next ones (the
+        checked triangles; the shadow rays' BVH per light orientation, refitted
+        to the next camera): filled by :func:`softshadow.render`, checked
+        against the meshes at every call (a mesh changed in place, replaced or
+        added starts it again), safe to share between threads. Not pickled."""
+        return self._prepared
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        del state["_prepared"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._prepared = _core.Prepared()
 
     @classmethod
     def from_trimesh(cls, obj: Any) -> Scene:

@@ -5,6 +5,7 @@
 
 use super::gbuffer::GBuffer;
 use super::maps::{Bias, EyeMaps};
+use super::prepared::Prepared;
 use crate::backend::BackendChoice;
 use crate::error_estimate::{Draw, ErrorEstimate};
 use crate::geom::camera::Camera;
@@ -28,6 +29,10 @@ pub struct EyeCall<'a> {
     /// Estimate the result's error from exact rays at a subset of the
     /// pixels drawn as it says (`estimate.rs`); None: no estimate.
     pub estimate_error: Option<Draw>,
+    /// What earlier calls on these meshes built and kept (`prepared.rs`),
+    /// read and filled by this one; None: everything is built for this
+    /// call alone.
+    pub prepared: Option<&'a Prepared>,
 }
 
 /// A rendered image.

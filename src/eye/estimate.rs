@@ -324,6 +324,7 @@ mod tests {
             backend: BackendChoice::Cpu,
             threads: None,
             estimate_error: Some(Draw::Timed),
+            prepared: None,
         };
         let scene = SceneTriangles::new(&meshes).unwrap();
         let g = CpuEye.first_hits(&camera, &scene).unwrap();

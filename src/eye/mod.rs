@@ -27,6 +27,7 @@ pub mod focus;
 pub mod framing;
 pub mod gbuffer;
 pub mod maps;
+pub mod prepared;
 pub mod rays;
 pub mod shading;
 pub mod shadow_mapping;

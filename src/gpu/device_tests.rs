@@ -570,6 +570,7 @@ mod eye {
             backend,
             threads: None,
             estimate_error: None,
+            prepared: None,
         })
     }
 
@@ -927,6 +928,7 @@ mod eye {
                     backend,
                     threads: None,
                     estimate_error: None,
+                    prepared: None,
                 })
                 .unwrap()
             };
@@ -1165,6 +1167,7 @@ mod eye {
                         backend: BackendChoice::Gpu,
                         threads: None,
                         estimate_error: None,
+                        prepared: None,
                     };
                     let mut sw = Stopwatch::new();
                     let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
@@ -1310,6 +1313,7 @@ mod eye {
                 backend: BackendChoice::Gpu,
                 threads: None,
                 estimate_error: None,
+                prepared: None,
             };
             let mut sw = Stopwatch::new();
             let p = match sm::prepare(&call, &cfg, &scene, &gb, &mut sw).unwrap() {

@@ -20,6 +20,9 @@ use super::bvh_node::Node;
 use super::bvh_wide::{collapse, Wide};
 use glam::Vec3;
 
+mod refit;
+pub use refit::Topology;
+
 /// Triangles per BVH leaf at most.
 const LEAF: usize = 4;
 /// Levels built by SAH; deeper nodes split at the median.
@@ -39,6 +42,21 @@ pub struct Bvh {
     /// one's parent (for the shadow cache).
     pub(crate) wide: Vec<Wide>,
     wide_parent: Vec<u32>,
+    /// The binary node each wide node was made from (`refit.rs`).
+    wide_source: Vec<u32>,
+}
+
+/// Each triangle as `hit_t` reads it (`Bvh::edges`).
+fn edges_of(tris: &[[Vec3; 3]]) -> Vec<[f32; 9]> {
+    use rayon::prelude::*;
+    tris.par_iter().map(edge_words).collect()
+}
+
+/// A triangle as `hit_t` reads it: v0, v1 - v0, v2 - v0.
+#[inline]
+fn edge_words(t: &[Vec3; 3]) -> [f32; 9] {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    [t[0].x, t[0].y, t[0].z, e1.x, e1.y, e1.z, e2.x, e2.y, e2.z]
 }
 
 fn bounds<'a>(tris: impl Iterator<Item = &'a [Vec3; 3]>) -> (Vec3, Vec3) {
@@ -205,14 +223,8 @@ impl Bvh {
         let codes = sah_depth.is_none().then(|| morton_order(&mut tris));
         let nodes = subtree(&mut tris, codes.as_deref(), 0, 0, sah_depth);
         let (tris, order): (Vec<[Vec3; 3]>, Vec<u32>) = tris.into_iter().unzip();
-        let edges = tris
-            .iter()
-            .map(|t| {
-                let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-                [t[0].x, t[0].y, t[0].z, e1.x, e1.y, e1.z, e2.x, e2.y, e2.z]
-            })
-            .collect();
-        let (wide, wide_parent) = collapse(&nodes);
+        let edges = edges_of(&tris);
+        let (wide, wide_parent, wide_source) = collapse(&nodes);
         Bvh {
             nodes,
             tris,
@@ -220,6 +232,7 @@ impl Bvh {
             edges,
             wide,
             wide_parent,
+            wide_source,
         }
     }
 
@@ -674,6 +687,7 @@ pub(crate) mod tests {
                 edges: vec![],
                 wide: vec![],
                 wide_parent: vec![],
+                wide_source: vec![],
             };
             assert_eq!(par.order, one.order);
             assert_eq!(canonical(&par), canonical(&one));

@@ -35,18 +35,20 @@ pub(crate) struct Wide {
 }
 
 /// The wide nodes of the binary tree `nodes` (root first; a root that is
-/// a leaf is the one slot of the one wide node) and each wide node's
-/// parent (the root's is itself).
-pub(crate) fn collapse(nodes: &[Node]) -> (Vec<Wide>, Vec<u32>) {
+/// a leaf is the one slot of the one wide node), each wide node's parent
+/// (the root's is itself) and the binary node each one was made from (whose
+/// box its slot in the parent holds: `Bvh::refit` reads it).
+pub(crate) fn collapse(nodes: &[Node]) -> (Vec<Wide>, Vec<u32>, Vec<u32>) {
     // An empty tree is a root leaf of no triangles.
     if nodes.is_empty() || (nodes.len() == 1 && nodes[0].count == 0) {
-        return (vec![], vec![]);
+        return (vec![], vec![], vec![]);
     }
     let mut wide = vec![empty()];
     let mut parent = vec![0u32];
+    let mut source = vec![0u32];
     if nodes[0].count > 0 {
         wide[0] = slots(nodes, &[0], |_| unreachable!());
-        return (wide, parent);
+        return (wide, parent, source);
     }
     // (binary inner node, the wide node it becomes)
     let mut work = vec![(0u32, 0usize)];
@@ -66,10 +68,29 @@ pub(crate) fn collapse(nodes: &[Node]) -> (Vec<Wide>, Vec<u32>) {
             work.push((c, k));
             wide.push(empty());
             parent.push(w as u32);
+            source.push(c);
             k as u32
         });
     }
-    (wide, parent)
+    (wide, parent, source)
+}
+
+/// Slot `k`'s boxes of wide node `w` set again from the binary nodes
+/// `nodes` (refitted): a leaf slot's from its binary leaf, an inner one's
+/// from the binary node its wide child was made from (`source`).
+pub(crate) fn refit_slots(w: &mut Wide, nodes: &[Node], source: &[u32]) {
+    for k in 0..w.len as usize {
+        let b = if w.leaves & (1 << k) != 0 {
+            w.child[k]
+        } else {
+            source[w.child[k] as usize]
+        };
+        let n = nodes[b as usize];
+        for a in 0..3 {
+            w.lo[a][k] = n.min[a];
+            w.hi[a][k] = n.max[a];
+        }
+    }
 }
 
 /// A wide node whose slots are the binary nodes `children`; `inner(c)`
@@ -120,8 +141,9 @@ mod tests {
             })
             .collect();
         let bvh = Bvh::build(tris);
-        let (wide, parent) = collapse(&bvh.nodes);
+        let (wide, parent, source) = collapse(&bvh.nodes);
         assert_eq!(parent.len(), wide.len());
+        assert_eq!(source.len(), wide.len());
         let mut seen = vec![0; bvh.nodes.len()];
         for (i, w) in wide.iter().enumerate() {
             assert!((2..=4).contains(&w.len));
@@ -150,10 +172,10 @@ mod tests {
     #[test]
     fn a_single_leaf_is_the_one_slot_of_the_root() {
         let bvh = Bvh::build(vec![[Vec3::ZERO, Vec3::X, Vec3::Y]]);
-        let (wide, parent) = collapse(&bvh.nodes);
+        let (wide, parent, source) = collapse(&bvh.nodes);
         assert_eq!(
-            (wide.len(), parent, wide[0].len, wide[0].leaves),
-            (1, vec![0], 1, 1)
+            (wide.len(), parent, source, wide[0].len, wide[0].leaves),
+            (1, vec![0], vec![0], 1, 1)
         );
         assert!(collapse(&Bvh::build(vec![]).nodes).0.is_empty());
     }

@@ -19,12 +19,14 @@ use crate::eye::framing::{
     traced_triangles,
 };
 use crate::eye::gbuffer::{GBuffer, SceneTriangles};
+use crate::eye::prepared::Found;
 use crate::eye::{shadow_mapping, CpuEye, EyeCall, EyeImage, EyeStages};
 use crate::methods::config::MAX_SAMPLES;
 use crate::methods::exact::Bvh;
 use crate::methods::MethodConfig;
 use crate::timing::Stopwatch;
 use glam::Vec3;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Seconds since `start`.
@@ -41,6 +43,18 @@ pub struct Traced {
     g: GBuffer,
     f: Framed,
     bvh: Bvh,
+}
+
+/// The call's triangles: kept by its preparation, or gathered and checked
+/// now; and what the preparation found.
+fn scene_of(call: &EyeCall) -> Result<(Arc<SceneTriangles>, Option<Found>)> {
+    match call.prepared {
+        Some(p) => {
+            let found = p.find(call.meshes, call.light)?;
+            Ok((found.scene.clone(), Some(found)))
+        }
+        None => Ok((Arc::new(SceneTriangles::new(call.meshes)?), None)),
+    }
 }
 
 /// Renders the visibility image of `call` on `backend`; returns the config
@@ -83,7 +97,7 @@ pub fn render_with<S: EyeStages>(
     if let MethodConfig::ShadowMapping(cfg) = call.method {
         let method = resolve_at_camera(call, S::BACKEND)?;
         let mut sw = Stopwatch::new();
-        let scene = SceneTriangles::new(call.meshes)?;
+        let (scene, _) = scene_of(call)?;
         let g = stages.first_hits(call.camera, &scene)?;
         sw.lap("first_hits");
         let visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
@@ -116,7 +130,7 @@ pub fn render_with<S: EyeStages>(
         return render_traced(stages, call, reuse, start);
     }
     let mut sw = Stopwatch::new();
-    let scene = SceneTriangles::new(call.meshes)?;
+    let (scene, _) = scene_of(call)?;
     let g = stages.first_hits(call.camera, &scene)?;
     sw.lap("first_hits");
     let mut f = frame(call, &scene, &g)?;
@@ -193,15 +207,32 @@ fn render_traced<S: EyeStages>(
     let Traced { g, f, bvh } = match reuse.as_mut().and_then(|r| r.take()) {
         Some(t) => t,
         None => {
-            let scene = SceneTriangles::new(call.meshes)?;
+            let (scene, found) = scene_of(call)?;
             let g = stages.first_hits(call.camera, &scene)?;
             sw.lap("first_hits");
             let f = frame(call, &scene, &g)?;
             sw.lap("transform");
             let tris = traced_triangles(&f, &scene);
             sw.lap("triangles");
-            let bvh = Bvh::build(tris);
-            sw.lap("bvh");
+            // A tree kept for this light's orientation is refitted to this
+            // call's light space; otherwise one is built (and its shape
+            // kept when the call has a preparation).
+            let kept = found.as_ref().and_then(|x| x.tree.as_ref());
+            let bvh = match kept.and_then(|t| t.refit(&tris)) {
+                Some(bvh) => {
+                    sw.lap("refit");
+                    bvh
+                }
+                None => {
+                    let bvh = Bvh::build(tris);
+                    sw.lap("bvh");
+                    if let (Some(p), Some(x)) = (call.prepared, &found) {
+                        p.keep(x, Arc::new(bvh.topology()));
+                        sw.lap("keep");
+                    }
+                    bvh
+                }
+            };
             Traced { g, f, bvh }
         }
     };

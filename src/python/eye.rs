@@ -7,6 +7,7 @@ use super::camera::PyCamera;
 use super::configs::{self, method_arg, Loose};
 use super::convert::{light_of, mesh, opt_float, opt_int, opt_resolution, triples, Light};
 use super::errors;
+use super::prepared::PyPrepared;
 use super::results::{map, sun_depth};
 use crate::api::Run;
 use crate::backend::BackendChoice;
@@ -95,7 +96,7 @@ pub fn irradiance<'py>(
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.
 #[pyfunction]
-#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None, estimate_error=None))]
+#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None, estimate_error=None, prepared=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -116,6 +117,7 @@ pub fn render<'py>(
     emission: Option<Bound<'py, PyAny>>,
     albedo: Option<Bound<'py, PyAny>>,
     estimate_error: Option<&str>,
+    prepared: Option<Bound<'py, PyPrepared>>,
 ) -> PyResult<EyeResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -141,6 +143,7 @@ pub fn render<'py>(
             backend: BackendChoice::parse(backend)?,
             threads: opt_int("threads", threads.as_ref())?,
             estimate_error: estimate_error.map(Draw::parse).transpose()?,
+            prepared: prepared.as_ref().map(|p| &p.get().0),
         };
         let arg = shading::emission_arg(&light);
         let lighting = Lighting::new(

@@ -32,6 +32,7 @@ mod eye;
 mod gpu;
 mod keyword_class;
 mod lights;
+mod prepared;
 mod results;
 mod shadow_configs;
 
@@ -53,6 +54,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;
     m.add_class::<eye::EyeResult>()?;
+    m.add_class::<prepared::PyPrepared>()?;
     m.add_class::<estimate::PyErrorEstimate>()?;
     m.add_function(wrap_pyfunction!(eye::render, m)?)?;
     m.add_function(wrap_pyfunction!(eye::light_emission, m)?)?;
