@@ -64,6 +64,20 @@ def add_output_arguments(p: argparse.ArgumentParser, default: Path) -> None:
     p.add_argument("--no-write", action="store_true", help="print the table only")
 
 
+def replace_block(path: Path, start: str, end: str, lines: list[str]) -> bool:
+    """Replaces what lies between the markers ``start`` and ``end`` in the
+    file at ``path`` by ``lines``; False (and the file as it was) when it has
+    no such markers."""
+    text = path.read_text()
+    if start not in text or end not in text:
+        print(f"{path.name} has no {start} ... {end} markers: left as it is", file=sys.stderr)
+        return False
+    head, rest = text.split(start, 1)
+    _, tail = rest.split(end, 1)
+    path.write_text(head + start + "\n" + "\n".join(lines) + "\n" + end + tail)
+    return True
+
+
 def runs(n: int) -> str:
     """``"1 run"``, ``"3 runs"``."""
     return f"{n} run{'s' if n != 1 else ''}"

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import argparse
 
-from _report import DOCS, ROOT, Report, add_output_arguments, command_line, runs
+from _report import DOCS, ROOT, Report, add_output_arguments, command_line, replace_block, runs
 
 from softshadow.experiments.eye_plane import best_within, eye_plane, markdown_eye_plane
 from softshadow.scenes.eye_view import EYE_SCENES
@@ -81,11 +81,7 @@ def main() -> None:
         "beyond its most samples."
     )
     report.write(args.out, intro=intro)
-    text = README.read_text()
-    if START in text and END in text:
-        head, rest = text.split(START, 1)
-        _, tail = rest.split(END, 1)
-        README.write_text(head + START + "\n" + "\n".join(table) + "\n" + END + tail)
+    replace_block(README, START, END, table)
 
 
 if __name__ == "__main__":

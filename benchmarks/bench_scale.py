@@ -37,6 +37,12 @@ its kernels there), medians of ``--repeats`` rounds:
   ``dr.sync_thread()``. Its whole job (``MitsubaEyeJob.run``: camera rays,
   first hits, read-back, sampling, shadow rays) is timed beside it.
 
+Each call is also timed first (on a new ``ss.Scene``: nothing prepared) and
+following (on the scene the warm-up prepared: the BVH refitted, not built),
+beside Mitsuba's scene load and job. With the default ``--out``, one line a
+scene goes into the README between ``<!-- scale-table:start -->`` and
+``<!-- scale-table:end -->``.
+
 Rays: the pixels on the light's front side (those Mitsuba's job traces:
 every hit pixel for the sun) times the samples, each renderer counting its
 own first hits; first hits are counted per pixel of the image. The second
@@ -61,13 +67,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from _report import DOCS, Report, add_output_arguments, command_line, runs
+from _report import DOCS, ROOT, Report, add_output_arguments, command_line, replace_block, runs
 
 import softshadow as ss
 from softshadow.reference._mitsuba import _mitsuba
 from softshadow.reference.eye_job import BATCH_RAYS, MitsubaEyeJob
 from softshadow.scenes.as_built import _camera, crowd, rect_light, slab
 from softshadow.scenes.primitives import torus
+
+README = ROOT / "README.md"
+START, END = "<!-- scale-table:start -->", "<!-- scale-table:end -->"
 
 Mesh = tuple[np.ndarray, np.ndarray]
 EyeScene = tuple[ss.Scene, Any, ss.Camera]
@@ -268,6 +277,7 @@ def main() -> None:
     pixels = res[0] * res[1]
     summary: list[str] = []
     prepared: list[str] = []
+    readme: list[str] = []
     for name in args.scenes:
         scene, light, cam = builders[name](res)
         counts = [len(f) for _, f in scene.meshes]
@@ -329,6 +339,8 @@ def main() -> None:
         )
         report.line("|---|---|---|---|---|---|---|")
         fits: dict[str, list[tuple[int, float]]] = {"ours": [], "mitsuba": []}
+        per_ray: dict[int, str] = {}
+        default_calls = (0.0, 0.0)
         for n in args.samples:
             tm = times[n]
             ours = {k: median_ms(v) for k, v in tm.ours.items()}
@@ -341,6 +353,7 @@ def main() -> None:
                 "first_hits": ("first hits (per pixel)", theirs["first_hits"], pixels, pixels),
                 "shadow": ("shadow rays (per ray)", theirs["shadow"], rays_ours, rays_theirs),
             }
+            per_ray[n] = ratio(theirs["shadow"] / max(rays_theirs, 1), ours.get("shadow", 0.0) / max(rays_ours, 1))
             for stage, v in ours.items():
                 if stage == "call":
                     continue
@@ -382,6 +395,13 @@ def main() -> None:
             mitsuba = f"{load_ms + job_ms:.0f} | {job_ms:.0f}" if job_ms is not None else " | "
             report.line(f"| {label} | {first:.0f} | {following:.0f} | {following / first:.2f} | {mitsuba} |")
             prepared.append(f"| {name} | {label} | {first:.0f} | {following:.0f} | {following / first:.2f} |")
+            if label == "default":
+                default_calls = (first, following)
+        n_max = max(args.samples)
+        readme.append(
+            f"| {name} | {scene.triangle_count:,} in {len(scene.meshes)} | {per_ray[n_max]} | "
+            f"{default_calls[0]:.0f} | {default_calls[1]:.0f} |"
+        )
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
         report.line()
         report.line(f"Peak resident memory of the benchmark process so far (Mitsuba's scenes too): {peak:.2f} GiB.")
@@ -424,6 +444,16 @@ def main() -> None:
         "A ratio above 1 means softshadow is faster."
     )
     report.write(args.out, intro=intro)
+    if args.out != DOCS / "scale.md":
+        return
+    n_max = max(args.samples)
+    table = [
+        f"| scene ({res[0]}×{res[1]}) | triangles in meshes | `exact` per shadow ray, Mitsuba's `ray_test` time / ours "
+        f"({n_max} samples) | default call, first (ms) | following (ms) |",
+        "|---|---|---|---|---|",
+        *readme,
+    ]
+    replace_block(README, START, END, table)
 
 
 if __name__ == "__main__":

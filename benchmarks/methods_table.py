@@ -32,6 +32,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _report import replace_block
 
 import softshadow as ss
 from softshadow import metrics, reference, scenes
@@ -152,14 +153,7 @@ def markdown(rows: list[tuple[str, str, Point]], mitsuba: list[tuple[int, Point]
 
 
 def rewrite_readme(table: str) -> bool:
-    text = README.read_text()
-    if START not in text or END not in text:
-        print(f"README.md has no {START} ... {END} markers: left as it is", file=sys.stderr)
-        return False
-    head, rest = text.split(START, 1)
-    _, tail = rest.split(END, 1)
-    README.write_text(f"{head}{START}\n{table}\n{END}{tail}")
-    return True
+    return replace_block(README, START, END, [table])
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -695,7 +695,7 @@ pub(crate) mod tests {
         }
     }
 
-    fn random_tris(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
+    pub(crate) fn random_tris(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
         let mut r = rng(seed);
         (0..n)
             .map(|_| {

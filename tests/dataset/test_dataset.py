@@ -180,6 +180,35 @@ def test_zstd_items_hold_the_zip_items_pixels_and_only_that_spec_hash_changes(tm
                 assert exr.header()["compression"] == io.exr_compression(name), (name, f)
 
 
+def test_views_share_one_scene_and_its_preparation_and_one_view_keeps_the_old_hash(tmp_path):
+    from softshadow.dataset import item as item_module
+    from softshadow.dataset.sampling import sample_item
+
+    plain = load_spec(write_spec(tmp_path, name="plain.toml"))
+    views = load_spec(write_spec(tmp_path, "views = 3\n" + SMALL.replace('name = "ssm"', 'name = "auto"'), "v.toml"))
+    assert views.views == 3 and plain.views == 1
+    assert "views" not in plain.canonical()
+    one = load_spec(write_spec(tmp_path, "views = 1\n" + SMALL, "one.toml"))
+    assert one.hash == plain.hash
+    items = [sample_item(views, k) for k in range(6)]
+    # Items 0-2 share objects and ground, 3-5 others; lights and cameras are each item's own.
+    for k in (1, 2):
+        assert (items[k]["objects"], items[k]["ground"]) == (items[0]["objects"], items[0]["ground"])
+        assert items[k]["camera"] != items[0]["camera"]
+    assert items[3]["objects"] != items[0]["objects"]
+    # The first item of a scene draws its objects as without views.
+    assert sample_item(plain, 3)["objects"] == items[3]["objects"]
+    # One process renders a scene's items through one Scene: later items refit its tree.
+    item_module._SCENES.clear()
+    scenes = [item_module._scene(views, k, items[k])[0] for k in range(4)]
+    assert scenes[0] is scenes[1] is scenes[2] and scenes[3] is not scenes[0]
+    out = tmp_path / "out"
+    assert run(views, out, count=6, workers=1, progress=False).done == 6
+    assert check_output(str(out)).complete == list(range(6))
+    held = [s.prepared.held for s in (v[0] for v in item_module._SCENES.values())]
+    assert held and all(h[0] for h in held)
+
+
 def test_spec_is_stored_and_another_spec_is_refused(tmp_path):
     spec = load_spec(write_spec(tmp_path))
     out = tmp_path / "out"

@@ -27,10 +27,11 @@ from typing import Any
 import numpy as np
 
 from .. import io as ssio
+from ..scene import Scene
 from . import limits as L
 from .build import build_camera, build_light, build_scene
 from .files import write_item_files
-from .sampling import item_seed, sample_item
+from .sampling import item_seed, sample_item, scene_item
 from .spec import REFERENCE, Spec, shading_available
 
 
@@ -85,12 +86,33 @@ def select_channels(all_channels: dict[str, np.ndarray], groups: tuple[str, ...]
     return out
 
 
+#: The scenes this process built last, by (spec hash, scene item): the
+#: items of one scene (``views``) that a process renders reuse its
+#: ``Scene`` and so what it prepared (its triangles; the shadow rays' tree,
+#: refitted to each camera and light of the same orientation).
+_SCENES: dict[tuple[str, int], tuple[Scene, list[np.ndarray]]] = {}
+_KEPT_SCENES = 2
+
+
+def _scene(spec: Spec, k: int, params: dict[str, Any]) -> tuple[Scene, list[np.ndarray]]:
+    """Item k's scene and albedos: built, or the one built for another item
+    of its scene (its objects are the same by construction)."""
+    if spec.views == 1:
+        return build_scene(params, spec.folder)
+    key = (spec.hash, scene_item(spec, k))
+    if key not in _SCENES:
+        while len(_SCENES) >= _KEPT_SCENES:
+            del _SCENES[next(iter(_SCENES))]
+        _SCENES[key] = build_scene(params, spec.folder)
+    return _SCENES[key]
+
+
 def render_item(
     spec: Spec, k: int, threads: int | None
 ) -> tuple[dict[str, np.ndarray], list[np.ndarray], dict[str, Any]]:
     """Item k's channels (all of them), light-view maps and record (without file names)."""
     params = sample_item(spec, k)
-    scene, albedo = build_scene(params, spec.folder)
+    scene, albedo = _scene(spec, k, params)
     camera = build_camera(params["camera"])
     m = spec.method
     record: dict[str, Any] = {"k": k, "seed": spec.seed, "spec_hash": spec.hash, "versions": versions(spec)}

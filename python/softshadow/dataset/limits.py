@@ -14,6 +14,8 @@ MAX_SIDE = 8192
 """Pixels per side of the eye view and of the light-view maps."""
 MAX_SEED = 2**63 - 1
 """The largest ``seed``."""
+MAX_VIEWS = 1024
+"""Items per scene (``views``)."""
 MAX_OBJECT_ENTRIES = 64
 """``[[objects]]`` tables per spec."""
 MAX_INSTANCES = 1000

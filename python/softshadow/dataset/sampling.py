@@ -6,7 +6,9 @@ any subset of items regenerates bit for bit on any number of workers. The
 stream is split in three (objects, light, camera) so that, say, a change of
 the camera's ranges leaves the objects and the light of every item as they
 were. The result is plain JSON values (the item's record) from which
-:mod:`.build` makes the scene.
+:mod:`.build` makes the scene. With ``views = n``, the n items of one scene
+(k // n alike) draw their objects and ground from the first one's objects
+stream and their light and camera from their own.
 
 Placement (per instance): the base mesh is scaled so that the largest side
 of its bounding box is 1, stretched per axis, scaled by ``scale``, tilted by
@@ -46,9 +48,18 @@ def _color(rng: np.random.Generator, c: Color) -> list[float]:
     return [uniform(rng, r) for r in c]
 
 
+def scene_item(spec: Spec, k: int) -> int:
+    """The item whose objects stream item k's scene is drawn from: the first
+    of its ``views`` (k itself when every item has its own scene)."""
+    return k - k % spec.views
+
+
 def sample_item(spec: Spec, k: int) -> dict[str, Any]:
-    """Every random choice of item k, as JSON values."""
-    r_obj, r_light, r_cam = item_rngs(spec.seed, k)
+    """Every random choice of item k, as JSON values. The objects and the
+    ground come from the objects stream of :func:`scene_item` (shared by the
+    ``views`` items of one scene), the light and camera from item k's own."""
+    _, r_light, r_cam = item_rngs(spec.seed, k)
+    r_obj = item_rngs(spec.seed, scene_item(spec, k))[0]
     objects: list[dict[str, Any]] = []
     for index, o in enumerate(spec.objects):
         objects += _instances(r_obj, index, o, spec)

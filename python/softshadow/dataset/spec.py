@@ -143,6 +143,10 @@ class Spec:
     """The spec file's folder (relative mesh paths resolve against it)."""
     mesh_hashes: dict[str, str] = field(repr=False, compare=False, default_factory=dict)
     """sha256 of every mesh file, by absolute path."""
+    views: int = 1
+    """Consecutive items that share one scene (objects and ground), each with
+    its own light and camera: items k and j share it when k // views ==
+    j // views (:func:`.sampling.scene_item`)."""
 
     def canonical(self) -> dict[str, Any]:
         """What defines the items (everything but ``count``), as JSON values:
@@ -157,6 +161,8 @@ class Spec:
             # The default, left out so that specs from before the field
             # keep their hash (and their output folders resume).
             del d["outputs"]["compression"]
+        if d["views"] == 1:
+            del d["views"]  # likewise
         return json.loads(json.dumps(d))
 
     @functools.cached_property
@@ -201,6 +207,7 @@ def parse_spec(data: dict[str, Any], *, text: str = "", folder: str = ".") -> Sp
     folder = os.path.abspath(folder)
     seed = top.integer("seed", 0, 0, L.MAX_SEED)
     count = top.integer("count", 1, 1, L.MAX_COUNT)
+    views = top.integer("views", 1, 1, L.MAX_VIEWS)
     ground = _ground(top.table("ground"))
     objects = tuple(_object(t, folder) for t in top.tables("objects", most=L.MAX_OBJECT_ENTRIES))
     instances = sum(_most_instances(o) for o in objects)
@@ -214,7 +221,7 @@ def parse_spec(data: dict[str, Any], *, text: str = "", folder: str = ".") -> Sp
     outputs = _outputs(top.table("outputs"), method)
     top.done()
     hashes = {f: sha256_file(f) for o in objects for f in o.files}
-    return Spec(seed, count, ground, objects, lights, camera, method, outputs, text, folder, hashes)
+    return Spec(seed, count, ground, objects, lights, camera, method, outputs, text, folder, hashes, views)
 
 
 def _ground(t: Table) -> GroundSpec:

@@ -147,18 +147,24 @@ def eye_plane(
     repeats: int,
     reference_samples: int,
     calls: list[tuple[str, str, Any]] | None = None,
+    built: tuple[Any, Any, Any] | None = None,
+    reference: Any = None,
+    mitsuba_samples: tuple[int, ...] = MITSUBA_SAMPLES,
 ) -> EyePlane:
     """Measures every call of ``calls`` (default :data:`CALLS`) and Mitsuba's
-    job on the eye scene ``name`` at ``resolution``; times are medians of
-    ``repeats`` rounds after a warm-up (which compiles Dr.Jit's kernels)."""
+    job (at ``mitsuba_samples`` a pixel) on the eye scene ``name`` at
+    ``resolution`` (or on ``built``, a (scene, light, camera) triple, against
+    ``reference``); times are medians of ``repeats`` rounds after a warm-up
+    (which compiles Dr.Jit's kernels and prepares the scene for the calls
+    after it, as Mitsuba's scene is loaded once)."""
     from ..reference import render_visibility
     from ..reference.eye_job import MitsubaEyeJob
 
     calls = CALLS if calls is None else calls
-    scene, light, cam = EYE_SCENES[name](resolution)
-    ref = render_visibility(scene, light, cam, samples=reference_samples, seed=1)
+    scene, light, cam = EYE_SCENES[name](resolution) if built is None else built
+    ref = render_visibility(scene, light, cam, samples=reference_samples, seed=1) if reference is None else reference
     job = MitsubaEyeJob(scene, light, cam)
-    jobs: list[tuple[str, Any]] = [(f"mitsuba {k}", lambda k=k: job.run(k)) for k in MITSUBA_SAMPLES]
+    jobs: list[tuple[str, Any]] = [(f"mitsuba {k}", lambda k=k: job.run(k)) for k in mitsuba_samples]
     jobs += [(label, lambda m=m: render(scene, light, cam, method=m)) for _, label, m in calls]
     for _, fn in jobs:
         fn()  # warm-up
@@ -177,7 +183,7 @@ def eye_plane(
             float(np.median(times[f"mitsuba {k}"])),
             compare_images(_Ref(ref, outs[f"mitsuba {k}"]), ref).shadow_error,
         )
-        for k in MITSUBA_SAMPLES
+        for k in mitsuba_samples
     ]
     rows = []
     for family, label, _ in calls:

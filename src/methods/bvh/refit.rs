@@ -98,23 +98,9 @@ impl Topology {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::rng;
+    use super::super::tests::{random_tris as scene, rng};
     use super::*;
     use crate::methods::packet::{Rays, ALL, LANES};
-
-    fn scene(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
-        let mut r = rng(seed);
-        (0..n)
-            .map(|_| {
-                let c = Vec3::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0, 1.0 + r() * 3.0);
-                [
-                    c,
-                    c + Vec3::new(r() * 0.4, r() * 0.1, r() * 0.2),
-                    c + Vec3::new(r() * 0.1, r() * 0.4, r() * 0.2),
-                ]
-            })
-            .collect()
-    }
 
     /// The triangles in another frame: rotated about z and x, scaled,
     /// moved (what another light space does to them).
