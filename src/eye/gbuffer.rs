@@ -79,19 +79,24 @@ impl SceneTriangles {
         if meshes.iter().map(|m| m.vertices.len()).sum::<usize>() > u32::MAX as usize {
             return Err(Error::invalid("meshes", "more than 2^32 vertices in all"));
         }
-        let (mut corners, mut mesh_of) = (vec![], vec![]);
-        let (mut vertices, mut faces) = (vec![], vec![]);
+        // Every list filled in parallel in place (one thread took 0.2 s of
+        // a first call on 2 000 000 triangles, most of it first touches of
+        // the new pages).
+        let nf = meshes.iter().map(|m| m.faces.len()).sum();
+        let nv = meshes.iter().map(|m| m.vertices.len()).sum();
+        let (mut corners, mut mesh_of) = (Vec::with_capacity(nf), Vec::with_capacity(nf));
+        let (mut vertices, mut faces) = (Vec::with_capacity(nv), Vec::with_capacity(nf));
         for (k, m) in meshes.iter().enumerate() {
             m.validate(&format!("meshes[{k}]"))?;
-            corners.extend(
+            corners.par_extend(
                 m.faces
-                    .iter()
+                    .par_iter()
                     .map(|f| f.map(|i| DVec3::from_array(m.vertices[i as usize]))),
             );
-            mesh_of.extend(std::iter::repeat_n(k as i32, m.faces.len()));
+            mesh_of.par_extend(rayon::iter::repeat_n(k as i32, m.faces.len()));
             let first = vertices.len() as u32;
-            faces.extend(m.faces.iter().map(|f| f.map(|i| first + i)));
-            vertices.extend(m.vertices.iter().map(|v| DVec3::from_array(*v)));
+            faces.par_extend(m.faces.par_iter().map(|f| f.map(|i| first + i)));
+            vertices.par_extend(m.vertices.par_iter().map(|v| DVec3::from_array(*v)));
         }
         Ok(SceneTriangles {
             corners,

@@ -29,7 +29,16 @@ use rayon::prelude::*;
 pub struct Topology(Bvh);
 
 impl Bvh {
-    /// This tree's shape.
+    /// This tree's shape, the tree consumed (nothing copied).
+    pub fn into_topology(self) -> Topology {
+        Topology(Bvh {
+            tris: vec![],
+            edges: vec![],
+            ..self
+        })
+    }
+
+    /// This tree's shape, copied.
     pub fn topology(&self) -> Topology {
         Topology(Bvh {
             nodes: self.nodes.clone(),
@@ -149,7 +158,7 @@ mod tests {
     fn rays_through_a_refitted_tree_answer_as_through_a_fresh_build() {
         let tris = scene(2000, 5);
         let new = moved(&tris);
-        let refit = Bvh::build(tris).topology().refit(&new).unwrap();
+        let refit = Bvh::build(tris).into_topology().refit(&new).unwrap();
         let fresh = Bvh::build(new.clone());
         let mut r = rng(9);
         for _ in 0..300 {
