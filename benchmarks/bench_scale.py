@@ -39,7 +39,8 @@ its kernels there), medians of ``--repeats`` rounds:
 
 Each call is also timed first (on a new ``ss.Scene``: nothing prepared) and
 following (on the scene the warm-up prepared: the BVH refitted, not built),
-beside Mitsuba's scene load and job. With the default ``--out``, one line a
+beside Mitsuba's scene load and job; the default call's peak memory is
+measured in a process of its own. With the default ``--out``, one line a
 scene goes into the README between ``<!-- scale-table:start -->`` and
 ``<!-- scale-table:end -->``.
 
@@ -61,9 +62,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import argparse
 import math
 import resource
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -261,6 +265,37 @@ def ratio(mitsuba_ms: float, ours_ms: float) -> str:
     return f"{mitsuba_ms / ours_ms:.2f}" if ours_ms > 0 else "–"
 
 
+def _status_gib(field: str = "VmRSS") -> float:
+    """A memory field of /proc/self/status in GiB: ``VmRSS`` (now) or ``VmHWM``
+    (the peak of this process image; ``ru_maxrss`` would keep the peak of the
+    process that forked it)."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(field + ":"):
+                return int(line.split()[1]) / 2**20
+    return float("nan")
+
+
+def call_memory(name: str, res: tuple[int, int], scale: float) -> tuple[float, float]:
+    """The default call's first render of scene ``name`` in a process of
+    its own (nothing else there has peaked): its peak resident memory above
+    what the process held before the call, and the peak, in GiB."""
+    code = (
+        "import sys; sys.path.insert(0, sys.argv[1]); import bench_scale as b, softshadow as ss; "
+        "s, l, c = b.scenes(float(sys.argv[3]))[sys.argv[2]]((int(sys.argv[4]), int(sys.argv[5]))); "
+        "before = b._status_gib(); ss.render(s, l, c); "
+        "peak = b._status_gib('VmHWM'); print(peak - before, peak)"
+    )
+    here = str(Path(__file__).resolve().parent)
+    out = subprocess.run(
+        [sys.executable, "-c", code, here, name, str(scale), str(res[0]), str(res[1])],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
+    return float(out[0]), float(out[1])
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--resolution", type=int, nargs=2, default=(640, 480), metavar=("W", "H"))
@@ -279,6 +314,7 @@ def main() -> None:
     prepared: list[str] = []
     readme: list[str] = []
     for name in args.scenes:
+        call_gib, peak_gib = call_memory(name, res, args.scale)
         scene, light, cam = builders[name](res)
         counts = [len(f) for _, f in scene.meshes]
         t = time.perf_counter()
@@ -400,11 +436,15 @@ def main() -> None:
         n_max = max(args.samples)
         readme.append(
             f"| {name} | {scene.triangle_count:,} in {len(scene.meshes)} | {per_ray[n_max]} | "
-            f"{default_calls[0]:.0f} | {default_calls[1]:.0f} |"
+            f"{default_calls[0]:.0f} | {default_calls[1]:.0f} | {call_gib:.2f} |"
         )
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
         report.line()
-        report.line(f"Peak resident memory of the benchmark process so far (Mitsuba's scenes too): {peak:.2f} GiB.")
+        report.line(
+            f"Memory: the default call's first render, in a process of its own, peaked {call_gib:.2f} GiB above "
+            f"what the process held before it ({peak_gib:.2f} GiB in all); this benchmark's process, Mitsuba's "
+            f"scenes included, has peaked at {peak:.2f} GiB so far."
+        )
         report.line()
         if len(args.samples) >= 2:
             report.line(
@@ -449,8 +489,8 @@ def main() -> None:
     n_max = max(args.samples)
     table = [
         f"| scene ({res[0]}×{res[1]}) | triangles in meshes | `exact` per shadow ray, Mitsuba's `ray_test` time / ours "
-        f"({n_max} samples) | default call, first (ms) | following (ms) |",
-        "|---|---|---|---|---|",
+        f"({n_max} samples) | default call, first (ms) | following (ms) | its peak memory (GiB) |",
+        "|---|---|---|---|---|---|",
         *readme,
     ]
     replace_block(README, START, END, table)

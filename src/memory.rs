@@ -1,4 +1,4 @@
-//! Refusing work whose maps would not fit in memory, before allocating.
+//! Refusing work that would not fit in memory, before allocating.
 //!
 //! Rust aborts the process when an allocation fails, so a map too large for
 //! the machine must be refused before it is allocated: the pipeline adds up
@@ -9,7 +9,8 @@
 
 use crate::error::{Error, Result};
 
-/// The environment variable that caps the bytes of maps one call may allocate.
+/// The environment variable that caps the bytes one call may allocate (its
+/// maps; an eye-view call's triangles, tree and images).
 pub const LIMIT_VAR: &str = "SOFTSHADOW_MEMORY_LIMIT";
 
 /// Requests below this many bytes fit on any machine this runs on: they
@@ -57,7 +58,7 @@ pub fn check_fits(arg: &str, what: &str, bytes: u64) -> Result<()> {
         Some(avail) if bytes > avail => Err(Error::too_large(
             arg,
             format!(
-                "{what} would need about {bytes} bytes of maps, more than the {avail} bytes \
+                "{what} would need about {bytes} bytes of memory, more than the {avail} bytes \
                  available (MemAvailable, or {LIMIT_VAR})"
             ),
         )),

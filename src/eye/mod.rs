@@ -20,6 +20,7 @@
 //! Lambertian direct lighting, unshadowed and times the visibility), so
 //! both backends shade a visibility alike.
 
+pub mod budget;
 pub mod call;
 mod casters;
 pub mod estimate;

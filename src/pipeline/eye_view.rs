@@ -12,6 +12,7 @@
 use crate::backend::Backend;
 use crate::error::Result;
 use crate::error_estimate::Draw;
+use crate::eye::budget::traced_bytes;
 use crate::eye::estimate::{self, REFERENCE_SAMPLES};
 use crate::eye::framing::Framed;
 use crate::eye::framing::{
@@ -21,6 +22,7 @@ use crate::eye::framing::{
 use crate::eye::gbuffer::{GBuffer, SceneTriangles};
 use crate::eye::prepared::Found;
 use crate::eye::{shadow_mapping, CpuEye, EyeCall, EyeImage, EyeStages};
+use crate::memory::check_fits;
 use crate::methods::config::MAX_SAMPLES;
 use crate::methods::exact::Bvh;
 use crate::methods::MethodConfig;
@@ -209,6 +211,14 @@ fn render_traced<S: EyeStages>(
     let Traced { g, f, mut bvh } = match reuse.as_mut().and_then(|r| r.take()) {
         Some(t) => t,
         None => {
+            let triangles = call.meshes.iter().map(|m| m.faces.len()).sum();
+            let vertices = call.meshes.iter().map(|m| m.vertices.len()).sum();
+            let (w, h) = size;
+            check_fits(
+                "meshes",
+                &format!("{triangles} triangles traced at {w}x{h} pixels"),
+                traced_bytes(triangles, vertices, w.saturating_mul(h)),
+            )?;
             let (scene, found) = scene_of(call)?;
             let g = stages.first_hits(call.camera, &scene)?;
             sw.lap("first_hits");

@@ -130,6 +130,20 @@ def test_maps_larger_than_the_memory_available_are_refused_before_allocating(mon
     assert ss.soft_shadow_map(scene, light, resolution=1024, method="exact", samples=1).visibility.min() == 0.0
 
 
+def test_an_eye_view_too_large_for_the_memory_is_refused_before_allocating(monkeypatch):
+    # The traced eye view (the default call) adds up its triangles', tree's
+    # and images' bytes first (src/eye/budget.rs) and names the meshes.
+    scene = ss.Scene(meshes=[scenes.quad((0.0, 0.0, 0.0), 2.0), scenes.quad((0.0, 1.0, 0.0), 0.5)])
+    light = ss.RectLight(center=(0, 3, 0), normal=(0, -1, 0), up=(0, 0, 1), size=(1.0, 1.0))
+    cam = ss.Camera.look_at(eye=(2, 2, 2), target=(0, 0, 0), up=(0, 1, 0), fov_y=40.0, resolution=(64, 48))
+    monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "100000")
+    with pytest.raises(ss.TooLargeError, match=r"meshes: 4 triangles traced at 64x48 pixels would need about \d+ bytes"):
+        ss.render(scene, light, cam)
+    assert scene.prepared.held == (False, 0)  # refused before the triangles were gathered
+    monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "10000000")
+    assert ss.render(scene, light, cam).visibility.shape == (48, 64)
+
+
 def test_the_memory_check_counts_what_closed_gaps_keep_per_layer(monkeypatch):
     # Connected micro-quads keep 8 more f32 per occluder texel and layer
     # (corner depths and their reciprocals): 64² maps with the hierarchy,
