@@ -137,7 +137,8 @@ def test_an_eye_view_too_large_for_the_memory_is_refused_before_allocating(monke
     light = ss.RectLight(center=(0, 3, 0), normal=(0, -1, 0), up=(0, 0, 1), size=(1.0, 1.0))
     cam = ss.Camera.look_at(eye=(2, 2, 2), target=(0, 0, 0), up=(0, 1, 0), fov_y=40.0, resolution=(64, 48))
     monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "100000")
-    with pytest.raises(ss.TooLargeError, match=r"meshes: 4 triangles traced at 64x48 pixels would need about \d+ bytes"):
+    refused = r"meshes: 4 triangles traced at 64x48 pixels would need about \d+ bytes"
+    with pytest.raises(ss.TooLargeError, match=refused):
         ss.render(scene, light, cam)
     assert scene.prepared.held == (False, 0)  # refused before the triangles were gathered
     monkeypatch.setenv("SOFTSHADOW_MEMORY_LIMIT", "10000000")
