@@ -23,6 +23,10 @@ pub enum Error {
     /// The GPU device failed while running (out of memory, lost device).
     #[error("GPU failure: {msg}")]
     Gpu { msg: String },
+    /// The call's `cancel::Token` was cancelled (Ctrl-C in Python) before
+    /// it finished; nothing it computed is returned.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 impl Error {

@@ -32,7 +32,7 @@ fn layer(module: &[String]) -> usize {
         Some("geom") => 2,
         Some(
             "error" | "error_estimate" | "memory" | "threads" | "timing" | "backend"
-            | "block_cache",
+            | "block_cache" | "cancel",
         ) => 1,
         other => panic!("src/layering.rs: no layer for module {other:?}; add it to `layer`"),
     }

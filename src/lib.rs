@@ -45,6 +45,7 @@ pub mod api;
 pub mod auto;
 pub mod backend;
 pub mod block_cache;
+pub mod cancel;
 pub mod error;
 pub mod error_estimate;
 pub mod eye;

@@ -7,6 +7,7 @@
 //! Pools are built once per count and kept: building one costs a thread
 //! spawn per worker, too much per call.
 
+use crate::cancel;
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -66,18 +67,25 @@ fn pool(n: usize) -> Result<Arc<rayon::ThreadPool>> {
 }
 
 /// Runs `f` on at most `cap` worker threads (the global pool for `None`) and
-/// returns its result with the number of threads it could use.
+/// returns its result with the number of threads it could use, or
+/// `Error::Interrupted` where the call's `cancel::Token` was cancelled
+/// while `f` ran (what `f` returns then may be partial: its loops skipped
+/// their chunks). The token goes with `f` onto the pool's thread.
 pub fn run_capped<T: Send>(
     cap: Option<usize>,
     f: impl FnOnce() -> Result<T> + Send,
 ) -> Result<(T, usize)> {
-    match cap {
-        None => Ok((f()?, rayon::current_num_threads())),
+    let token = cancel::current();
+    let out = match cap {
+        None => (f()?, rayon::current_num_threads()),
         Some(n) => {
             let p = pool(n)?;
-            p.install(|| Ok((f()?, rayon::current_num_threads())))
+            let t = token.clone();
+            p.install(|| cancel::with(t, || Ok::<_, Error>((f()?, rayon::current_num_threads()))))?
         }
-    }
+    };
+    token.check()?;
+    Ok(out)
 }
 
 #[cfg(test)]

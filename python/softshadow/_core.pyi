@@ -572,7 +572,7 @@ def render(
     occluder_resolution: _Resolution | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
-    backend: str = "cpu",
+    backend: str = ...,  # "cpu" (shown as ... by the extension: a converted default)
     threads: int | None = None,
     emission: _Color | None = None,
     albedo: _Color | list[_Color] | None = None,
@@ -653,7 +653,7 @@ def shadow_map_from_meshes(
     occluder_resolution: _Resolution | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
-    backend: str = "cpu",
+    backend: str = ...,  # "cpu" (shown as ... by the extension: a converted default)
     threads: int | None = None,
     estimate_error: str | None = None,
 ) -> MeshShadowResult:
@@ -675,7 +675,7 @@ def shadow_map_from_scene(
     occluder_resolution: _Resolution | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
-    backend: str = "cpu",
+    backend: str = ...,  # "cpu" (shown as ... by the extension: a converted default)
     threads: int | None = None,
     estimate_error: str | None = None,
 ) -> MeshShadowResult:
@@ -696,7 +696,7 @@ def shadow_map_from_depth(
     occluder_resolution: _Resolution | None = None,
     hierarchy: bool | None = None,
     precision: str | None = None,
-    backend: str = "cpu",
+    backend: str = ...,  # "cpu" (shown as ... by the extension: a converted default)
     threads: int | None = None,
 ) -> DepthShadowResult:
     """Visibility from depth maps (the occluder maps may have their own

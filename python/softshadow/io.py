@@ -1,13 +1,21 @@
-"""Writing maps to EXR (OpenEXR, optional) and PNG (no dependency)."""
+"""Writing maps to EXR (OpenEXR, optional: the ``io`` extra) and PNG (no dependency)."""
 
 from __future__ import annotations
 
 import os
 import struct
 import zlib
+from types import ModuleType
 from typing import Any
 
 import numpy as np
+
+from ._extras import require
+
+
+def _openexr(needed_for: str) -> ModuleType:
+    """OpenEXR, or MissingExtraError naming the ``io`` extra (no bare ``No module named``)."""
+    return require("OpenEXR", "io", needed_for)
 
 
 def _as_map(name: str, a: Any) -> np.ndarray:
@@ -30,7 +38,7 @@ def exr_compression(compression: str) -> Any:
     """OpenEXR's constant for ``compression`` (a key of ``EXR_COMPRESSIONS``),
     or ValueError naming ``compression`` when the name or the installed
     OpenEXR does not have it."""
-    import OpenEXR
+    OpenEXR = _openexr("EXR compression")
 
     if compression not in EXR_COMPRESSIONS:
         raise ValueError(f"compression: must be one of {sorted(EXR_COMPRESSIONS)}, got {compression!r}")
@@ -51,10 +59,7 @@ def write_exr(path: str | os.PathLike[str], channels: dict[str, Any] | Any, *, c
     ``"zstd"`` (smaller and faster to write; read by OpenEXR 3.5 and later
     only) or ``"none"``. Needs the ``OpenEXR`` package (``pip install softshadow[io]``).
     """
-    try:
-        import OpenEXR
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise ImportError("write_exr needs OpenEXR: pip install softshadow[io]") from e
+    OpenEXR = _openexr("write_exr")
     mode = exr_compression(compression)
     if not isinstance(channels, dict):
         channels = {"Y": channels}
@@ -72,7 +77,7 @@ def write_exr(path: str | os.PathLike[str], channels: dict[str, Any] | Any, *, c
 def read_exr(path: str | os.PathLike[str]) -> dict[str, np.ndarray]:
     """Reads every channel of an EXR file as arrays. A missing file raises
     FileNotFoundError, one OpenEXR cannot read ValueError (both name it)."""
-    import OpenEXR
+    OpenEXR = _openexr("read_exr")
 
     p = os.fspath(path)
     if not os.path.isfile(p):

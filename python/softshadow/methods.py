@@ -45,8 +45,9 @@ def capabilities() -> dict[str, MethodInfo]:
 def limits() -> dict[str, Any]:
     """Limits that are not one method's: ``max_texels`` per map,
     ``max_extent`` (tangent half-extent), ``max_passes``, ``max_samples``
-    (``exact``), ``max_threads`` (``threads=``) and ``gpu_max_side`` (0
-    without a GPU backend)."""
+    (``exact``), ``max_threads`` (``threads=``), ``gpu_max_side`` (0
+    without a GPU backend) and ``max_emission`` (a light's ``radiance`` or
+    ``irradiance`` per channel: the largest float32)."""
     return dict(_core.limits())
 
 

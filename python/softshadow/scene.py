@@ -79,7 +79,9 @@ class Scene:
         if meshes is not None and (occluders is not None or receivers is not None):
             raise TypeError("meshes: pass either meshes or occluders and receivers, not both")
         if meshes is None and (occluders is None or receivers is None):
-            raise TypeError("Scene: pass meshes=[...] (every mesh casts and receives) or both occluders and receivers")
+            raise TypeError(
+                "meshes: pass meshes=[...] (every mesh casts and receives), or both occluders and receivers"
+            )
         self.split = meshes is None
         if self.split:
             self.occluders: list[Mesh] = self._meshes(occluders, "occluders")
@@ -124,11 +126,13 @@ class Scene:
         mesh instanced by several nodes appears once per node), a
         ``trimesh.Trimesh``, or a path trimesh can load. Geometry without
         faces (paths, point clouds) is skipped; a scene with no triangles
-        raises ValueError."""
+        raises ValueError; without trimesh, MissingExtraError naming the
+        ``io`` extra."""
         import os
 
-        import trimesh
+        from ._extras import require
 
+        trimesh = require("trimesh", "io", "Scene.from_trimesh")
         if isinstance(obj, (str, os.PathLike)):
             obj = trimesh.load(os.fspath(obj))
         if isinstance(obj, trimesh.Trimesh):

@@ -6,7 +6,7 @@
 
 use super::call::EyeCall;
 use super::gbuffer::{GBuffer, SceneTriangles};
-use super::{casters, focus, maps, tangent_plane};
+use super::{casters, focus, gather_budget, maps, tangent_plane};
 use crate::backend::Backend;
 use crate::error::Result;
 use crate::geom::light::MapGrid;
@@ -245,15 +245,34 @@ pub fn map_grid(
         Some((w, h)) => (w as usize, h as usize),
         None => fitted,
     };
+    let (grid, method) = grid_at(call, resolution, extent, backend)?;
+    let scene = gather_budget::Scene {
+        pts_ls: &f.pts_ls,
+        unit: f.unit,
+        light_shape: f.light_shape,
+        verts: &f.verts,
+    };
+    gather_budget::within_budget(call, scene, faces, (grid, method), |r| {
+        grid_at(call, r, extent, backend)
+    })
+}
+
+/// The config resolved for `backend` at `resolution` and its occluder grid
+/// over `extent`: the eye view has occluder maps only, at the resolved
+/// config's occluder resolution (`resolution` unless the config sets one;
+/// "auto"'s rule takes a quarter of it).
+fn grid_at(
+    call: &EyeCall,
+    resolution: (usize, usize),
+    extent: [f64; 2],
+    backend: Backend,
+) -> Result<(MapGrid, MethodConfig)> {
     let method = call.method.resolve(&CallContext {
         backend,
         resolution,
         depth_layers: None,
         eye: true,
     })?;
-    // The eye view has occluder maps only: the resolved config's
-    // occluder resolution (the fitted one unless the config sets it;
-    // "auto"'s rule takes a quarter of it).
     let (w, h) = method.occluder_resolution().unwrap_or(resolution);
     Ok((MapGrid::new(w, h, extent)?, method))
 }

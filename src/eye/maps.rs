@@ -270,6 +270,7 @@ pub(crate) fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
+    crate::methods::check_work(method, &inputs, Some(&sp.points))?;
     let mut v = match method {
         // Every mesh is an occluder: its silhouette straight from the mesh.
         Method::Smoothies { width, falloff } => crate::methods::smoothies::Smoothies {

@@ -26,6 +26,7 @@ mod casters;
 pub mod estimate;
 pub mod focus;
 pub mod framing;
+mod gather_budget;
 pub mod gbuffer;
 pub mod maps;
 pub mod prepared;

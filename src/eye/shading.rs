@@ -42,6 +42,13 @@ pub const DEFAULT_ALBEDO: f64 = 0.8;
 /// A light's radiance (rectangle) or irradiance (sun) when none is given.
 pub const DEFAULT_EMISSION: f64 = 1.0;
 
+/// The largest emission, per channel: the largest f32. The images are f32
+/// and no pixel exceeds its light's emission (`unshadowed` is albedo times
+/// the emission times the form factor, at most 1, for a rectangle, and
+/// times cos / π for the sun), so no finite input within it gives an
+/// infinite pixel.
+pub const MAX_EMISSION: f64 = f32::MAX as f64;
+
 /// A value as the user gave it: a number, or a sequence of values.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ColorValue {
@@ -101,12 +108,12 @@ pub fn emission(arg: &str, value: Option<&ColorValue>) -> Result<[f64; 3]> {
         None => [DEFAULT_EMISSION; 3],
         Some(v) => v.color(arg)?,
     };
-    if rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
+    if rgb.iter().all(|c| (0.0..=MAX_EMISSION).contains(c)) {
         Ok(rgb)
     } else {
         Err(Error::invalid(
             arg,
-            format!("must be finite and >= 0, got {rgb:?}"),
+            format!("must be in [0, {MAX_EMISSION:e}] (finite in the float32 images), got {rgb:?}"),
         ))
     }
 }
@@ -304,6 +311,8 @@ mod tests {
         assert_eq!(emission("radiance", None).unwrap(), [1.0; 3]);
         assert!(emission("radiance", Some(&num(-1.0))).is_err());
         assert!(emission("radiance", Some(&num(f64::NAN))).is_err());
+        assert!(emission("radiance", Some(&num(1e300))).is_err());
+        assert!(emission("radiance", Some(&num(MAX_EMISSION))).is_ok());
         assert!(emission("radiance", Some(&list(vec![num(1.0), num(2.0)]))).is_err());
         assert_eq!(albedo(None, 2).unwrap(), vec![[0.8; 3]; 2]);
         let rgb = list(vec![num(0.1), num(0.2), num(0.3)]);

@@ -140,6 +140,30 @@ pub(crate) struct Prepared {
     pub lookups: Vec<(usize, DVec3, [f32; 2])>,
 }
 
+/// Whether pixel `k` of `g` (a surface) gets no light at all: behind a
+/// rectangle's plane, or facing away from the light (`tw` its direction).
+fn unlit(light: &Light, tw: &Toward, g: &GBuffer, k: usize) -> bool {
+    let p = DVec3::from_array(g.position[k]);
+    let n = glam::Vec3::from_array(g.normal[k]).as_dvec3();
+    let in_front = match light {
+        Light::Rect(l) => (p - l.center).dot(l.n) > 0.0,
+        Light::Sun(_) => true,
+    };
+    !in_front || n.dot(tw.at(p)) <= 0.0
+}
+
+/// Sets back to 0 the pixels of `v` that get no light (`unlit`), after the
+/// eye-space blur (either backend's) has mixed their neighbours into them:
+/// they are 0 on every method.
+pub(crate) fn keep_unlit_dark(call: &EyeCall, g: &GBuffer, v: &mut [f32]) {
+    let tw = toward(call.light);
+    for k in g.hits() {
+        if unlit(call.light, &tw, g, k) {
+            v[k] = 0.0;
+        }
+    }
+}
+
 /// The stages before the map, on the CPU for both backends: `Err(v)` when
 /// there is no map to draw (nothing in front of the rectangle), `v` the
 /// image.
@@ -184,15 +208,10 @@ pub(crate) fn prepare(
         faces,
     );
     sw.lap("setup");
-    let in_front = |p: DVec3| match call.light {
-        Light::Rect(l) => (p - l.center).dot(l.n) > 0.0,
-        Light::Sun(_) => true,
-    };
     let mut lookups = Vec::with_capacity(hits.len());
     for &k in &hits {
         let p = DVec3::from_array(g.position[k]);
-        let n = glam::Vec3::from_array(g.normal[k]).as_dvec3();
-        if !in_front(p) || n.dot(tw.at(p)) <= 0.0 {
+        if unlit(call.light, &tw, g, k) {
             visibility[k] = 0.0;
         } else {
             lookups.push((k, p, [0.0; 2]));

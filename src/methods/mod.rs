@@ -250,6 +250,26 @@ pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
     }
 }
 
+/// Refuses, before any receiver is shaded, a call whose cost grows with a
+/// parameter rather than with what the answer needs: PCSS's texel reads
+/// (`Pcss::check_reads`), the gather kernels' visits
+/// (`gather::work::check_visits`; the eye view plans its fitted maps under
+/// that bound first, `eye::gather_budget`). `pts`: the receivers, or None
+/// for the receiver map's texels.
+pub fn check_work(
+    method: Method,
+    inputs: &ShadowInputs,
+    pts: Option<&[LightPoint]>,
+) -> crate::error::Result<()> {
+    match method {
+        Method::Pcss { max_taps } => pcss::Pcss { max_taps }.check_reads(inputs, pts),
+        Method::Ssm { .. } | Method::Bitmask { .. } => {
+            gather::work::check_visits(method, inputs, pts)
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Visibility at receiver points, as `shade_map`.
 pub fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -> Vec<f32> {
     if inputs.light_shape.is_point() && method.reads_input(Input::OccluderLayers) {

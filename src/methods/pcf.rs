@@ -144,6 +144,21 @@ impl Axis {
         axis
     }
 
+    /// How many texels `for_each` reads (with repeats): an upper bound on
+    /// its calls, what a box filter's cost is counted in.
+    pub(crate) fn reads(&self) -> usize {
+        let borders = usize::from(self.left > 0.0) + usize::from(self.right > 0.0);
+        let inside = if !(self.a < self.b) {
+            0
+        } else if self.taps == 0 {
+            self.i1 - self.i0 + 1
+        } else {
+            // A tap straddles two texels.
+            2 * self.taps as usize
+        };
+        borders + inside
+    }
+
     /// Calls `f(texel, weight)` for every weighted texel (a texel may come
     /// more than once in stratified mode). The weights sum to the fraction
     /// of the box inside the map (to 1 with the clamp border).

@@ -219,10 +219,15 @@ pub(crate) fn visibilities<R: RayOrigin>(
 ) -> Vec<f32> {
     debug_assert_eq!(order.len(), receivers.len());
     let light = s.rect(0, s.light.grid.0, 0, s.light.grid.1);
+    // A cancelled call's remaining packets are skipped (`crate::cancel`).
+    let stop = crate::cancel::current();
     let traced: Vec<Vec<(usize, f32)>> = order
         .par_chunks(CHUNK)
         .map(|chunk| {
             let mut out = Vec::with_capacity(chunk.len());
+            if stop.is_cancelled() {
+                return out;
+            }
             let mut pending: Vec<(u64, &R)> = Vec::with_capacity(chunk.len());
             let mut keys = Vec::with_capacity(chunk.len());
             for &k in chunk {
@@ -237,6 +242,9 @@ pub(crate) fn visibilities<R: RayOrigin>(
                 }
             }
             for (group, keys) in pending.chunks(LANES).zip(keys.chunks(LANES)) {
+                if stop.is_cancelled() {
+                    break;
+                }
                 let v = trace_packet(bvh, group, s);
                 out.extend(keys.iter().copied().zip(v));
             }

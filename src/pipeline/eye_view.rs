@@ -22,9 +22,11 @@ use crate::eye::framing::{
 use crate::eye::gbuffer::{GBuffer, SceneTriangles};
 use crate::eye::prepared::Found;
 use crate::eye::{shadow_mapping, CpuEye, EyeCall, EyeImage, EyeStages};
-use crate::memory::check_fits;
+use crate::geom::light::MapGrid;
+use crate::memory::{check_fits, map_bytes};
 use crate::methods::config::MAX_SAMPLES;
 use crate::methods::exact::Bvh;
+use crate::methods::shadow_mapping::config::DepthBias;
 use crate::methods::MethodConfig;
 use crate::timing::Stopwatch;
 use glam::Vec3;
@@ -97,12 +99,23 @@ pub fn render_with<S: EyeStages>(
     let start = Instant::now();
     let size = (call.camera.width, call.camera.height);
     if let MethodConfig::ShadowMapping(cfg) = call.method {
+        // The depth map, and the second-nearest one for the midpoint bias.
+        let (w, h) = cfg.resolution;
+        let maps = 1 + usize::from(cfg.bias == DepthBias::Midpoint);
+        check_fits(
+            "resolution",
+            &format!("a {w}x{h} shadow map"),
+            map_bytes(w.saturating_mul(h), maps),
+        )?;
         let method = resolve_at_camera(call, S::BACKEND)?;
         let mut sw = Stopwatch::new();
         let (scene, _) = scene_of(call)?;
         let g = stages.first_hits(call.camera, &scene)?;
         sw.lap("first_hits");
-        let visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
+        let mut visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
+        if cfg.blur.is_some() {
+            shadow_mapping::keep_unlit_dark(call, &g, &mut visibility);
+        }
         // The estimate frames the scene for its exact rays: every
         // triangle can shadow (ShadowMapping does not pick casters).
         let estimate = if let Some(how) = call.estimate_error {
@@ -145,6 +158,7 @@ pub fn render_with<S: EyeStages>(
     if !f.points.is_empty() {
         let casting = casting_faces(call, &scene, &f);
         let (grid, m) = map_grid(call, &g, &f, &casting, S::BACKEND)?;
+        check_maps_fit(call, &grid, &m)?;
         method = m;
         sw.lap("extent");
         // The estimate's rays meet the casters only: the other triangles
@@ -191,6 +205,34 @@ pub fn render_with<S: EyeStages>(
         },
         method,
     ))
+}
+
+/// Refuses, before any map is allocated, occluder maps of `grid` that
+/// `method` would keep more bytes of than are available: each layer and
+/// the kernel's own maps of it (its 1/depth copy, corners, the
+/// hierarchy's levels: `Method::kernel_maps_per_layer`, as the light view
+/// counts them in `frame/light_view.rs`), and the copy of each layer the
+/// image returns (an upper bound: at 4096², two layers, the process's peak
+/// grew by 8.4 maps' bytes for `ssm`'s 10 counted here, and by 13.5 for
+/// `bitmask`'s 34 with closed gaps). Named after the option
+/// that set the size: the config's `occluder_resolution` where the user
+/// gave one, else `map_resolution` (given, or fitted to the pixels).
+fn check_maps_fit(call: &EyeCall, grid: &MapGrid, method: &MethodConfig) -> Result<()> {
+    let layers = method.passes() as usize;
+    let per_layer = 2 + method.kernel().kernel_maps_per_layer();
+    let arg = if call.method.occluder_resolution().is_some() {
+        "occluder_resolution"
+    } else {
+        "map_resolution"
+    };
+    check_fits(
+        arg,
+        &format!(
+            "{}x{} occluder maps ({layers} layers)",
+            grid.width, grid.height
+        ),
+        map_bytes(grid.len(), per_layer * layers),
+    )
 }
 
 /// `exact`: shadow rays from each visible point (`EyeStages::trace`) through

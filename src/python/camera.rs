@@ -60,12 +60,17 @@ impl PyCamera {
     #[staticmethod]
     #[pyo3(signature = (*, eye, target, up, fov_y, resolution))]
     fn look_at(
-        eye: [f64; 3],
-        target: [f64; 3],
-        up: [f64; 3],
-        fov_y: f64,
+        eye: &Bound<'_, PyAny>,
+        target: &Bound<'_, PyAny>,
+        up: &Bound<'_, PyAny>,
+        fov_y: &Bound<'_, PyAny>,
         resolution: &Bound<'_, PyAny>,
     ) -> PyResult<Self> {
+        use super::convert::{float, vector};
+        // Each converted by name (pyo3's own `[f64; 3]` and `f64` errors
+        // named no argument).
+        let (eye, target) = (vector::<3>("eye", eye)?, vector::<3>("target", target)?);
+        let (up, fov_y) = (vector::<3>("up", up)?, float("fov_y", fov_y)?);
         let res = super::convert::resolution("resolution", resolution)?;
         errors::guard(|| Ok(PyCamera(Camera::look_at(eye, target, up, fov_y, res)?)))
     }

@@ -188,5 +188,6 @@ pub fn limits(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("max_samples", l.max_samples)?;
     d.set_item("max_threads", l.max_threads)?;
     d.set_item("gpu_max_side", l.gpu_max_side)?;
+    d.set_item("max_emission", crate::eye::shading::MAX_EMISSION)?;
     Ok(d)
 }

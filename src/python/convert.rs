@@ -1,6 +1,7 @@
 //! Python values to core values: types are checked here (TypeError naming
 //! the argument), values by the core (ValueError from its `Error`).
 
+use crate::backend::BackendChoice;
 use crate::geom::light::RectLight;
 use crate::geom::light_space::{Light as CoreLight, LightSpace};
 use crate::geom::mesh::MeshRef;
@@ -126,6 +127,45 @@ pub fn opt_float(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<f64
     }
 }
 
+/// A float vector of length `N` as NumPy reads it (`np.asarray(value,
+/// float64)`): TypeError for what is not numbers, ValueError for another
+/// length, each naming `arg`; the core checks the values.
+pub fn vector<const N: usize>(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
+    if value.is_none() {
+        // (NumPy reads None as a NaN of shape ().)
+        return Err(PyTypeError::new_err(format!(
+            "{arg}: must be a sequence of {N} numbers, got None"
+        )));
+    }
+    let py = value.py();
+    let np = py.import("numpy")?;
+    let a = np
+        .call_method1("asarray", (value, "float64"))
+        .map_err(|_| {
+            let got = value.repr().map(|r| r.to_string()).unwrap_or_default();
+            PyTypeError::new_err(format!(
+                "{arg}: must be a sequence of {N} numbers, got {got}"
+            ))
+        })?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    if shape != [N] {
+        let shape = PyTuple::new(py, &shape)?.repr()?.to_string();
+        return Err(PyValueError::new_err(format!(
+            "{arg}: must have {N} components, got shape {shape}"
+        )));
+    }
+    let v: Vec<f64> = a.call_method0("tolist")?.extract()?;
+    Ok(std::array::from_fn(|k| v[k]))
+}
+
+/// A real number (int or float, not bool): TypeError naming `arg` for
+/// anything else, None included.
+pub fn float(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
+    opt_float(arg, Some(v))?.ok_or_else(|| {
+        PyTypeError::new_err(format!("{arg}: must be a number, got {}", type_name(v)))
+    })
+}
+
 /// A str.
 pub fn string(arg: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
     v.extract::<String>()
@@ -136,6 +176,30 @@ pub fn opt_string(arg: &str, v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<St
     v.filter(|v| !v.is_none())
         .map(|v| string(arg, v))
         .transpose()
+}
+
+/// `backend=`: a str naming a backend. A custom extraction so that a
+/// wrong type is refused by the argument's name (pyo3's own message for a
+/// `&str` names neither the argument nor the choices).
+pub struct Backend(pub BackendChoice);
+
+impl Backend {
+    /// The signatures' default.
+    pub const CPU: Backend = Backend(BackendChoice::Cpu);
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Backend {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let name = obj.extract::<String>().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "backend: must be a str (\"cpu\", \"gpu\" or \"auto\"), got {}",
+                type_name(&obj)
+            ))
+        })?;
+        Ok(Backend(BackendChoice::parse(&name)?))
+    }
 }
 
 /// A resolution: an int (square) or a pair (W, H) of ints.

@@ -2,11 +2,12 @@
 //! (`crate::backend`), wrap the result.
 
 use super::configs::{method_arg, Loose};
-use super::convert::{light_of, mesh, opt_int, same_shape, slice, space_of, triples, Light};
+use super::convert::{
+    light_of, mesh, opt_int, opt_string, same_shape, slice, space_of, triples, Backend, Light,
+};
 use super::errors;
 use super::results::{DepthShadowResult, MeshShadowResult};
 use crate::api::{self, DepthCall, MeshCall, SceneCall};
-use crate::backend::BackendChoice;
 use crate::error_estimate::Draw;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -42,7 +43,7 @@ pub fn check_mesh<'py>(
 
 /// Meshes -> light-view maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, resolution, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, estimate_error=None))]
+#[pyo3(signature = (occ_vertices, occ_faces, rec_vertices, rec_faces, light, resolution, extent, method, *, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend=Backend::CPU, threads=None, estimate_error=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn shadow_map_from_meshes<'py>(
     py: Python<'py>,
@@ -59,9 +60,9 @@ pub fn shadow_map_from_meshes<'py>(
     occluder_resolution: Option<Bound<'py, PyAny>>,
     hierarchy: Option<Bound<'py, PyAny>>,
     precision: Option<Bound<'py, PyAny>>,
-    backend: &str,
+    backend: Backend,
     threads: Option<Bound<'py, PyAny>>,
-    estimate_error: Option<&str>,
+    estimate_error: Option<Bound<'py, PyAny>>,
 ) -> PyResult<MeshShadowResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -79,11 +80,14 @@ pub fn shadow_map_from_meshes<'py>(
             resolution: super::convert::resolution("resolution", resolution)?,
             extent: extent.map(|e| [e.0, e.1]),
             method: method_arg(method, &loose)?,
-            backend: BackendChoice::parse(backend)?,
+            backend: backend.0,
             threads: opt_int("threads", threads.as_ref())?,
-            estimate_error: estimate_error.map(Draw::parse).transpose()?,
+            estimate_error: opt_string("estimate_error", estimate_error.as_ref())?
+                .as_deref()
+                .map(Draw::parse)
+                .transpose()?,
         };
-        let run = py.detach(|| api::shadow_map(&call))?;
+        let run = super::interrupt::run(py, || api::shadow_map(&call))?;
         MeshShadowResult::new(py, run)
     })
 }
@@ -91,7 +95,7 @@ pub fn shadow_map_from_meshes<'py>(
 /// A scene shadowing itself (one mesh of every mesh) -> light-view maps ->
 /// visibility.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, light, resolution, extent, method, *, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, estimate_error=None))]
+#[pyo3(signature = (vertices, faces, light, resolution, extent, method, *, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend=Backend::CPU, threads=None, estimate_error=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn shadow_map_from_scene<'py>(
     py: Python<'py>,
@@ -108,9 +112,9 @@ pub fn shadow_map_from_scene<'py>(
     occluder_resolution: Option<Bound<'py, PyAny>>,
     hierarchy: Option<Bound<'py, PyAny>>,
     precision: Option<Bound<'py, PyAny>>,
-    backend: &str,
+    backend: Backend,
     threads: Option<Bound<'py, PyAny>>,
-    estimate_error: Option<&str>,
+    estimate_error: Option<Bound<'py, PyAny>>,
 ) -> PyResult<MeshShadowResult> {
     errors::guard(|| {
         let light = light_of(light)?;
@@ -128,18 +132,21 @@ pub fn shadow_map_from_scene<'py>(
             extent: extent.map(|e| [e.0, e.1]),
             method: method_arg(method, &loose)?,
             bias: crate::eye::Bias::new(normal_offset, depth_bias)?,
-            backend: BackendChoice::parse(backend)?,
+            backend: backend.0,
             threads: opt_int("threads", threads.as_ref())?,
-            estimate_error: estimate_error.map(Draw::parse).transpose()?,
+            estimate_error: opt_string("estimate_error", estimate_error.as_ref())?
+                .as_deref()
+                .map(Draw::parse)
+                .transpose()?,
         };
-        let run = py.detach(|| api::scene_shadow_map(&call))?;
+        let run = super::interrupt::run(py, || api::scene_shadow_map(&call))?;
         MeshShadowResult::new(py, run)
     })
 }
 
 /// Depth maps -> visibility.
 #[pyfunction]
-#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, *, angular_size=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None))]
+#[pyo3(signature = (occluder_depth, occluder_depth_back, receiver_depth, light_size, extent, method, *, angular_size=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend=Backend::CPU, threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn shadow_map_from_depth<'py>(
     py: Python<'py>,
@@ -155,7 +162,7 @@ pub fn shadow_map_from_depth<'py>(
     occluder_resolution: Option<Bound<'py, PyAny>>,
     hierarchy: Option<Bound<'py, PyAny>>,
     precision: Option<Bound<'py, PyAny>>,
-    backend: &str,
+    backend: Backend,
     threads: Option<Bound<'py, PyAny>>,
 ) -> PyResult<DepthShadowResult> {
     errors::guard(|| {
@@ -197,10 +204,10 @@ pub fn shadow_map_from_depth<'py>(
             },
             receiver: slice("receiver_depth", &receiver_depth)?,
             method,
-            backend: BackendChoice::parse(backend)?,
+            backend: backend.0,
             threads: opt_int("threads", threads.as_ref())?,
         };
-        let run = py.detach(|| api::shadow_map_from_depth(&call))?;
+        let run = super::interrupt::run(py, || api::shadow_map_from_depth(&call))?;
         DepthShadowResult::new(py, &grid, run)
     })
 }

@@ -1,7 +1,7 @@
 //! The one place where core errors (and panics) become Python exceptions.
 
 use crate::error::Error;
-use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
@@ -51,6 +51,9 @@ impl From<Error> for PyErr {
         match e {
             Error::GpuUnavailable { .. } => GpuUnavailableError::new_err(msg),
             Error::Gpu { .. } => PyRuntimeError::new_err(msg),
+            // A cancelled token whose reason never reached Python (the
+            // bindings raise the interpreter's own KeyboardInterrupt).
+            Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
             // About an argument's value; the message starts with its name.
             Error::InvalidArgument { .. } | Error::ShapeMismatch { .. } => {
                 PyValueError::new_err(msg)

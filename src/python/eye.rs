@@ -5,12 +5,13 @@
 
 use super::camera::PyCamera;
 use super::configs::{self, method_arg, Loose};
-use super::convert::{light_of, mesh, opt_float, opt_int, opt_resolution, triples, Light};
+use super::convert::{
+    light_of, mesh, opt_float, opt_int, opt_resolution, opt_string, triples, Backend, Light,
+};
 use super::errors;
 use super::prepared::PyPrepared;
 use super::results::{map, sun_depth};
 use crate::api::Run;
-use crate::backend::BackendChoice;
 use crate::error_estimate::Draw;
 use crate::eye::shading::{self, ColorValue};
 use crate::eye::{Bias, EyeCall, EyeImage, Lighting, Shaded};
@@ -96,7 +97,7 @@ pub fn irradiance<'py>(
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.
 #[pyfunction]
-#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend="cpu", threads=None, emission=None, albedo=None, estimate_error=None, prepared=None))]
+#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend=Backend::CPU, threads=None, emission=None, albedo=None, estimate_error=None, prepared=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -112,11 +113,11 @@ pub fn render<'py>(
     occluder_resolution: Option<Bound<'py, PyAny>>,
     hierarchy: Option<Bound<'py, PyAny>>,
     precision: Option<Bound<'py, PyAny>>,
-    backend: &str,
+    backend: Backend,
     threads: Option<Bound<'py, PyAny>>,
     emission: Option<Bound<'py, PyAny>>,
     albedo: Option<Bound<'py, PyAny>>,
-    estimate_error: Option<&str>,
+    estimate_error: Option<Bound<'py, PyAny>>,
     prepared: Option<Bound<'py, PyPrepared>>,
 ) -> PyResult<EyeResult> {
     errors::guard(|| {
@@ -140,9 +141,12 @@ pub fn render<'py>(
             method: method_arg(method, &loose)?,
             map_resolution: opt_resolution("map_resolution", map_resolution.as_ref())?,
             bias: Bias::new(normal_offset, depth_bias)?,
-            backend: BackendChoice::parse(backend)?,
+            backend: backend.0,
             threads: opt_int("threads", threads.as_ref())?,
-            estimate_error: estimate_error.map(Draw::parse).transpose()?,
+            estimate_error: opt_string("estimate_error", estimate_error.as_ref())?
+                .as_deref()
+                .map(Draw::parse)
+                .transpose()?,
             prepared: prepared.as_ref().map(|p| &p.get().0),
         };
         let arg = shading::emission_arg(&light);
@@ -152,7 +156,8 @@ pub fn render<'py>(
             opt_color("albedo", albedo.as_ref())?.as_ref(),
             refs.len(),
         )?;
-        let (run, shaded) = py.detach(|| crate::api::render_shaded(&call, &lighting))?;
+        let (run, shaded) =
+            super::interrupt::run(py, || crate::api::render_shaded(&call, &lighting))?;
         EyeResult::new(py, run, shaded)
     })
 }

@@ -9,6 +9,7 @@
 //! (on a surface facing it). Only the eye view's shaded images read it;
 //! visibility never does.
 
+use super::convert::vector;
 use super::convert::Light;
 use super::errors;
 use super::eye::{irradiance, light_emission};
@@ -19,31 +20,6 @@ use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-
-/// A float vector of length `N` as NumPy reads it (`np.asarray(value,
-/// float64)`): TypeError for what is not numbers, ValueError for another
-/// length, each naming `arg`; the core checks the values.
-fn vector<const N: usize>(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
-    let py = value.py();
-    let np = py.import("numpy")?;
-    let a = np
-        .call_method1("asarray", (value, "float64"))
-        .map_err(|_| {
-            let got = value.repr().map(|r| r.to_string()).unwrap_or_default();
-            PyTypeError::new_err(format!(
-                "{arg}: must be a sequence of {N} numbers, got {got}"
-            ))
-        })?;
-    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
-    if shape != [N] {
-        let shape = PyTuple::new(py, &shape)?.repr()?.to_string();
-        return Err(PyValueError::new_err(format!(
-            "{arg}: must have {N} components, got shape {shape}"
-        )));
-    }
-    let v: Vec<f64> = a.call_method0("tolist")?.extract()?;
-    Ok(std::array::from_fn(|k| v[k]))
-}
 
 /// A number (both components) or a pair of numbers.
 fn pair(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; 2]> {

@@ -30,6 +30,7 @@ mod errors;
 mod estimate;
 mod eye;
 mod gpu;
+mod interrupt;
 mod keyword_class;
 mod lights;
 mod prepared;

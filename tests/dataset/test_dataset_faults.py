@@ -158,7 +158,7 @@ def test_a_full_or_forbidden_disk_stops_the_run_and_nothing_half_written_counts(
     out = tmp_path / "out"
     with pytest.raises(StorageError, match=os.strerror(code)) as info:
         run(spec, out, retries=5, progress=False)
-    assert "rerun to resume" in str(info.value) and "2 items" in str(info.value)
+    assert "rerun the same command to resume" in str(info.value) and "2 items" in str(info.value)
     assert len(writes) == 3  # no retry against a full disk
     report = check_output(str(out))
     assert report.complete == [0, 1] and report.missing == [2, 3, 4, 5] and not report.broken

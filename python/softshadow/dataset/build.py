@@ -7,6 +7,11 @@ and tube radius 0.15, or a mesh file read by trimesh); each process caches
 them. Mesh order in the scene: the instances in the record's order, then
 the ground, so an image's ``mesh_id`` indexes the record's ``objects`` (the
 ground is the last id).
+
+A mesh file the reader refuses raises :class:`MeshError` naming the file
+and the reader's complaint (trimesh's own messages, "Not a ply file!",
+often do not): the spec's loading reads every file once this way
+(:func:`check_mesh_file`), so a broken one is refused before any item.
 """
 
 from __future__ import annotations
@@ -17,9 +22,15 @@ from typing import Any
 
 import numpy as np
 
+from .._extras import require
 from ..lights import DirectionalLight, RectLight
 from ..scene import Camera, Mesh, Scene
 from ..scenes.primitives import box, bunny_mesh, quad, sphere, torus
+
+
+class MeshError(ValueError):
+    """A mesh file that cannot be used; the message names it and why. Not
+    retried (:mod:`.book`): a broken input file stays broken."""
 
 
 @functools.lru_cache(maxsize=64)
@@ -40,7 +51,7 @@ def base_mesh(kind: str, path: str | None = None) -> Mesh:
     lo, hi = v.min(axis=0), v.max(axis=0)
     side = float((hi - lo).max())
     if not np.isfinite(side) or side <= 0.0:
-        raise ValueError(f"{path or kind}: the mesh has no extent")
+        raise (MeshError if path else ValueError)(f"{path or kind}: the mesh has no finite, non-zero extent")
     v = (v - 0.5 * (lo + hi)) / side
     v.setflags(write=False)
     f = np.ascontiguousarray(f, dtype=np.uint32)
@@ -49,12 +60,22 @@ def base_mesh(kind: str, path: str | None = None) -> Mesh:
 
 
 def _read_mesh(path: str) -> Mesh:
-    import trimesh
-
-    loaded = trimesh.load(path, force="mesh")
+    trimesh = require("trimesh", "dataset", 'an object of kind = "mesh"')
+    try:
+        loaded = trimesh.load(path, force="mesh")
+    except Exception as e:  # trimesh's readers raise anything: ValueError, IndexError, KeyError, ...
+        raise MeshError(f"{path}: trimesh cannot read it ({type(e).__name__}: {e})") from e
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
-        raise ValueError(f"{path}: trimesh found no triangles")
-    return np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces)
+        raise MeshError(f"{path}: trimesh found no triangles")
+    v, f = np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces)
+    if f.size and (f.min() < 0 or f.max() >= len(v)):
+        raise MeshError(f"{path}: a face indexes vertex {int(f.max())} of {len(v)}")
+    return v, f
+
+
+def check_mesh_file(path: str) -> None:
+    """Reads and normalizes a mesh file as an item would (cached); MeshError if it cannot be used."""
+    base_mesh("mesh", path)
 
 
 def _rotation(axis: np.ndarray, degrees: float) -> np.ndarray:

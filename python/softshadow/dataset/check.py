@@ -6,21 +6,30 @@ absent, its sha256 differs from the manifest's, or it does not open: the
 EXR must read with OpenEXR and hold the expected channels at the
 resolution in ``dataset.json``, the JSON record must parse and name the
 item's k, seed and spec hash, a PNG must start with the PNG signature.
+
+Only item k's own files are read (``items/00000/00000042.exr`` and its
+siblings), never through a link: a manifest entry naming another path
+(``../../x``) or a file that is a link is reported broken, not opened.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import stat
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from .. import io as ssio
+from .._extras import require
 from . import limits as L
-from .files import TMP_MARK, sha256_file
+from .files import TMP_MARK, file_inside, open_nofollow, sha256_file
 from .manifest import read_dataset, read_manifest
+
+SUFFIXES = (".exr", ".json", ".maps.exr", ".png", ".shaded.png")
+"""The files an item may have, after its base name."""
 
 
 @dataclass
@@ -51,16 +60,41 @@ def check_item(out: str, info: dict[str, Any], k: int, rec: dict[str, Any], *, h
     for role in ("exr", "json"):
         if base + "." + role not in files:
             return f"the manifest lacks its .{role} file"
+    for rel in files:
+        if not isinstance(rel, str) or rel not in {base + s for s in SUFFIXES}:
+            escapes = not isinstance(rel, str) or os.path.isabs(rel) or ".." in rel.replace("\\", "/").split("/")
+            where = "leads outside --out" if escapes else f"is not one of item {k}'s files"
+            return f"the manifest lists {rel!r}, which {where}; not read"
     for rel, digest in files.items():
-        path = os.path.join(out, rel)
-        if not os.path.isfile(path):
+        try:
+            path = file_inside(out, rel)
+        except ValueError:
+            return f"{rel}: its folder leads outside --out (a link); not read"
+        try:
+            mode = os.lstat(path).st_mode
+        except FileNotFoundError:
             return f"{rel}: missing"
-        if hashes and sha256_file(path) != digest:
-            return f"{rel}: sha256 differs from the manifest's"
+        except OSError as e:
+            return f"{rel}: cannot read it ({e.strerror or e})"
+        if stat.S_ISLNK(mode):
+            return f"{rel}: is a symbolic link (a link in --out is never read: it could lead outside)"
+        if not stat.S_ISREG(mode):
+            return f"{rel}: not a regular file"
+        try:
+            if hashes and sha256_file(path, follow=False) != digest:
+                return f"{rel}: sha256 differs from the manifest's"
+        except OSError as e:
+            return f"{rel}: cannot read it ({e.strerror or e})"
         problem = _opens(path, rel, info, k)
         if problem:
             return f"{rel}: {problem}"
     return None
+
+
+def _read_bytes(path: str, most: int) -> bytes:
+    """Up to ``most`` bytes of a file, not through a link."""
+    with open(open_nofollow(path, os.O_RDONLY), "rb") as f:
+        return f.read(most)
 
 
 def _opens(path: str, rel: str, info: dict[str, Any], k: int) -> str | None:
@@ -84,8 +118,7 @@ def _opens(path: str, rel: str, info: dict[str, Any], k: int) -> str | None:
         return None
     if rel.endswith(".json"):
         try:
-            with open(path, encoding="utf-8") as f:
-                record = json.load(f)
+            record = json.loads(_read_bytes(path, 1 << 24).decode("utf-8"))
         except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
             return f"does not open as JSON ({e})"
         if not isinstance(record, dict):
@@ -95,15 +128,18 @@ def _opens(path: str, rel: str, info: dict[str, Any], k: int) -> str | None:
                 return f"record's {key} is {record.get(key)!r}, expected {want!r}"
         return None
     if rel.endswith(".png"):
-        with open(path, "rb") as f:
-            if f.read(8) != b"\x89PNG\r\n\x1a\n":
+        try:
+            if _read_bytes(path, 8) != b"\x89PNG\r\n\x1a\n":
                 return "not a PNG file"
+        except OSError as e:
+            return f"cannot read it ({e.strerror or e})"
         return None
     return None
 
 
 def check_output(out: str, *, hashes: bool = True) -> CheckReport:
     """Checks every item of the dataset in ``out`` (see the module's docstring)."""
+    require("OpenEXR", "dataset", "softshadow-dataset check (it opens every item's EXR)")
     info = read_dataset(out)
     records = read_manifest(out)
     report = CheckReport(count=int(info["count"]))
@@ -120,12 +156,19 @@ def check_output(out: str, *, hashes: bool = True) -> CheckReport:
         else:
             report.broken[k] = problem
     folder = os.path.join(out, info["folder"])
-    if os.path.isdir(folder):
+    if _real_folder(folder):  # a link's folder is not listed: it may lie outside --out
         for sub in sorted(os.listdir(folder)):
             d = os.path.join(folder, sub)
-            if os.path.isdir(d):
+            if _real_folder(d):
                 report.temporaries += [f"{info['folder']}/{sub}/{n}" for n in sorted(os.listdir(d)) if TMP_MARK in n]
     return report
+
+
+def _real_folder(path: str) -> bool:
+    try:
+        return stat.S_ISDIR(os.lstat(path).st_mode)
+    except OSError:
+        return False
 
 
 def ranges(ks: list[int]) -> str:

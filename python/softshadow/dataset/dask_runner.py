@@ -17,6 +17,7 @@ import uuid
 from collections import deque
 from typing import Any
 
+from .._extras import require
 from .book import Book, default_threads
 from .item import make_item
 from .spec import Spec
@@ -25,7 +26,8 @@ from .spec import Spec
 def run_dask(
     book: Book, spec: Spec, out: str, todo: list[int], dask: Any, workers: int, threads: int | None, window: int | None
 ) -> str:
-    from distributed import Client, LocalCluster, as_completed
+    distributed = require("distributed", "dataset", "handing items to Dask (dask=, --dask)")
+    Client, LocalCluster, as_completed = distributed.Client, distributed.LocalCluster, distributed.as_completed
 
     own: list[Any] = []
     if isinstance(dask, Client):

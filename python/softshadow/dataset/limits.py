@@ -1,9 +1,11 @@
 """The limits a dataset spec and a run must respect, in one place.
 
 A spec that exceeds one is refused on load, before any work, with the field
-named (docs/dataset.md lists them). They bound what a hostile or mistyped
-spec can make the machine do: allocate absurd images, loop for ever, or
-write outside ``--out``.
+named; a command-line argument out of its range is refused by the parser
+(exit code 2) naming the argument, and :func:`.runner.run` refuses the same
+values (docs/dataset.md lists them). They bound what a hostile or mistyped
+spec or command can make the machine do: allocate absurd images, loop for
+ever, or write outside ``--out``.
 """
 
 from __future__ import annotations
@@ -30,6 +32,11 @@ MAX_RETRIES = 100
 """``--retries``."""
 MAX_WORKERS = 1024
 """``--workers``."""
+MAX_THREADS = 1024
+"""``--threads``: the core's own bound on ``threads=`` (``softshadow.limits()["max_threads"]``)."""
+MAX_WINDOW = 100_000
+"""``--window``: tasks in flight at once. More only loads the scheduler (the
+default is 2 per worker thread, so this serves 50 000 threads)."""
 MAX_NAME = 64
 """Characters of ``outputs.folder``."""
 

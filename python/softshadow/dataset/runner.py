@@ -12,14 +12,18 @@ on any worker, then records it as failed and goes on (the accounting,
 dies costs only the items it held: they are handed out again (the local
 pool is rebuilt; Dask's scheduler reschedules by itself). Errors of the
 output's storage (full disk, read-only or forbidden folder) stop the run:
-every further item would fail the same way.
+every further item would fail the same way. Local worker processes die
+with the run (:mod:`.lifeline`), however it dies.
+
+Before any work: every argument is checked against its range
+(:mod:`.limits`), and the optional packages the run will use are imported
+(a missing one is named with its extra, :mod:`softshadow._extras`).
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
-import sys
 import time
 from collections import deque
 from collections.abc import Iterable
@@ -27,15 +31,18 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
+from .._extras import require
 from . import limits as L
 from .book import STORAGE_ERRNOS as STORAGE_ERRNOS  # re-exported, as before the move
 from .book import Book, Summary, default_threads
 from .book import storage_problem as storage_problem
 from .check import check_item
 from .dask_runner import run_dask
-from .files import sweep_temporaries
+from .files import regular_file, sweep_temporaries
 from .item import item_files, make_item
+from .lifeline import die_with_parent
 from .manifest import Output, read_dataset, read_manifest
+from .progress import progress_bar
 from .spec import Spec
 
 
@@ -61,7 +68,7 @@ def _item_folders(output: Output) -> list[str]:
     folder = os.path.join(output.root, output.spec.outputs.folder)
     try:
         return [os.path.join(folder, d) for d in os.listdir(folder)]
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):
         return []
 
 
@@ -76,10 +83,28 @@ def complete_items(out: str, spec: Spec, *, verify: bool) -> set[int]:
             if check_item(out, info, k, rec) is None:
                 done.add(k)
         elif set(rec.get("files", {})) == set(item_files(spec, k).values()) and all(
-            os.path.isfile(os.path.join(out, rel)) for rel in rec["files"]
+            regular_file(os.path.join(out, rel))
+            for rel in rec["files"]  # a link is not an item's file
         ):
             done.add(k)
     return done
+
+
+def _check_arguments(**values: int | None) -> None:
+    """ValueError naming the first argument out of its range (None: the default)."""
+    bounds = {
+        "count": (1, L.MAX_COUNT),
+        "workers": (1, L.MAX_WORKERS),
+        "retries": (0, L.MAX_RETRIES),
+        "threads": (1, L.MAX_THREADS),
+        "window": (1, L.MAX_WINDOW),
+    }
+    for name, value in values.items():
+        lo, hi = bounds[name]
+        if value is None and name in ("threads", "window"):
+            continue
+        if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+            raise ValueError(f"{name}: must be an integer in [{lo}, {hi}], got {value!r}")
 
 
 def run(
@@ -103,29 +128,28 @@ def run(
     ``threads``: the core's threads per item (default: the cores divided
     among the local workers; 1 per Dask task on a cluster you give).
     Raises StorageError when the folder cannot take files, OutputError or
-    SpecError when it cannot be used at all.
+    SpecError when it cannot be used at all, ValueError naming an argument
+    out of its range, MissingExtraError naming the extra of a missing
+    optional package (tqdm only with ``progress``), all before any work.
     """
     count = spec.count if count is None else count
-    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= L.MAX_COUNT:
-        raise ValueError(f"count: must be an integer in [1, {L.MAX_COUNT}], got {count!r}")
-    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= L.MAX_WORKERS:
-        raise ValueError(f"workers: must be an integer in [1, {L.MAX_WORKERS}], got {workers!r}")
-    if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= L.MAX_RETRIES:
-        raise ValueError(f"retries: must be an integer in [0, {L.MAX_RETRIES}], got {retries!r}")
-    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
-        raise ValueError(f"threads: must be a positive integer, got {threads!r}")
+    _check_arguments(count=count, workers=workers, retries=retries, threads=threads, window=window)
     wanted = list(range(count)) if items is None else sorted(set(items))
     if wanted and not 0 <= wanted[0] <= wanted[-1] < count:
         raise ValueError(f"items: must lie within 0..{count - 1}")
-    from tqdm import tqdm  # type: ignore[import-untyped]
+    require("OpenEXR", "dataset", "writing the items' EXR files")
+    if dask is not None:
+        require("distributed", "dataset", "handing items to Dask (dask=, --dask)")
+    new_bar = progress_bar(shown=progress)
 
     with Output(os.fspath(out), spec, count) as output:
         sweep_temporaries(_item_folders(output))  # the lock is ours: no writer is running
-        done = complete_items(output.root, spec, verify=verify)
+        # Without dataset.json (deleted after damage) the manifest's items may be another spec's: re-check them.
+        done = complete_items(output.root, spec, verify=verify or output.recovered)
         todo = [k for k in wanted if k not in done]
         summary = Summary(skipped=len(wanted) - len(todo))
         t0 = time.perf_counter()
-        with tqdm(total=len(todo), unit="item", desc="items", disable=not progress, file=sys.stderr) as bar:
+        with new_bar(len(todo)) as bar:
             book = Book(output, retries, bar, summary)
             try:
                 if dask is not None:
@@ -154,6 +178,7 @@ def _run_serial(book: Book, spec: Spec, out: str, todo: list[int], threads: int 
 
 def _init_worker(threads: int) -> None:
     os.environ["SOFTSHADOW_THREADS"] = str(threads)
+    die_with_parent()  # no orphan left working when the run is killed
 
 
 def _run_pool(

@@ -20,19 +20,18 @@ import inspect
 import json
 import os
 import re
+import stat
 import sys
 from dataclasses import asdict, dataclass, field
+from types import ModuleType
 from typing import Any
 
+from .._extras import require
 from ..io import exr_compression
 from . import limits as L
+from .build import MeshError, check_mesh_file
 from .fields import IntRange, Range, SpecError, Table
 from .files import sha256_file
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib  # type: ignore[import-not-found]
 
 Color = tuple[Range, Range, Range]
 
@@ -47,7 +46,8 @@ MESH_EXTENSIONS = {".obj", ".ply", ".stl", ".off", ".glb", ".gltf", ".dae", ".3m
 REFERENCE = "reference"
 RESERVED_NAMES = {"spec.toml", "dataset.json", "manifest.jsonl", "lock"}
 """The files of ``--out`` itself, which ``outputs.folder`` may not be."""
-_FOLDER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
+FOLDER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
+"""What ``outputs.folder`` may be: one plain name (also checked in ``dataset.json``)."""
 
 
 @dataclass(frozen=True)
@@ -183,8 +183,19 @@ def shading_available() -> bool:
     return "albedo" in inspect.signature(ss.render).parameters
 
 
+def _toml() -> ModuleType:
+    """tomllib (Python 3.11+) or tomli, the ``dataset`` extra's backport for 3.10."""
+    if sys.version_info >= (3, 11):
+        try:
+            return require("tomllib", "dataset", "reading a spec (TOML)")
+        except ImportError:
+            pass  # a stripped Python: the backport does as well
+    return require("tomli", "dataset", "reading a spec (TOML)")
+
+
 def load_spec(path: str | os.PathLike[str]) -> Spec:
     """Reads and validates a spec file; raises :class:`SpecError` naming the field."""
+    tomllib = _toml()
     p = os.path.abspath(os.fspath(path))
     try:
         with open(p, "rb") as f:
@@ -308,26 +319,64 @@ def _most_instances(o: ObjectSpec) -> int:
     return o.grid[0] * o.grid[1] if o.layout == "grid" else o.count[1]
 
 
+def _file_kind(mode: int) -> str:
+    for test, kind in (
+        (stat.S_ISDIR, "folder"),
+        (stat.S_ISCHR, "character device"),
+        (stat.S_ISBLK, "block device"),
+        (stat.S_ISFIFO, "FIFO"),
+        (stat.S_ISSOCK, "socket"),
+    ):
+        if test(mode):
+            return kind
+    return "special file"
+
+
 def _mesh_files(name: str, path: str, folder: str) -> tuple[str, ...]:
+    """The mesh files of ``path`` (a file or a folder of them), each read once
+    (:func:`.build.check_mesh_file`): a file that cannot be used is refused
+    now, naming it, rather than failing every item that draws it. Only
+    regular files: reading a device (``/dev/zero``) or a FIFO would never end."""
     if not path or "\x00" in path:
         raise SpecError(f"{name}: must be a mesh file or a folder of them, got {path!r}")
     full = os.path.normpath(os.path.join(folder, os.path.expanduser(path)))
-    if os.path.isfile(full):
+    try:
+        mode = os.stat(full).st_mode
+    except FileNotFoundError:
+        where = f"relative paths start at the spec's folder {folder!r}"
+        raise SpecError(f"{name}: no such file or folder {path!r} ({where})") from None
+    except OSError as e:
+        raise SpecError(f"{name}: cannot read {path!r}: {e.strerror or e}") from None
+    if stat.S_ISREG(mode):
         if os.path.splitext(full)[1].lower() not in MESH_EXTENSIONS:
             raise SpecError(f"{name}: {path!r} is not a mesh file; allowed extensions: {sorted(MESH_EXTENSIONS)}")
-        return (full,)
-    if os.path.isdir(full):
+        found = [full]
+    elif stat.S_ISDIR(mode):
         found = []
         for entry in sorted(os.listdir(full)):
+            if os.path.splitext(entry)[1].lower() not in MESH_EXTENSIONS:
+                continue
             f = os.path.join(full, entry)
-            if os.path.splitext(entry)[1].lower() in MESH_EXTENSIONS and os.path.isfile(f):
-                found.append(f)
-                if len(found) > L.MAX_MESH_FILES:
-                    raise SpecError(f"{name}: {path!r} holds more than {L.MAX_MESH_FILES} mesh files")
+            try:
+                entry_mode = os.stat(f).st_mode
+            except OSError as e:
+                raise SpecError(f"{name}: {entry!r} in folder {path!r} cannot be read: {e.strerror or e}") from None
+            if not stat.S_ISREG(entry_mode):
+                kind = _file_kind(entry_mode)
+                raise SpecError(f"{name}: {entry!r} in folder {path!r} is a {kind}, not a regular file")
+            found.append(f)
+            if len(found) > L.MAX_MESH_FILES:
+                raise SpecError(f"{name}: {path!r} holds more than {L.MAX_MESH_FILES} mesh files")
         if not found:
             raise SpecError(f"{name}: folder {path!r} holds no mesh file ({sorted(MESH_EXTENSIONS)})")
-        return tuple(found)
-    raise SpecError(f"{name}: no such file or folder {path!r} (relative paths start at the spec's folder {folder!r})")
+    else:
+        raise SpecError(f"{name}: {path!r} is a {_file_kind(mode)}, not a regular file or a folder of mesh files")
+    for f in found:
+        try:
+            check_mesh_file(f)
+        except MeshError as e:
+            raise SpecError(f"{name}: {e}") from None
+    return tuple(found)
 
 
 def _light(t: Table) -> LightSpec:
@@ -491,7 +540,7 @@ def _outputs(t: Table, method: MethodSpec) -> OutputSpec:
     if light_maps and (method.name in ("exact", REFERENCE)):
         raise t.fail("light_maps", f"method {method.name!r} makes no light-view maps")
     folder = t.string("folder", "items")
-    if len(folder) > L.MAX_NAME or not _FOLDER_NAME.match(folder) or folder in RESERVED_NAMES:
+    if len(folder) > L.MAX_NAME or not FOLDER_NAME.match(folder) or folder in RESERVED_NAMES:
         raise t.fail(
             "folder",
             f"must be one plain folder name inside --out (letters, digits, '_', '-', '.'; not starting with '.'; "

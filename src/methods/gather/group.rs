@@ -60,6 +60,9 @@ impl Kernel {
         let w = self.rec_width;
         let rows = receiver.len() / w;
         for c in (0..w).step_by(TILE_W) {
+            if self.stop.is_cancelled() {
+                return;
+            }
             let e = (c + TILE_W).min(w);
             let pts = (0..ROWS_PER_GROUP).flat_map(|r| {
                 (0..TILE_W).map(move |k| {
@@ -92,6 +95,9 @@ impl Kernel {
         out: &mut [f32],
     ) {
         for (o, p) in out.chunks_mut(LANES).zip(pts.chunks(LANES)) {
+            if self.stop.is_cancelled() {
+                return;
+            }
             if let Some(g) = Group::new(p.iter().map(|p| (p.x, p.y, p.z)), false) {
                 let v = self.shade_group(a, &g);
                 o.copy_from_slice(&v[..o.len()]);

@@ -264,6 +264,7 @@ impl Kernel {
             texel_per_d: (4.0 * (hw / lx).max(hh / ly)) as f32,
             max_on_light: 2.0 * hierarchy.map_or(0.0, |h| h.max_texel_on_light),
             plane_wr: None,
+            stop: crate::cancel::current(),
         }
     }
 

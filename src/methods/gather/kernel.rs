@@ -159,6 +159,9 @@ pub(super) struct Kernel {
     /// light), for which every layer holds its quads' corner reciprocals
     /// (`Layer::plane_invs`); None: none computed.
     pub(super) plane_wr: Option<f32>,
+    /// The call's cancellation (`crate::cancel`), read where the kernel is
+    /// made: a cancelled call's remaining groups are skipped.
+    pub(super) stop: crate::cancel::Token,
 }
 
 /// Up to LANES receivers shaded together. Inactive lanes (no receiver) have

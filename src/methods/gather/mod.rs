@@ -25,6 +25,7 @@ mod hierarchy;
 mod kernel;
 mod simd;
 mod traverse;
+pub mod work;
 
 pub use hierarchy::Hierarchy;
 use kernel::Kernel;

@@ -1,0 +1,142 @@
+//! Keeping a gather kernel's call (`ssm`, `bitmask`) within a bounded cost.
+//!
+//! The kernel's work is the receivers times the occluder texels each one's
+//! light can reach (`methods::gather::work`). Where the light is wide (a
+//! sun of tens of degrees and more) every receiver reaches the whole map,
+//! and the fitted map, whose texels follow the pixels' footprint, makes the
+//! work grow with the square of the pixels (a 179° sun: 0.08 s at 160x120,
+//! 0.94 s at 320x240, 12.7 s at 640x480). So wide a light casts only
+//! shadows as wide: a coarser map loses nothing a pixel can show. A fitted
+//! map whose bound exceeds `PLANNED_VISITS` is made coarser until it does
+//! not (the work falls with the texels, about as the square of the side);
+//! a map size the user set is kept, and the call refused with the reason
+//! past `MAX_VISITS`, as the light view's (`methods::check_work`).
+
+use super::call::EyeCall;
+use crate::error::{Error, Result};
+use crate::geom::light::MapGrid;
+use crate::geom::light_shape::LightShape;
+use crate::methods::gather::work::{visit_cost, visits_bound, MAX_VISITS, PLANNED_VISITS};
+use crate::methods::{LightPoint, Method, MethodConfig};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Coarser grids tried at most (each one aims at the budget from the last
+/// one's bound: one is nearly always enough).
+const TRIES: usize = 4;
+
+/// What the bound reads of the eye view's framing (`framing::Framed`).
+pub struct Scene<'a> {
+    /// The visible points in light space (not unit-scaled), the kernels'
+    /// depth unit and the light's shape in it.
+    pub pts_ls: &'a [DVec3],
+    pub unit: f64,
+    pub light_shape: LightShape,
+    /// Every vertex in kernel light space, unit-scaled.
+    pub verts: &'a [DVec3],
+}
+
+/// `planned` (the grid and config at the fitted or given resolution), or
+/// where its work bound is over budget, the grid and config `at` gives for
+/// a coarser resolution; an error naming the option where the user set the
+/// size. `faces` are the occluders (indices into `f.verts`).
+pub fn within_budget(
+    call: &EyeCall,
+    f: Scene,
+    faces: &[[u32; 3]],
+    planned: (MapGrid, MethodConfig),
+    at: impl Fn((usize, usize)) -> Result<(MapGrid, MethodConfig)>,
+) -> Result<(MapGrid, MethodConfig)> {
+    if !matches!(
+        planned.1.kernel(),
+        Method::Ssm { .. } | Method::Bitmask { .. }
+    ) {
+        return Ok(planned);
+    }
+    let Some(z_near) = nearest_occluder(&f, faces) else {
+        return Ok(planned);
+    };
+    let inv_unit = 1.0 / f.unit;
+    let points: Vec<LightPoint> = f
+        .pts_ls
+        .par_iter()
+        .map(|q| {
+            let q = *q * inv_unit;
+            if q.z > 0.0 {
+                LightPoint {
+                    x: (q.x / q.z) as f32,
+                    y: (q.y / q.z) as f32,
+                    z: q.z as f32,
+                }
+            } else {
+                LightPoint {
+                    x: 0.0,
+                    y: 0.0,
+                    z: f32::INFINITY,
+                }
+            }
+        })
+        .collect();
+    let bound = |(grid, method): &(MapGrid, MethodConfig)| {
+        let layers = method.passes() as usize;
+        visit_cost(method.kernel()) * visits_bound(grid, f.light_shape, z_near, layers, &points)
+    };
+    let budget = PLANNED_VISITS;
+    let mut plan = planned;
+    let mut visits = bound(&plan);
+    if visits <= budget {
+        return Ok(plan);
+    }
+    let given = if call.method.occluder_resolution().is_some() {
+        Some("occluder_resolution")
+    } else if call.map_resolution.is_some() {
+        Some("map_resolution")
+    } else {
+        None
+    };
+    if let Some(arg) = given {
+        if visits <= MAX_VISITS {
+            return Ok(plan);
+        }
+        let g = &plan.0;
+        return Err(Error::invalid(
+            arg,
+            format!(
+                "{}x{} occluder maps: the light reaches so far across them that the kernel \
+                 would visit about {visits:.1e} texels, more than the {MAX_VISITS:.1e} a call may \
+                 make; leave the map size to the call (it coarsens the maps as \
+                 wide a light allows), make it smaller, or use method=\"exact\"",
+                g.width, g.height
+            ),
+        ));
+    }
+    for _ in 0..TRIES {
+        let scale = (budget / visits).sqrt().min(0.9);
+        let (w, h) = (plan.0.width, plan.0.height);
+        let smaller = (
+            ((w as f64 * scale) as usize).max(1),
+            ((h as f64 * scale) as usize).max(1),
+        );
+        plan = at(smaller)?;
+        visits = bound(&plan);
+        if visits <= budget || smaller == (1, 1) {
+            break;
+        }
+    }
+    Ok(plan)
+}
+
+/// The nearest depth (kernel unit) of the occluders `faces` as the
+/// rasterizer sees it: a triangle reaching the light's plane is clipped at
+/// its near plane, whose depth is then the nearest. None when no occluder
+/// lies in front of the light.
+fn nearest_occluder(f: &Scene, faces: &[[u32; 3]]) -> Option<f64> {
+    let z = faces
+        .par_iter()
+        .flat_map_iter(|t| t.iter().map(|&i| f.verts[i as usize].z))
+        .reduce(|| f64::INFINITY, f64::min);
+    if !(z < f64::INFINITY) {
+        return None;
+    }
+    Some(z.max(crate::raster::near_plane(f.verts)))
+}
