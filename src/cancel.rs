@@ -3,7 +3,7 @@
 //! the call's token), or any Rust caller's own reason.
 //!
 //! A call runs under one `Token` (`with`). Its long parallel loops (the
-//! shadow rays, the gather kernels, PCSS, smoothies, the error estimate)
+//! shadow rays, the gather kernels, PCSS, the BVH build's parallel nodes)
 //! read the token once on the thread that starts them (`current`: it is
 //! thread-local, and rayon's workers do not inherit it) and skip every chunk
 //! that starts after it was cancelled; chunks are a few milliseconds of

@@ -264,6 +264,8 @@ impl GpuKernel for ExactKernel {
         Ok(Some(Box::new(move || {
             let t = light_space_triangles(verts, faces);
             let sh = ExactShading::new(g, i.grid, t, samples, i.light_shape);
+            // A cancelled build is cut short (`crate::cancel`): not for the device.
+            crate::cancel::current().check()?;
             Ok(Box::new(sh) as Box<dyn Stage>)
         })))
     }

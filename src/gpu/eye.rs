@@ -248,6 +248,8 @@ pub(crate) fn first_hits(
     scene: &SceneTriangles,
 ) -> Result<(Vec<Option<u32>>, Timings)> {
     let bvh = gbuffer::camera_bvh(camera, scene);
+    // A cancelled build is cut short (`crate::cancel`): not for the device.
+    crate::cancel::current().check()?;
     let n = camera.width * camera.height;
     fits(g, "resolution", n as u64 * 12)?;
     if n >= u32::MAX as usize {

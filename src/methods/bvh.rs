@@ -221,7 +221,10 @@ impl Bvh {
             .map(|(k, t)| (t, k as u32))
             .collect();
         let codes = sah_depth.is_none().then(|| morton_order(&mut tris));
-        let nodes = subtree(&mut tris, codes.as_deref(), 0, 0, sah_depth);
+        // A cancelled call's build ends at the next parallel node
+        // (`crate::cancel`): a leaf over what is left, a tree no one traces.
+        let stop = crate::cancel::current();
+        let nodes = subtree(&mut tris, codes.as_deref(), 0, 0, sah_depth, &stop);
         let (tris, order): (Vec<[Vec3; 3]>, Vec<u32>) = tris.into_iter().unzip();
         let edges = edges_of(&tris);
         let (wide, wide_parent, wide_source) = collapse(&nodes);
@@ -451,9 +454,13 @@ fn subtree(
     base: usize,
     depth: usize,
     sah_depth: Option<usize>,
+    stop: &crate::cancel::Token,
 ) -> Vec<Node> {
     if tris.len() <= PARALLEL_TRIS {
         return serial_subtree(tris, codes, base, depth, sah_depth);
+    }
+    if stop.is_cancelled() {
+        return vec![node_over(tris, base)];
     }
     let root = node_over(tris, base);
     let mid = split(tris, codes, depth, sah_depth);
@@ -466,8 +473,8 @@ fn subtree(
         None => (None, None),
     };
     let (lv, rv) = rayon::join(
-        || subtree(lt, lc, base, depth + 1, sah_depth),
-        || subtree(rt, rc, base + mid, depth + 1, sah_depth),
+        || subtree(lt, lc, base, depth + 1, sah_depth, stop),
+        || subtree(rt, rc, base + mid, depth + 1, sah_depth, stop),
     );
     // [root, left, right, left's descendants, right's descendants].
     let (l_at, r_at) = (3, 3 + lv.len() - 1);

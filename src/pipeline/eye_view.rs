@@ -279,6 +279,8 @@ fn render_traced<S: EyeStages>(
                 }
                 None => {
                     let bvh = Bvh::build(tris);
+                    // A cancelled build is cut short: neither traced nor kept.
+                    crate::cancel::current().check()?;
                     sw.lap("bvh");
                     keep_for = call.prepared.zip(found);
                     bvh

@@ -3,7 +3,8 @@
 
 use super::configs::{method_arg, Loose};
 use super::convert::{
-    light_of, mesh, opt_int, opt_string, same_shape, slice, space_of, triples, Backend, Light,
+    light_of, mesh, opt_float, opt_int, opt_string, same_shape, slice, space_of, triples, Backend,
+    Light,
 };
 use super::errors;
 use super::results::{DepthShadowResult, MeshShadowResult};
@@ -105,8 +106,8 @@ pub fn shadow_map_from_scene<'py>(
     resolution: &Bound<'py, PyAny>,
     extent: Option<(f64, f64)>,
     method: &Bound<'py, PyAny>,
-    normal_offset: Option<f64>,
-    depth_bias: Option<f64>,
+    normal_offset: Option<Bound<'py, PyAny>>,
+    depth_bias: Option<Bound<'py, PyAny>>,
     passes: Option<Bound<'py, PyAny>>,
     samples: Option<Bound<'py, PyAny>>,
     occluder_resolution: Option<Bound<'py, PyAny>>,
@@ -131,7 +132,10 @@ pub fn shadow_map_from_scene<'py>(
             resolution: super::convert::resolution("resolution", resolution)?,
             extent: extent.map(|e| [e.0, e.1]),
             method: method_arg(method, &loose)?,
-            bias: crate::eye::Bias::new(normal_offset, depth_bias)?,
+            bias: crate::eye::Bias::new(
+                opt_float("normal_offset", normal_offset.as_ref())?,
+                opt_float("depth_bias", depth_bias.as_ref())?,
+            )?,
             backend: backend.0,
             threads: opt_int("threads", threads.as_ref())?,
             estimate_error: opt_string("estimate_error", estimate_error.as_ref())?

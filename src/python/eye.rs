@@ -106,8 +106,8 @@ pub fn render<'py>(
     camera: &PyCamera,
     method: &Bound<'py, PyAny>,
     map_resolution: Option<Bound<'py, PyAny>>,
-    normal_offset: Option<f64>,
-    depth_bias: Option<f64>,
+    normal_offset: Option<Bound<'py, PyAny>>,
+    depth_bias: Option<Bound<'py, PyAny>>,
     passes: Option<Bound<'py, PyAny>>,
     samples: Option<Bound<'py, PyAny>>,
     occluder_resolution: Option<Bound<'py, PyAny>>,
@@ -140,7 +140,10 @@ pub fn render<'py>(
             camera: &camera.0,
             method: method_arg(method, &loose)?,
             map_resolution: opt_resolution("map_resolution", map_resolution.as_ref())?,
-            bias: Bias::new(normal_offset, depth_bias)?,
+            bias: Bias::new(
+                opt_float("normal_offset", normal_offset.as_ref())?,
+                opt_float("depth_bias", depth_bias.as_ref())?,
+            )?,
             backend: backend.0,
             threads: opt_int("threads", threads.as_ref())?,
             estimate_error: opt_string("estimate_error", estimate_error.as_ref())?

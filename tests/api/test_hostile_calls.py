@@ -51,6 +51,15 @@ def test_an_estimate_error_of_the_wrong_type_is_refused_by_name(table):
         ss.render(table, LIGHT, _camera(32, 24), estimate_error=3)
 
 
+@pytest.mark.parametrize("arg", ["normal_offset", "depth_bias"])
+def test_a_bias_of_the_wrong_type_is_refused_by_name(table, arg):
+    # A list gave pyo3's "must be real number, not list" (fuzz_render.py).
+    with pytest.raises(TypeError, match=rf"^{arg}: must be a number, got list"):
+        ss.render(table, LIGHT, _camera(32, 24), method="ssm", **{arg: [0.5]})
+    with pytest.raises(TypeError, match=rf"^{arg}: must be a number, got list"):
+        ss.soft_shadow_map(table, LIGHT, resolution=16, method="exact", **{arg: [0.5]})
+
+
 @pytest.mark.parametrize("big", [1e300, 3.5e38, float(np.finfo(np.float64).max)])
 def test_emissions_that_overflow_the_float32_images_are_refused(big):
     with pytest.raises(ValueError, match=r"^radiance: must be in \[0, 3.4028"):
