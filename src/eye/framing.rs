@@ -252,7 +252,7 @@ pub fn map_grid(
         light_shape: f.light_shape,
         verts: &f.verts,
     };
-    gather_budget::within_budget(call, scene, faces, (grid, method), |r| {
+    gather_budget::within_budget(call, scene, faces, resolution, (grid, method), |r| {
         grid_at(call, r, extent, backend)
     })
 }

@@ -36,14 +36,16 @@ pub struct Scene<'a> {
     pub verts: &'a [DVec3],
 }
 
-/// `planned` (the grid and config at the fitted or given resolution), or
+/// `planned` (the grid and config at `resolution`, fitted or given), or
 /// where its work bound is over budget, the grid and config `at` gives for
-/// a coarser resolution; an error naming the option where the user set the
+/// a coarser resolution (the config derives its occluder grid from it, as
+/// from the first); an error naming the option where the user set the
 /// size. `faces` are the occluders (indices into `f.verts`).
 pub fn within_budget(
     call: &EyeCall,
     f: Scene,
     faces: &[[u32; 3]],
+    resolution: (usize, usize),
     planned: (MapGrid, MethodConfig),
     at: impl Fn((usize, usize)) -> Result<(MapGrid, MethodConfig)>,
 ) -> Result<(MapGrid, MethodConfig)> {
@@ -110,16 +112,16 @@ pub fn within_budget(
             ),
         ));
     }
+    let mut res = resolution;
     for _ in 0..TRIES {
         let scale = (budget / visits).sqrt().min(0.9);
-        let (w, h) = (plan.0.width, plan.0.height);
-        let smaller = (
-            ((w as f64 * scale) as usize).max(1),
-            ((h as f64 * scale) as usize).max(1),
+        res = (
+            ((res.0 as f64 * scale) as usize).max(1),
+            ((res.1 as f64 * scale) as usize).max(1),
         );
-        plan = at(smaller)?;
+        plan = at(res)?;
         visits = bound(&plan);
-        if visits <= budget || smaller == (1, 1) {
+        if visits <= budget || res == (1, 1) {
             break;
         }
     }
