@@ -13,6 +13,7 @@
 //! past `MAX_VISITS`, as the light view's (`methods::check_work`).
 
 use super::call::EyeCall;
+use super::maps::{kernel_point, EMPTY_POINT};
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -58,6 +59,8 @@ pub fn within_budget(
     let Some(z_near) = nearest_occluder(&f, faces) else {
         return Ok(planned);
     };
+    // The visible points as the kernels will read them (the biases, which
+    // move them by a texel or so, left out).
     let inv_unit = 1.0 / f.unit;
     let points: Vec<LightPoint> = f
         .pts_ls
@@ -65,17 +68,9 @@ pub fn within_budget(
         .map(|q| {
             let q = *q * inv_unit;
             if q.z > 0.0 {
-                LightPoint {
-                    x: (q.x / q.z) as f32,
-                    y: (q.y / q.z) as f32,
-                    z: q.z as f32,
-                }
+                kernel_point(q)
             } else {
-                LightPoint {
-                    x: 0.0,
-                    y: 0.0,
-                    z: f32::INFINITY,
-                }
+                EMPTY_POINT
             }
         })
         .collect();

@@ -156,6 +156,17 @@ pub(crate) const EMPTY_POINT: LightPoint = LightPoint {
     z: f32::INFINITY,
 };
 
+/// A light-space point (unit-scaled) as the kernels read it: its tangents
+/// and depth (`q.z > 0`, in front of the light).
+pub(crate) fn kernel_point(q: DVec3) -> LightPoint {
+    let inv_z = 1.0 / q.z;
+    LightPoint {
+        x: (q.x * inv_z) as f32,
+        y: (q.y * inv_z) as f32,
+        z: q.z as f32,
+    }
+}
+
 /// The points (world, with their camera-facing `normals`, and `pts_ls`
 /// their kernel light-space images before unit scaling) moved by the
 /// biases, and their tangent-plane bounds, in one pass. A point whose bound
@@ -209,12 +220,7 @@ pub fn shading_points(
             let moved = biased(space, p, n, texel, bias);
             let q = space.to_light(moved) * inv_unit;
             if q.z > 0.0 {
-                let inv_z = 1.0 / q.z;
-                *lp = LightPoint {
-                    x: (q.x * inv_z) as f32,
-                    y: (q.y * inv_z) as f32,
-                    z: q.z as f32,
-                };
+                *lp = kernel_point(q);
                 *b = front as f32;
                 // The plane through the biased point: 1/z is linear on the
                 // grid over it, so a texel's step is exact at any size.

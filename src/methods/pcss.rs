@@ -315,9 +315,8 @@ impl Pcss {
 /// check_reads`): about 14 s on 2 cores, where the bound's reads took
 /// 1.4 ns each (4.7e9 in 6.7 s at 512² with `max_taps=64`), and under a
 /// minute on one (a call the bound let through at 1.5e10 took 60 s with
-/// `threads=1`). The default
-/// `max_taps` stays far below it: 16 taps a side read at most 1 024 texels
-/// a receiver, 1.1e9 at 1024².
+/// `threads=1`). The default `max_taps` stays far below it: 16 taps a
+/// side read at most 2 x 34² = 2 312 texels a receiver, 2.4e9 at 1024².
 pub const MAX_READS: f64 = 1e10;
 
 impl Pcss {
