@@ -1,12 +1,12 @@
-"""A/B of the gather kernels' work bound (src/methods/gather/work.rs) on the
+"""A/B of the gather kernels' work bounds (src/methods/gather/work.rs) on the
 as-built scenes: run once with the shipped build and once with a build whose
-PLANNED_VISITS and MAX_VISITS are f64::INFINITY (the rule off), then compare
+PLANNED_VISITS and VISITS_PER_RECEIVER are f64::INFINITY (the rules off), then compare
 the two JSON files: the occluder resolution each call ran with, its time,
 and its error over the pixels the cached 4096-sample Mitsuba reference
 shadows (``bench_scenes.py``'s cache).
 
     python benchmarks/ab_gather_budget.py out_rule.json      # the shipped build
-    # edit the two constants to f64::INFINITY, rebuild, then:
+    # set the two constants to f64::INFINITY, rebuild, then:
     python benchmarks/ab_gather_budget.py out_off.json
     python benchmarks/ab_gather_budget.py --compare out_off.json out_rule.json
 

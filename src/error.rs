@@ -16,6 +16,11 @@ pub enum Error {
     /// The request would allocate more than we are willing to before starting.
     #[error("{arg}: {msg}")]
     TooLarge { arg: String, msg: String },
+    /// A call whose kernel counted more work than a call may do, stopped
+    /// (`methods::bounded`); `arg` names the option whose size drove it,
+    /// `over` how many times the limit the whole call was estimated at.
+    #[error("{arg}: {msg}")]
+    TooCostly { arg: String, msg: String, over: f64 },
     /// `backend="gpu"` was asked for and no GPU adapter can be opened (none
     /// present, no driver, or switched off by SOFTSHADOW_GPU=off).
     #[error("no GPU available: {msg}")]
@@ -47,6 +52,13 @@ impl Error {
     }
     pub fn gpu(msg: impl Into<String>) -> Self {
         Error::Gpu { msg: msg.into() }
+    }
+    pub fn too_costly(arg: impl Into<String>, msg: impl Into<String>, over: f64) -> Self {
+        Error::TooCostly {
+            arg: arg.into(),
+            msg: msg.into(),
+            over,
+        }
     }
     pub fn too_large(arg: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::TooLarge {

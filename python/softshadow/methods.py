@@ -46,8 +46,12 @@ def limits() -> dict[str, Any]:
     """Limits that are not one method's: ``max_texels`` per map,
     ``max_extent`` (tangent half-extent), ``max_passes``, ``max_samples``
     (``exact``), ``max_threads`` (``threads=``), ``gpu_max_side`` (0
-    without a GPU backend) and ``max_emission`` (a light's ``radiance`` or
-    ``irradiance`` per channel: the largest float32)."""
+    without a GPU backend), ``max_emission`` (a light's ``radiance`` or
+    ``irradiance`` per channel: the largest float32), and the cost limits:
+    ``visits_per_receiver`` (the weighted occluder texels a gather kernel,
+    ``ssm`` or ``bitmask``, may visit per receiver it shades, counted as it
+    runs), ``pcss_reads_per_receiver`` (PCSS's texel reads, bounded before
+    it runs), each with at least ``min_receivers`` receivers' worth."""
     return dict(_core.limits())
 
 

@@ -35,6 +35,19 @@ pub struct EyeCall<'a> {
     pub prepared: Option<&'a Prepared>,
 }
 
+impl EyeCall<'_> {
+    /// The option that sizes the call's occluder maps, which a refusal of
+    /// their cost names: the method's own `occluder_resolution` where set,
+    /// else `map_resolution` (set, or fitted to the pixels).
+    pub fn map_size_arg(&self) -> &'static str {
+        if self.method.occluder_resolution().is_some() {
+            "occluder_resolution"
+        } else {
+            "map_resolution"
+        }
+    }
+}
+
 /// A rendered image.
 #[derive(Debug, Clone)]
 pub struct EyeImage {

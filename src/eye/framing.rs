@@ -185,6 +185,14 @@ pub fn casting_faces<'s>(
         .into()
 }
 
+/// The map methods' plan: their occluder grid, the config resolved for a
+/// backend at a resolution, and that resolution.
+pub struct MapPlan {
+    pub grid: MapGrid,
+    pub method: MethodConfig,
+    pub resolution: (usize, usize),
+}
+
 /// The map methods' occluder grid (focused on what the occluders `faces`
 /// can shadow of the visible points, sized from their footprint unless the
 /// call sets it) and the config resolved for `backend` at that resolution.
@@ -195,7 +203,7 @@ pub fn map_grid(
     f: &Framed,
     faces: &[[u32; 3]],
     backend: Backend,
-) -> Result<(MapGrid, MethodConfig)> {
+) -> Result<MapPlan> {
     let visible = focus::VisibleBounds::of(&f.pts_ls, f.unit);
     let mut used = vec![false; f.verts.len()];
     for t in faces {
@@ -252,9 +260,43 @@ pub fn map_grid(
         light_shape: f.light_shape,
         verts: &f.verts,
     };
-    gather_budget::within_budget(call, scene, faces, resolution, (grid, method), |r| {
-        grid_at(call, r, extent, backend)
+    let ((grid, method), resolution) =
+        gather_budget::within_budget(call, scene, faces, resolution, (grid, method), |r| {
+            grid_at(call, r, extent, backend)
+        })?;
+    Ok(MapPlan {
+        grid,
+        method,
+        resolution,
     })
+}
+
+/// `plan` coarser, over the same extent: the fitted plan whose kernel
+/// passed its visits' limit (`methods::bounded`), estimated at `over` times
+/// it, runs again on it. The visits fall about as the texels, the square of
+/// the side: the side is scaled by 0.8 / sqrt(over) (a margin for the
+/// estimate, from the groups shaded before the stop), and at least halved.
+/// None where the call set the map size (the refusal stands) or the plan
+/// is already 1x1.
+pub fn coarser(
+    call: &EyeCall,
+    plan: &MapPlan,
+    over: f64,
+    backend: Backend,
+) -> Result<Option<MapPlan>> {
+    let (w, h) = plan.resolution;
+    if call.map_resolution.is_some() || call.method.occluder_resolution().is_some() || w * h <= 1 {
+        return Ok(None);
+    }
+    let scale = (0.8 / over.max(1.0).sqrt()).min(0.5);
+    let side = |n: usize| ((n as f64 * scale) as usize).max(1);
+    let resolution = (side(w), side(h));
+    let (grid, method) = grid_at(call, resolution, [plan.grid.tx, plan.grid.ty], backend)?;
+    Ok(Some(MapPlan {
+        grid,
+        method,
+        resolution,
+    }))
 }
 
 /// The config resolved for `backend` at `resolution` and its occluder grid

@@ -8,16 +8,17 @@
 //! 0.94 s at 320x240, 12.7 s at 640x480). So wide a light casts only
 //! shadows as wide: a coarser map loses nothing a pixel can show. A fitted
 //! map whose bound exceeds `PLANNED_VISITS` is made coarser until it does
-//! not (the work falls with the texels, about as the square of the side);
-//! a map size the user set is kept, and the call refused with the reason
-//! past `MAX_VISITS`, as the light view's (`methods::check_work`).
+//! not (the work falls with the texels, about as the square of the side).
+//! A map size the user set is kept; what bounds every call, planned or
+//! set, is the kernel's count of the visits it makes, stopped and refused
+//! past `VISITS_PER_RECEIVER` a receiver (`methods::bounded`).
 
 use super::call::EyeCall;
 use super::maps::{kernel_point, EMPTY_POINT};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::methods::gather::work::{visit_cost, visits_bound, MAX_VISITS, PLANNED_VISITS};
+use crate::methods::gather::work::{visit_cost, visits_bound, PLANNED_VISITS};
 use crate::methods::{LightPoint, Method, MethodConfig};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -40,8 +41,8 @@ pub struct Scene<'a> {
 /// `planned` (the grid and config at `resolution`, fitted or given), or
 /// where its work bound is over budget, the grid and config `at` gives for
 /// a coarser resolution (the config derives its occluder grid from it, as
-/// from the first); an error naming the option where the user set the
-/// size. `faces` are the occluders (indices into `f.verts`).
+/// from the first); a size the user set is kept. With the resolution it
+/// was planned at. `faces` are the occluders (indices into `f.verts`).
 pub fn within_budget(
     call: &EyeCall,
     f: Scene,
@@ -49,15 +50,15 @@ pub fn within_budget(
     resolution: (usize, usize),
     planned: (MapGrid, MethodConfig),
     at: impl Fn((usize, usize)) -> Result<(MapGrid, MethodConfig)>,
-) -> Result<(MapGrid, MethodConfig)> {
+) -> Result<((MapGrid, MethodConfig), (usize, usize))> {
     if !matches!(
         planned.1.kernel(),
         Method::Ssm { .. } | Method::Bitmask { .. }
     ) {
-        return Ok(planned);
+        return Ok((planned, resolution));
     }
     let Some(z_near) = nearest_occluder(&f, faces) else {
-        return Ok(planned);
+        return Ok((planned, resolution));
     };
     // The visible points as the kernels will read them (the biases, which
     // move them by a texel or so, left out).
@@ -82,30 +83,12 @@ pub fn within_budget(
     let mut plan = planned;
     let mut visits = bound(&plan);
     if visits <= budget {
-        return Ok(plan);
+        return Ok((plan, resolution));
     }
-    let given = if call.method.occluder_resolution().is_some() {
-        Some("occluder_resolution")
-    } else if call.map_resolution.is_some() {
-        Some("map_resolution")
-    } else {
-        None
-    };
-    if let Some(arg) = given {
-        if visits <= MAX_VISITS {
-            return Ok(plan);
-        }
-        let g = &plan.0;
-        return Err(Error::invalid(
-            arg,
-            format!(
-                "{}x{} occluder maps: the light reaches so far across them that the kernel \
-                 would visit about {visits:.1e} texels, more than the {MAX_VISITS:.1e} a call may \
-                 make; leave the map size to the call (it coarsens the maps as \
-                 wide a light allows), make it smaller, or use method=\"exact\"",
-                g.width, g.height
-            ),
-        ));
+    // A map size the user set is kept: the kernel's meter refuses it, naming
+    // the option, if its visits pass the limit (`methods::bounded`).
+    if call.method.occluder_resolution().is_some() || call.map_resolution.is_some() {
+        return Ok((plan, resolution));
     }
     let mut res = resolution;
     for _ in 0..TRIES {
@@ -120,7 +103,7 @@ pub fn within_budget(
             break;
         }
     }
-    Ok(plan)
+    Ok((plan, res))
 }
 
 /// The nearest depth (kernel unit) of the occluders `faces` as the

@@ -251,6 +251,7 @@ pub(crate) fn shade(
     pts_ls: &[DVec3],
     normals: &[[f32; 3]],
     bias: &Bias,
+    arg: &str,
     sw: &mut Stopwatch,
 ) -> Result<(Vec<f32>, EyeMaps)> {
     let mut layers = occluder_layers(&grid, tris, passes);
@@ -276,8 +277,7 @@ pub(crate) fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    crate::methods::check_work(method, &inputs, Some(&sp.points))?;
-    let mut v = match method {
+    let shade = || match method {
         // Every mesh is an occluder: its silhouette straight from the mesh.
         Method::Smoothies { width, falloff } => crate::methods::smoothies::Smoothies {
             width: width.0,
@@ -288,6 +288,7 @@ pub(crate) fn shade(
             .visibility_on_planes(&inputs, &sp.points, &sp.planes),
         _ => crate::methods::shade_points(method, &inputs, &sp.points),
     };
+    let mut v = crate::methods::bounded(method, &inputs, Some(&sp.points), arg, shade)?;
     sw.lap("shadow");
     finish(&mut v, &sp.bound);
     for l in layers.iter_mut() {

@@ -145,6 +145,7 @@ impl EyeStages for CpuEye {
             &f.pts_ls,
             &f.normals,
             &call.bias,
+            call.map_size_arg(),
             sw,
         )
     }

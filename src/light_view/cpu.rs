@@ -9,7 +9,7 @@ use crate::frame::{light_space_triangles, DepthInUnit, FramedScene, MapSettings}
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::memory::{check_fits, map_bytes};
-use crate::methods::{check_work, shade_map, Input, Method, ShadowInputs};
+use crate::methods::{bounded, shade_map, Input, Method, ShadowInputs};
 use crate::raster::{rasterize, Prepared};
 use crate::timing::{Stopwatch, Timings};
 
@@ -74,8 +74,9 @@ impl LightViewStages for CpuLightView {
             occluder_layers: layers,
             occluder_triangles: triangles.as_deref(),
         };
-        check_work(s.method, &inputs, None)?;
-        let visibility = shade_map(s.method, &inputs);
+        let visibility = bounded(s.method, &inputs, None, "occluder_resolution", || {
+            shade_map(s.method, &inputs)
+        })?;
         sw.lap("shadow");
         let (front, back) = match occ {
             Some(o) => (Some(o.nearest), o.farthest),
@@ -131,8 +132,9 @@ impl LightViewStages for CpuLightView {
             occluder_layers: layers,
             occluder_triangles: None,
         };
-        check_work(method, &inputs, None)?;
-        let v = shade_map(method, &inputs);
+        let v = bounded(method, &inputs, None, "occluder_resolution", || {
+            shade_map(method, &inputs)
+        })?;
         sw.lap("shadow");
         Ok(v)
     }

@@ -23,6 +23,12 @@ pub struct Limits {
     pub max_threads: usize,
     /// Largest map side on the GPU backend (0 without one).
     pub gpu_max_side: usize,
+    /// The receivers' worth of work every call may spend (`inputs`).
+    pub min_receivers: usize,
+    /// Weighted gather visits a call may make per receiver (`gather::work`).
+    pub visits_per_receiver: f64,
+    /// PCSS texel reads a call may plan per receiver (`pcss`).
+    pub pcss_reads_per_receiver: f64,
 }
 
 pub fn limits() -> Limits {
@@ -37,6 +43,9 @@ pub fn limits() -> Limits {
         } else {
             0
         },
+        min_receivers: super::inputs::MIN_RECEIVERS,
+        visits_per_receiver: super::gather::work::VISITS_PER_RECEIVER,
+        pcss_reads_per_receiver: super::pcss::READS_PER_RECEIVER,
     }
 }
 

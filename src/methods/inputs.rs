@@ -67,3 +67,15 @@ impl Input {
         }
     }
 }
+
+/// Whether a receiver depth (a texel's, a point's) holds a surface in
+/// front of the light: what the cost limits count receivers by.
+#[inline]
+pub fn is_receiver(z: f32) -> bool {
+    z.is_finite() && z > 0.0
+}
+
+/// The receivers' worth of work every call may spend, however few it
+/// shades (a 640x480 image's): the floor of the cost limits that grow with
+/// the receivers (`gather::work::visit_limit`, `pcss::READS_PER_RECEIVER`).
+pub const MIN_RECEIVERS: usize = 640 * 480;

@@ -43,7 +43,7 @@ pub use auto_config::{auto_rule, AutoConfig};
 pub use bitmask::{BitmaskConfig, HIERARCHY_DEFAULT_BITMASK};
 pub use exact::ExactConfig;
 pub use gather::Hierarchy;
-pub use inputs::{Input, LightPoint, ShadowInputs, ShadowMethod};
+pub use inputs::{is_receiver, Input, LightPoint, ShadowInputs, ShadowMethod};
 pub use pcss::PcssConfig;
 pub use shadow_mapping::config::ShadowMappingConfig;
 pub use smoothies::config::SmoothiesConfig;
@@ -250,23 +250,40 @@ pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
     }
 }
 
-/// Refuses, before any receiver is shaded, a call whose cost grows with a
-/// parameter rather than with what the answer needs: PCSS's texel reads
-/// (`Pcss::check_reads`), the gather kernels' visits
-/// (`gather::work::check_visits`; the eye view plans its fitted maps under
-/// that bound first, `eye::gather_budget`). `pts`: the receivers, or None
-/// for the receiver map's texels.
-pub fn check_work(
+/// Runs `shade` (a call of `method` on `inputs`: `shade_map`, `shade_points`
+/// or a method's own entry), refusing a call whose cost grows with a
+/// parameter rather than with what the answer needs: PCSS's texel reads,
+/// bounded before any receiver is shaded (`Pcss::check_reads`); the gather
+/// kernels' visits, counted as they are made (`gather::work::metered`) and
+/// stopped past `gather::work::visit_limit` (a number a receiver),
+/// naming `arg`, the option whose size drove them. `pts`: the receivers,
+/// or None for the receiver map's texels.
+pub fn bounded<T>(
     method: Method,
     inputs: &ShadowInputs,
     pts: Option<&[LightPoint]>,
-) -> crate::error::Result<()> {
+    arg: &str,
+    shade: impl FnOnce() -> T,
+) -> crate::error::Result<T> {
     match method {
-        Method::Pcss { max_taps } => pcss::Pcss { max_taps }.check_reads(inputs, pts),
-        Method::Ssm { .. } | Method::Bitmask { .. } => {
-            gather::work::check_visits(method, inputs, pts)
+        Method::Pcss { max_taps } => {
+            pcss::Pcss { max_taps }.check_reads(inputs, pts)?;
+            Ok(shade())
         }
-        _ => Ok(()),
+        Method::Ssm { .. } | Method::Bitmask { .. } if !inputs.light_shape.is_point() => {
+            let receivers = match pts {
+                Some(p) => p.iter().filter(|p| is_receiver(p.z)).count(),
+                None => inputs.receiver.iter().filter(|&&z| is_receiver(z)).count(),
+            };
+            let limit = gather::work::visit_limit(method, receivers);
+            let (v, count) = gather::meter::metered(limit, shade);
+            if count.visits > limit {
+                let e = gather::work::refusal(method, inputs, receivers, arg, count.estimated);
+                return Err(e);
+            }
+            Ok(v)
+        }
+        _ => Ok(shade()),
     }
 }
 

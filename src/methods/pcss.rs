@@ -87,6 +87,7 @@ use super::config::{
     MethodSpec,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::inputs::{is_receiver, MIN_RECEIVERS};
 use super::keywords::{count, resolution, KeywordForm, Keywords};
 use super::pcf::{self, occludes, Axis, Border};
 use super::Input;
@@ -311,17 +312,19 @@ impl Pcss {
     }
 }
 
-/// The most texel reads one PCSS call may be planned to make (`Pcss::
-/// check_reads`): about 14 s on 2 cores, where the bound's reads took
-/// 1.4 ns each (4.7e9 in 6.7 s at 512² with `max_taps=64`), and under a
-/// minute on one (a call the bound let through at 1.5e10 took 60 s with
-/// `threads=1`). The default `max_taps` stays far below it: 16 taps a
-/// side read at most 2 x 34² = 2 312 texels a receiver, 2.4e9 at 1024².
-pub const MAX_READS: f64 = 1e10;
+/// The texel reads one PCSS call may be planned to make per receiver
+/// (`Pcss::check_reads`), with at least `inputs::MIN_RECEIVERS`
+/// receivers' worth: 5.0e9 at 640x480 and below. The bound's reads took
+/// 1.4 ns each (4.7e9 in 6.7 s at 512² with `max_taps=64`) to 3.3 ns (a
+/// 640x480 image whose 1e10 took 33 s, fuzz seed 13 call 793) on 2 cores,
+/// so at most about 17 s there. The default `max_taps` never reaches it:
+/// 16 taps a side read at most 2 x 34² = 2 312 texels a receiver.
+pub const READS_PER_RECEIVER: f64 = 16384.0;
 
 impl Pcss {
     /// Refuses, naming `max_taps`, a call whose receivers would read more
-    /// than `MAX_READS` texels, summed over the receivers before any is
+    /// than `READS_PER_RECEIVER` texels each, summed over the receivers
+    /// (at least `MIN_RECEIVERS` of them) before any is
     /// shaded (`Kernel::reads`): a wide box read with many taps costs
     /// max_taps² reads a receiver, twice. `points`: the receivers (None:
     /// the texels of the receiver map `inputs.receiver`).
@@ -332,8 +335,11 @@ impl Pcss {
         let Some(kernel) = Kernel::new(inputs, self.max_taps) else {
             return Ok(());
         };
-        let reads: f64 = match points {
-            Some(p) => p.par_iter().map(|p| kernel.reads(p.x, p.y, p.z)).sum(),
+        let (reads, receivers): (f64, usize) = match points {
+            Some(p) => p
+                .par_iter()
+                .map(|p| (kernel.reads(p.x, p.y, p.z), is_receiver(p.z) as usize))
+                .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1)),
             None => {
                 let g = inputs.grid;
                 (0..g.len())
@@ -341,18 +347,19 @@ impl Pcss {
                     .map(|k| {
                         let z = inputs.receiver.get(k).copied().unwrap_or(f32::INFINITY);
                         let (x, y) = (g.x_of(k % g.width) as f32, g.y_of(k / g.width) as f32);
-                        kernel.reads(x, y, z)
+                        (kernel.reads(x, y, z), is_receiver(z) as usize)
                     })
-                    .sum()
+                    .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
             }
         };
-        if reads > MAX_READS {
+        let max_reads = READS_PER_RECEIVER * receivers.max(MIN_RECEIVERS) as f64;
+        if reads > max_reads {
             return Err(Error::invalid(
                 "max_taps",
                 format!(
                     "{}: the receivers' blocker searches and filters would read about {reads:.1e} \
-                     texels, more than the {MAX_READS:.1e} a call may make; lower \
-                     max_taps or the map resolution",
+                     texels, more than the {max_reads:.1e} a call with {receivers} receivers may \
+                     ({READS_PER_RECEIVER} a receiver); lower max_taps or the map resolution",
                     self.max_taps
                 ),
             ));

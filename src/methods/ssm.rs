@@ -813,4 +813,66 @@ mod tests {
         let max = crate::methods::plate_case::max_error(&Ssm::default(), 64);
         assert!(max < 1e-5, "max error {max}");
     }
+
+    /// A plate over a floor under a light as wide as the map: every tile
+    /// reaches most of the occluder map.
+    fn wide_light_visibility(limit: u64, threads: usize) -> (Vec<f32>, u64) {
+        let n = 64;
+        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+        let front: Vec<f32> = (0..n * n)
+            .map(|k| {
+                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
+                if x.abs() < 0.3 && y.abs() < 0.2 {
+                    2.0
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        let receiver = vec![4.0f32; n * n];
+        let inputs = ShadowInputs {
+            grid,
+            occluder_grid: grid,
+            light_shape: LightShape::rect([8.0, 8.0]),
+            receiver: &receiver,
+            occluder_layers: vec![&front],
+            occluder_triangles: None,
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let (v, count) = pool.install(|| {
+            crate::methods::gather::meter::metered(limit, || Ssm::default().visibility_map(&inputs))
+        });
+        if count.visits <= limit {
+            assert_eq!(count.estimated, count.visits as f64);
+        } else {
+            // Stopped: the total is estimated from the groups shaded.
+            assert!(count.estimated > count.visits as f64, "{count:?}");
+        }
+        (v, count.visits)
+    }
+
+    #[test]
+    fn the_meter_counts_the_same_visits_on_any_thread_count_and_stops_past_its_limit() {
+        let (full, visits) = wide_light_visibility(u64::MAX, 1);
+        assert!(visits > 10_000, "{visits}");
+        // The count is the groups' own, whatever order they ran in.
+        for threads in [2, 4] {
+            assert_eq!(
+                wide_light_visibility(u64::MAX, threads),
+                (full.clone(), visits)
+            );
+        }
+        // At the count the call finishes; one under, it is stopped (the
+        // groups after the crossing skipped, leaving their texels at 1).
+        let (v, at) = wide_light_visibility(visits, 3);
+        assert_eq!((v, at), (full.clone(), visits));
+        let (v, over) = wide_light_visibility(visits / 4, 3);
+        assert!(over > visits / 4 && over < visits, "{over} of {visits}");
+        assert_ne!(v, full);
+        // Outside `metered` no kernel counts.
+        assert!(crate::methods::gather::meter::current_meter().is_none());
+    }
 }

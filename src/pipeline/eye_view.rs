@@ -10,13 +10,13 @@
 //! surface.
 
 use crate::backend::Backend;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::error_estimate::Draw;
 use crate::eye::budget::traced_bytes;
 use crate::eye::estimate::{self, REFERENCE_SAMPLES};
 use crate::eye::framing::Framed;
 use crate::eye::framing::{
-    casting_faces, exact_samples, frame, light_triangles, map_grid, resolve_at_camera,
+    casting_faces, coarser, exact_samples, frame, light_triangles, map_grid, resolve_at_camera,
     traced_triangles,
 };
 use crate::eye::gbuffer::{GBuffer, SceneTriangles};
@@ -157,9 +157,8 @@ pub fn render_with<S: EyeStages>(
     let method;
     if !f.points.is_empty() {
         let casting = casting_faces(call, &scene, &f);
-        let (grid, m) = map_grid(call, &g, &f, &casting, S::BACKEND)?;
-        check_maps_fit(call, &grid, &m)?;
-        method = m;
+        let mut plan = map_grid(call, &g, &f, &casting, S::BACKEND)?;
+        check_maps_fit(call, &plan.grid, &plan.method)?;
         sw.lap("extent");
         // The estimate's rays meet the casters only: the other triangles
         // cannot shadow a point that faces the light (casters.rs), and a
@@ -172,7 +171,23 @@ pub fn render_with<S: EyeStages>(
             (how, t)
         });
         let tris = light_triangles(&mut f, &casting);
-        let (v, m) = stages.shade_maps(call, &f, &tris, grid, &method, &mut sw)?;
+        // A fitted plan whose kernel passed its visits' limit (the
+        // prediction it was planned under fell short) runs again on a
+        // coarser map (`framing::coarser`): so wide a light casts only
+        // shadows as wide. A size the user set is refused, naming it
+        // (`methods::bounded`).
+        let (v, m) = loop {
+            match stages.shade_maps(call, &f, &tris, plan.grid, &plan.method, &mut sw) {
+                Err(e @ Error::TooCostly { over, .. }) => {
+                    match coarser(call, &plan, over, S::BACKEND)? {
+                        Some(p) => plan = p,
+                        None => return Err(e),
+                    }
+                }
+                r => break r?,
+            }
+        };
+        method = plan.method;
         maps = Some(m);
         sw.lap("maps_out");
         if let Some((how, traced)) = traced {
@@ -220,13 +235,8 @@ pub fn render_with<S: EyeStages>(
 fn check_maps_fit(call: &EyeCall, grid: &MapGrid, method: &MethodConfig) -> Result<()> {
     let layers = method.passes() as usize;
     let per_layer = 2 + method.kernel().kernel_maps_per_layer();
-    let arg = if call.method.occluder_resolution().is_some() {
-        "occluder_resolution"
-    } else {
-        "map_resolution"
-    };
     check_fits(
-        arg,
+        call.map_size_arg(),
         &format!(
             "{}x{} occluder maps ({layers} layers)",
             grid.width, grid.height

@@ -124,6 +124,7 @@ pub fn from_scene(
             &pts_ls,
             &normals,
             bias,
+            "occluder_resolution",
             &mut sw,
         )?;
         for (&k, v) in texels.iter().zip(v) {

@@ -11,7 +11,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::frame::{check_depth, light_space_triangles};
-use crate::methods::shade_points;
+use crate::methods::{bounded, shade_points};
 
 /// What a method reads of the occluders when shading points.
 #[derive(Debug, Clone)]
@@ -148,7 +148,10 @@ pub fn sample_points(
         occluder_layers: layers.iter().map(|l| &l[..]).collect(),
         occluder_triangles: triangles.as_deref(),
     };
-    Ok((shade_points(method, &inputs, &ls), inside))
+    let v = bounded(method, &inputs, Some(&ls), "occluder_resolution", || {
+        shade_points(method, &inputs, &ls)
+    })?;
+    Ok((v, inside))
 }
 
 /// World points of the receiver texels (texel centers at their receiver

@@ -55,9 +55,9 @@ impl From<Error> for PyErr {
             // bindings raise the interpreter's own KeyboardInterrupt).
             Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
             // About an argument's value; the message starts with its name.
-            Error::InvalidArgument { .. } | Error::ShapeMismatch { .. } => {
-                PyValueError::new_err(msg)
-            }
+            Error::InvalidArgument { .. }
+            | Error::ShapeMismatch { .. }
+            | Error::TooCostly { .. } => PyValueError::new_err(msg),
             // Refused before allocating: TooLargeError, both a ValueError
             // (a bad argument) and a MemoryError.
             Error::TooLarge { .. } => Python::attach(|py| match too_large_error(py) {

@@ -46,6 +46,24 @@ impl Group {
 }
 
 impl Kernel {
+    /// Whether the remaining groups are to be skipped: the call was
+    /// cancelled, or its visits passed the meter's limit.
+    #[inline(always)]
+    fn stopped(&self) -> bool {
+        self.stop.is_cancelled() || self.meter.as_ref().is_some_and(|m| m.over())
+    }
+
+    /// `shade_group`, its visits charged to the meter.
+    #[inline(always)]
+    fn shade_counted<A: Accumulator>(&self, a: &A, g: &Group) -> super::kernel::Lanes {
+        let mut visits = 0u64;
+        let v = self.shade_group(a, g, &mut visits);
+        if let Some(m) = &self.meter {
+            m.charge(visits);
+        }
+        v
+    }
+
     #[inline(always)]
     /// Shades output rows j0 and j0 + 1 (when present): each group is a tile
     /// of TILE_W columns by ROWS_PER_GROUP rows, so that a visit of an
@@ -60,7 +78,7 @@ impl Kernel {
         let w = self.rec_width;
         let rows = receiver.len() / w;
         for c in (0..w).step_by(TILE_W) {
-            if self.stop.is_cancelled() {
+            if self.stopped() {
                 return;
             }
             let e = (c + TILE_W).min(w);
@@ -79,7 +97,7 @@ impl Kernel {
                 })
             });
             if let Some(g) = Group::new(pts, e - c == TILE_W && rows == ROWS_PER_GROUP) {
-                let v = self.shade_group(a, &g);
+                let v = self.shade_counted(a, &g);
                 for r in 0..rows {
                     out[r * w + c..r * w + e].copy_from_slice(&v[r * TILE_W..r * TILE_W + (e - c)]);
                 }
@@ -95,11 +113,11 @@ impl Kernel {
         out: &mut [f32],
     ) {
         for (o, p) in out.chunks_mut(LANES).zip(pts.chunks(LANES)) {
-            if self.stop.is_cancelled() {
+            if self.stopped() {
                 return;
             }
             if let Some(g) = Group::new(p.iter().map(|p| (p.x, p.y, p.z)), false) {
-                let v = self.shade_group(a, &g);
+                let v = self.shade_counted(a, &g);
                 o.copy_from_slice(&v[..o.len()]);
             }
         }

@@ -265,6 +265,7 @@ impl Kernel {
             max_on_light: 2.0 * hierarchy.map_or(0.0, |h| h.max_texel_on_light),
             plane_wr: None,
             stop: crate::cancel::current(),
+            meter: super::meter::current_meter(),
         }
     }
 

@@ -162,6 +162,9 @@ pub(super) struct Kernel {
     /// The call's cancellation (`crate::cancel`), read where the kernel is
     /// made: a cancelled call's remaining groups are skipped.
     pub(super) stop: crate::cancel::Token,
+    /// The visits' meter of the call (`work::metered`), read where the
+    /// kernel is made: once past its limit, the remaining groups are skipped.
+    pub(super) meter: Option<std::sync::Arc<super::meter::Meter>>,
 }
 
 /// Up to LANES receivers shaded together. Inactive lanes (no receiver) have

@@ -17,12 +17,14 @@
 //! receivers and the per-group loops; `hierarchy.rs`: the occluder pyramid
 //! (built in `Kernel::new`) and the level choice; `traverse.rs`: the
 //! traversal over occluder texels for one group; `simd.rs`: the runtime
-//! dispatch.
+//! dispatch; `work.rs`: what a call's visits cost and may cost; `meter.rs`:
+//! the count of them as they are made.
 
 pub mod corners;
 mod group;
 mod hierarchy;
 mod kernel;
+pub mod meter;
 mod simd;
 mod traverse;
 pub mod work;
@@ -48,6 +50,9 @@ pub(super) fn visibility_map<A: Accumulator>(
         k.set_plane(inputs.receiver);
     }
     let w = k.rec_width;
+    if let Some(m) = &k.meter {
+        m.plan(w.div_ceil(TILE_W) * (inputs.grid.len() / w.max(1)).div_ceil(ROWS_PER_GROUP));
+    }
     let mut out = vec![1f32; inputs.grid.len()];
     out.par_chunks_mut(w * ROWS_PER_GROUP)
         .zip(inputs.receiver.par_chunks(w * ROWS_PER_GROUP))
@@ -145,6 +150,9 @@ pub(super) fn visibility_points<A: Accumulator>(
     hierarchy: Option<Hierarchy>,
 ) -> Vec<f32> {
     let k = Kernel::new(inputs, hierarchy, A::CORNERS);
+    if let Some(m) = &k.meter {
+        m.plan(points.len().div_ceil(LANES));
+    }
     // Shade neighbours together: sort the points by the texel they fall in,
     // so that each group's union of extents stays small.
     let order = point_order(&inputs.occluder_grid, points);

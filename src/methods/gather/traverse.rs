@@ -10,7 +10,14 @@ impl Kernel {
     /// Adds one layer's micro-patches to `acc` for each lane, visiting rows
     /// outward and stopping when every lane is fully occluded.
     #[inline(always)]
-    fn add_layer<A: Accumulator>(&self, a: &A, acc: &mut A::State, li: usize, g: &Group) {
+    fn add_layer<A: Accumulator>(
+        &self,
+        a: &A,
+        acc: &mut A::State,
+        li: usize,
+        g: &Group,
+        visits: &mut u64,
+    ) {
         let Some(level) = self.level_for(li, g) else {
             return;
         };
@@ -29,7 +36,7 @@ impl Kernel {
                 if j as isize > j_lo && layer.row_batch[j] != layer.row_batch[j - 1] {
                     a.end_batch(acc);
                 }
-                if self.add_row(a, acc, lv, layer, j, g) {
+                if self.add_row(a, acc, lv, layer, j, g, visits) {
                     a.end_row(acc);
                     if a.full(acc, g) {
                         return;
@@ -45,7 +52,8 @@ impl Kernel {
         while up >= j_lo || down <= j_hi {
             let mut touched = false;
             for j in [up, down] {
-                if j >= j_lo && j <= j_hi && self.add_row(a, acc, lv, layer, j as usize, g) {
+                if j >= j_lo && j <= j_hi && self.add_row(a, acc, lv, layer, j as usize, g, visits)
+                {
                     a.end_row(acc);
                     touched = true;
                 }
@@ -59,8 +67,10 @@ impl Kernel {
     }
 
     /// Adds occluder row j's micro-patches to every lane; false when the row
-    /// cannot reach any lane.
+    /// cannot reach any lane. Counts into `visits` one for the row and one
+    /// per texel of its trimmed run (`work::Meter`).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn add_row<A: Accumulator>(
         &self,
         a: &A,
@@ -69,6 +79,7 @@ impl Kernel {
         layer: &Layer,
         j: usize,
         g: &Group,
+        visits: &mut u64,
     ) -> bool {
         let span = layer.rows[j];
         if span.first >= span.last || span.w_max <= g.wr_min {
@@ -121,10 +132,12 @@ impl Kernel {
         while b_hi > b_lo && !reaches(b_hi - 1) {
             b_hi -= 1;
         }
+        *visits += 1;
         if b_lo == b_hi {
             return true;
         }
         let (s, e) = ((b_lo * BLOCK).max(i_lo), (b_hi * BLOCK).min(i_hi));
+        *visits += (e - s) as u64;
         // w <= wr_min: empty, or behind every lane's receiver.
         if A::CORNERS {
             let (r0, r1) = (j * lv.width + s, j * lv.width + e);
@@ -175,11 +188,11 @@ impl Kernel {
 
     /// Visibility per lane, the layers merged as the accumulator says.
     #[inline(always)]
-    pub(super) fn shade_group<A: Accumulator>(&self, a: &A, g: &Group) -> Lanes {
+    pub(super) fn shade_group<A: Accumulator>(&self, a: &A, g: &Group, visits: &mut u64) -> Lanes {
         let occ = if A::LAYERS_SHARE_STATE {
             let mut acc = a.empty();
             for li in (0..self.levels[0].layers.len()).rev() {
-                self.add_layer(a, &mut acc, li, g);
+                self.add_layer(a, &mut acc, li, g, visits);
                 if a.full(&acc, g) {
                     break;
                 }
@@ -194,7 +207,7 @@ impl Kernel {
             let mut occ = [0f32; LANES];
             for li in (0..self.levels[0].layers.len()).rev() {
                 let mut acc = a.empty();
-                self.add_layer(a, &mut acc, li, g);
+                self.add_layer(a, &mut acc, li, g, visits);
                 let o = a.occlusion(&acc);
                 for l in 0..LANES {
                     occ[l] = occ[l].max(o[l]);

@@ -15,10 +15,10 @@
 //! is the whole map (a 179° sun).
 
 use super::kernel::LANES;
-use crate::error::{Error, Result};
+use crate::error::Error;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::methods::pcss::nearest_depth;
+use crate::methods::inputs::MIN_RECEIVERS;
 use crate::methods::{LightPoint, Method, ShadowInputs};
 use rayon::prelude::*;
 
@@ -31,23 +31,39 @@ use rayon::prelude::*;
 /// 0.0293 -> 0.0330), because the bound predicts time poorly: 3.6 ns (a
 /// shelf) to 210 ns (a closed box) of `bitmask` per bounded visit. What it
 /// still catches grows with the square of the pixels: a camera inside a
-/// closed box at 1080p.
+/// closed box at 1080p. What bounds a call is the count of the visits it
+/// makes (`meter::Meter`, `VISITS_PER_RECEIVER`), not this prediction.
 pub const PLANNED_VISITS: f64 = 6e8;
 
-/// The most weighted visits a call may be asked to make by the map size its
-/// caller set: past it the call is refused (`check_visits`). A 179° sun's
-/// bitmask light view at 512² bounds 1.9e9 (118 s); at 256², 1.2e8 (11 s),
-/// which runs.
-pub const MAX_VISITS: f64 = 1.5e9;
+/// The weighted visits (`visit_cost`) a call may make per receiver it
+/// shades, counted as they are made (`meter::Meter`), with at least
+/// `inputs::MIN_RECEIVERS` receivers' worth: so the work a call may do grows
+/// with its answer, not with a map size or sample count that no answer
+/// needs. A weighted visit took 50-250 ns on 2 cores (every method, map
+/// and light measured; 230 ns on the as-built blinds), and a stopped call
+/// up to 320 ns a weighted visit of the limit, its maps' rasterizing and
+/// set-up included (benchmarks/calibrate_visits.py: a closed room with
+/// 5600² maps), twice that on one core (`threads=1`, fuzz seed 14 call
+/// 393): so the floor, 7.7e7 weighted visits, stops a call within about
+/// 25 s on 2 cores and 50 s on one. The as-built scenes' calls (640x480,
+/// `ssm` and `bitmask`, calibration and held out) count at most 7.0e7 (the
+/// held-out blinds' bitmask, 16 s), which it leaves as they were; the count
+/// does not depend on the machine. A call past it is stopped: refused
+/// naming the option that set its map size, or where the map was fitted to
+/// the pixels, run again on a coarser one (`pipeline::eye_view`).
+pub const VISITS_PER_RECEIVER: f64 = 250.0;
 
 /// What one visit of `method`'s kernel costs, in visits of `bitmask` with
-/// 256 samples: its masks' words (the 1 024-sample bitmask of 6 layers on
-/// 355x715 maps took 44 s where the bound was counted unweighted); `ssm`
-/// sums a number per lane, about a twentieth of the 256-sample mask's time
-/// on the closed box (counted as an eighth).
+/// 256 samples, as measured per counted visit (benchmarks/calibrate_visits.py,
+/// on 2 cores): about 200 ns for the bitmask's masks of up to 256 samples
+/// (16 and 64 samples cost as much: the kernel's masks are 256 bits), 1.5-2.3
+/// us for 1 024 samples' (counted as 12), 7-11 ns for `ssm`'s sums: counted
+/// as an eighth, above what it measures, which is the weight the plan's
+/// threshold (`PLANNED_VISITS`) was judged with on the as-built scenes.
 pub fn visit_cost(method: Method) -> f64 {
     match method {
-        Method::Bitmask { samples, .. } => (samples as f64 / 256.0).max(0.25),
+        Method::Bitmask { samples, .. } if samples > 256 => 12.0,
+        Method::Bitmask { .. } => 1.0,
         _ => 0.125,
     }
 }
@@ -87,56 +103,38 @@ pub fn visits_bound(
     per_receiver / LANES as f64 * layers as f64
 }
 
-/// Refuses, naming `occluder_resolution`, a call of a gather kernel whose
-/// visits `visits_bound` puts over `MAX_VISITS` (weighted by `visit_cost`
-/// of `method`), from its inputs: the
-/// nearest occluder texel of its layers, and the receivers `points` (None:
-/// the receiver map's texels). The eye view plans its fitted maps under the
-/// bound first (`eye::gather_budget`, with a margin): this refuses the maps
-/// a light view was asked for.
-pub fn check_visits(
+/// The raw visits (`meter::Meter`) a call of `method` shading `receivers`
+/// receivers may make: `VISITS_PER_RECEIVER` each (at least
+/// `MIN_RECEIVERS`), weighted by `visit_cost`.
+pub fn visit_limit(method: Method, receivers: usize) -> u64 {
+    (VISITS_PER_RECEIVER * receivers.max(MIN_RECEIVERS) as f64 / visit_cost(method)) as u64
+}
+
+/// The refusal of a call of `method` whose kernel passed `visit_limit`,
+/// naming `arg`, the option whose map size drove the visits; `estimated`:
+/// the raw visits the whole call was estimated at (`meter::Count`).
+pub fn refusal(
     method: Method,
     inputs: &ShadowInputs,
-    points: Option<&[LightPoint]>,
-) -> Result<()> {
-    let z_near = inputs
-        .occluder_layers
-        .iter()
-        .map(|l| nearest_depth(l))
-        .fold(f32::INFINITY, f32::min) as f64;
-    if !z_near.is_finite() {
-        return Ok(());
-    }
-    let layers = inputs.occluder_layers.len();
-    let (g, og) = (&inputs.grid, &inputs.occluder_grid);
-    let visits = visit_cost(method)
-        * match points {
-            Some(p) => visits_bound(og, inputs.light_shape, z_near, layers, p),
-            None => {
-                let texels: Vec<LightPoint> = (0..g.len())
-                    .into_par_iter()
-                    .map(|k| LightPoint {
-                        x: g.x_of(k % g.width) as f32,
-                        y: g.y_of(k / g.width) as f32,
-                        z: inputs.receiver.get(k).copied().unwrap_or(f32::INFINITY),
-                    })
-                    .collect();
-                visits_bound(og, inputs.light_shape, z_near, layers, &texels)
-            }
-        };
-    if visits > MAX_VISITS {
-        return Err(Error::invalid(
-            "occluder_resolution",
-            format!(
-                "{}x{} occluder maps: the light reaches so far across them that the kernel \
-                 would visit about {visits:.1e} texels, more than the {MAX_VISITS:.1e} a call \
-                 may make; set a coarser occluder_resolution (the output keeps its \
-                 resolution: so wide a light casts only wide shadows), or use method=\"exact\"",
-                og.width, og.height
-            ),
-        ));
-    }
-    Ok(())
+    receivers: usize,
+    arg: &str,
+    estimated: f64,
+) -> Error {
+    let limit = visit_limit(method, receivers) as f64;
+    let og = &inputs.occluder_grid;
+    Error::too_costly(
+        arg,
+        format!(
+            "{}x{} occluder maps: the light reaches so far across them that the kernel \
+             visited more texels than a call with {receivers} receivers may ({:.1e}: \
+             {VISITS_PER_RECEIVER} a receiver, at least {MIN_RECEIVERS} receivers' worth, \
+             weighted by the method's cost per texel) and was stopped; set a coarser {arg} \
+             (so wide a light casts only wide shadows: a coarser map loses little), fewer \
+             samples, or use method=\"exact\"",
+            og.width, og.height, limit,
+        ),
+        estimated / limit,
+    )
 }
 
 #[cfg(test)]
