@@ -435,7 +435,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         x1: f32,
         r: &RowLanes,
         g: &Group,
-    ) {
+    ) -> bool {
         let b = self.p.bounds(w - g.wr[0]);
         let (mut xa, mut xb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for c in 0..TILE_W {
@@ -445,7 +445,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         // The rows' ranges only for a micro-patch that reaches a column.
         let x = Ranks::new(&b, &xa, &xb);
         if x.empty() {
-            return;
+            return false;
         }
         let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for row in 0..ROWS_PER_GROUP {
@@ -454,6 +454,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
             yb[row] = r.ay1[l];
         }
         self.mark_ranks(acc, &x, &Ranks::new(&b, &ya, &yb));
+        true
     }
 
     /// The quad [x0, x1] x (row) with corner 1/depths `c` ([top-left,
@@ -509,7 +510,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         x1: f32,
         r: &RowLanes,
         _g: &Group,
-    ) {
+    ) -> bool {
         let b = self.p.scaled(1.0);
         // The corners' projections per column, then per row, four columns
         // (rows) to a vector: written column by column, the compiler packed
@@ -528,7 +529,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
         // The rows' spans only for a quad that reaches a column.
         let x = Ranks::new(&b, &xa, &xb);
         if x.empty() {
-            return;
+            return false;
         }
         let (mut ya, mut yb) = ([0f32; TILE_W], [0f32; TILE_W]);
         for h in 0..ROWS_PER_GROUP / 4 {
@@ -550,6 +551,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
             hi.write_to_slice(&mut yb[4 * h..]);
         }
         self.mark_ranks(acc, &x, &Ranks::new(&b, &ya, &yb));
+        true
     }
 
     fn full(&self, acc: &Self::State, g: &Group) -> bool {

@@ -186,7 +186,7 @@ impl Accumulator for Sum {
         x1: f32,
         r: &RowLanes,
         g: &Group,
-    ) {
+    ) -> bool {
         let d = w - g.wr[0];
         let dd = d.mul_add(d, D2_MIN);
         let cx: [f32; TILE_W] =
@@ -200,6 +200,7 @@ impl Accumulator for Sum {
                 acc.open[row * TILE_W + c] += x * y;
             }
         }
+        true
     }
 
     /// The gather calls `full` after every row it shades: the row's sums

@@ -34,7 +34,9 @@ pub(in crate::methods) trait Accumulator: Sync {
     /// column) whose receivers share one depth, as on a floor facing the
     /// light: lanes in a column then share x, lanes in a row share y, and a
     /// method may work per column and per row instead of per lane. Must give
-    /// the same bits as `add_texel`.
+    /// the same bits as `add_texel`. Returns whether it did the work of a
+    /// full visit, false where it found early that the micro-patch reaches
+    /// no lane (what the visits' count charges: `meter.rs`).
     #[inline(always)]
     fn add_texel_tile(
         &self,
@@ -44,8 +46,9 @@ pub(in crate::methods) trait Accumulator: Sync {
         x1: f32,
         row: &RowLanes,
         g: &Group,
-    ) {
-        self.add_texel(acc, w, x0, x1, row, g)
+    ) -> bool {
+        self.add_texel(acc, w, x0, x1, row, g);
+        true
     }
     /// Whether the micro-patches are connected quads (`corners.rs`): the
     /// traversal then calls `add_quad` with each texel's corner 1/depths
@@ -68,7 +71,8 @@ pub(in crate::methods) trait Accumulator: Sync {
         self.add_texel(acc, w, x0, x1, row, g)
     }
     /// `add_quad` for a whole tile on one depth (as `add_texel_tile`), with
-    /// the corners' `corners::corner_invs` for the tile's receiver depth.
+    /// the corners' `corners::corner_invs` for the tile's receiver depth;
+    /// returns as `add_texel_tile` does.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn add_quad_tile(
@@ -81,8 +85,9 @@ pub(in crate::methods) trait Accumulator: Sync {
         x1: f32,
         row: &RowLanes,
         g: &Group,
-    ) {
-        self.add_quad(acc, w, c, x0, x1, row, g)
+    ) -> bool {
+        self.add_quad(acc, w, c, x0, x1, row, g);
+        true
     }
 }
 

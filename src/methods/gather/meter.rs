@@ -7,8 +7,12 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// The visits a running kernel has made, counted where it makes them
-/// (`traverse.rs`: each occluder row's run of texels, plus one for the
-/// row), against the most it may make. The prediction (`work::visits_bound`)
+/// (`traverse.rs` `add_row`: one a row, one a texel shaded lane by lane or
+/// shaded for a whole tile where the method did its work, an eighth where
+/// it found early that the micro-patch reaches no lane), against the most
+/// it may make. Counting that early exit matters: on the fence's light view
+/// (1 024 samples, 512² maps) most tile visits end there, and charged in
+/// full they counted 3.3x the visits that cost the time. The prediction (`work::visits_bound`)
 /// decides how fine a fitted map may be; this decides whether a call
 /// finishes. The
 /// count of a call does not depend on the order its groups run in (each

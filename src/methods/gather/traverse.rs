@@ -67,8 +67,8 @@ impl Kernel {
     }
 
     /// Adds occluder row j's micro-patches to every lane; false when the row
-    /// cannot reach any lane. Counts into `visits` one for the row and one
-    /// per texel of its trimmed run (`work::Meter`).
+    /// cannot reach any lane. Counts into `visits` one for the row and the
+    /// visits its texels made (`meter.rs`).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn add_row<A: Accumulator>(
@@ -137,7 +137,12 @@ impl Kernel {
             return true;
         }
         let (s, e) = ((b_lo * BLOCK).max(i_lo), (b_hi * BLOCK).min(i_hi));
-        *visits += (e - s) as u64;
+        // The count (`meter.rs`): a texel shaded lane by lane is a full
+        // visit; one shaded for a whole tile is, where the method did its
+        // work (`add_texel_tile`), else an eighth (it found early that the
+        // micro-patch reaches no lane).
+        let mut full = 0u64;
+        let mut tile = 0u64;
         // w <= wr_min: empty, or behind every lane's receiver.
         if A::CORNERS {
             let (r0, r1) = (j * lv.width + s, j * lv.width + e);
@@ -158,31 +163,37 @@ impl Kernel {
                     .zip(corners.iter().zip(&layer.plane_invs[r0..r1]))
                     .filter(|((&w, _), _)| w > g.wr_min);
                 for ((&w, &x0), (c, inv)) in quads {
-                    a.add_quad_tile(acc, w, c, inv, x0, x0 + wx, &rl, g);
+                    tile += 1;
+                    full += a.add_quad_tile(acc, w, c, inv, x0, x0 + wx, &rl, g) as u64;
                 }
             } else if g.uniform_tile {
                 let wr = g.wr[0];
                 for ((&w, &x0), c) in quads {
                     let inv = super::corners::corner_invs(c, wr, w - wr);
-                    a.add_quad_tile(acc, w, c, &inv, x0, x0 + wx, &rl, g);
+                    tile += 1;
+                    full += a.add_quad_tile(acc, w, c, &inv, x0, x0 + wx, &rl, g) as u64;
                 }
             } else {
                 for ((&w, &x0), c) in quads {
+                    full += 1;
                     a.add_quad(acc, w, c, x0, x0 + wx, &rl, g);
                 }
             }
-            return true;
-        }
-        let texels = row[s..e].iter().zip(&lv.col_x0_scaled[s..e]);
-        if g.uniform_tile {
-            for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
-                a.add_texel_tile(acc, w, x0, x0 + wx, &rl, g);
-            }
         } else {
-            for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
-                a.add_texel(acc, w, x0, x0 + wx, &rl, g);
+            let texels = row[s..e].iter().zip(&lv.col_x0_scaled[s..e]);
+            if g.uniform_tile {
+                for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
+                    tile += 1;
+                    full += a.add_texel_tile(acc, w, x0, x0 + wx, &rl, g) as u64;
+                }
+            } else {
+                for (&w, &x0) in texels.filter(|(&w, _)| w > g.wr_min) {
+                    full += 1;
+                    a.add_texel(acc, w, x0, x0 + wx, &rl, g);
+                }
             }
         }
+        *visits += full + (tile - full.min(tile)) / 8;
         true
     }
 
