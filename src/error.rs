@@ -17,10 +17,9 @@ pub enum Error {
     #[error("{arg}: {msg}")]
     TooLarge { arg: String, msg: String },
     /// A call whose kernel counted more work than a call may do, stopped
-    /// (`methods::bounded`); `arg` names the option whose size drove it,
-    /// `over` how many times the limit the whole call was estimated at.
+    /// (`methods::bounded`); `arg` names the option whose size drove it.
     #[error("{arg}: {msg}")]
-    TooCostly { arg: String, msg: String, over: f64 },
+    TooCostly { arg: String, msg: String },
     /// `backend="gpu"` was asked for and no GPU adapter can be opened (none
     /// present, no driver, or switched off by SOFTSHADOW_GPU=off).
     #[error("no GPU available: {msg}")]
@@ -53,11 +52,10 @@ impl Error {
     pub fn gpu(msg: impl Into<String>) -> Self {
         Error::Gpu { msg: msg.into() }
     }
-    pub fn too_costly(arg: impl Into<String>, msg: impl Into<String>, over: f64) -> Self {
+    pub fn too_costly(arg: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::TooCostly {
             arg: arg.into(),
             msg: msg.into(),
-            over,
         }
     }
     pub fn too_large(arg: impl Into<String>, msg: impl Into<String>) -> Self {

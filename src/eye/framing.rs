@@ -271,25 +271,25 @@ pub fn map_grid(
     })
 }
 
-/// `plan` coarser, over the same extent: the fitted plan whose kernel
-/// passed its visits' limit (`methods::bounded`), estimated at `over` times
-/// it, runs again on it. The visits fall about as the texels, the square of
-/// the side: the side is scaled by 0.8 / sqrt(over) (a margin for the
-/// estimate, from the groups shaded before the stop), and at least halved.
-/// None where the call set the map size (the refusal stands) or the plan
-/// is already 1x1.
-pub fn coarser(
-    call: &EyeCall,
-    plan: &MapPlan,
-    over: f64,
-    backend: Backend,
-) -> Result<Option<MapPlan>> {
+/// The side of a retried fitted plan, relative to the stopped one's.
+const RETRY_SCALE: f64 = 0.35;
+
+/// `plan` at 0.35 of its resolution a side (an eighth of the texels), over
+/// the same extent: the fitted plan whose kernel passed its visits' limit
+/// (`methods::bounded`) runs again on it (its visits fall about as the
+/// texels, so one retry covers an overrun up to about 8x, where halving took
+/// two on the closed room with 1 024 samples). A fixed factor, not
+/// one from an estimate of the overrun: how many groups a stopped kernel
+/// shaded depends on the threads, and the map, hence the result, must
+/// not. None
+/// where the call set the map size (the refusal stands) or the plan is
+/// already 1x1.
+pub fn coarser(call: &EyeCall, plan: &MapPlan, backend: Backend) -> Result<Option<MapPlan>> {
     let (w, h) = plan.resolution;
     if call.map_resolution.is_some() || call.method.occluder_resolution().is_some() || w * h <= 1 {
         return Ok(None);
     }
-    let scale = (0.8 / over.max(1.0).sqrt()).min(0.5);
-    let side = |n: usize| ((n as f64 * scale) as usize).max(1);
+    let side = |n: usize| ((n as f64 * RETRY_SCALE) as usize).max(1);
     let resolution = (side(w), side(h));
     let (grid, method) = grid_at(call, resolution, [plan.grid.tx, plan.grid.ty], backend)?;
     Ok(Some(MapPlan {

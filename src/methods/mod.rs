@@ -254,7 +254,7 @@ pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
 /// or a method's own entry), refusing a call whose cost grows with a
 /// parameter rather than with what the answer needs: PCSS's texel reads,
 /// bounded before any receiver is shaded (`Pcss::check_reads`); the gather
-/// kernels' visits, counted as they are made (`gather::work::metered`) and
+/// kernels' visits, counted as they are made (`gather::meter::metered`) and
 /// stopped past `gather::work::visit_limit` (a number a receiver),
 /// naming `arg`, the option whose size drove them. `pts`: the receivers,
 /// or None for the receiver map's texels.
@@ -276,10 +276,9 @@ pub fn bounded<T>(
                 None => inputs.receiver.iter().filter(|&&z| is_receiver(z)).count(),
             };
             let limit = gather::work::visit_limit(method, receivers);
-            let (v, count) = gather::meter::metered(limit, shade);
-            if count.visits > limit {
-                let e = gather::work::refusal(method, inputs, receivers, arg, count.estimated);
-                return Err(e);
+            let (v, visits) = gather::meter::metered(limit, shade);
+            if visits > limit {
+                return Err(gather::work::refusal(method, inputs, receivers, arg));
             }
             Ok(v)
         }

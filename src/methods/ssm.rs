@@ -843,16 +843,9 @@ mod tests {
             .num_threads(threads)
             .build()
             .unwrap();
-        let (v, count) = pool.install(|| {
+        pool.install(|| {
             crate::methods::gather::meter::metered(limit, || Ssm::default().visibility_map(&inputs))
-        });
-        if count.visits <= limit {
-            assert_eq!(count.estimated, count.visits as f64);
-        } else {
-            // Stopped: the total is estimated from the groups shaded.
-            assert!(count.estimated > count.visits as f64, "{count:?}");
-        }
-        (v, count.visits)
+        })
     }
 
     #[test]

@@ -178,12 +178,10 @@ pub fn render_with<S: EyeStages>(
         // (`methods::bounded`).
         let (v, m) = loop {
             match stages.shade_maps(call, &f, &tris, plan.grid, &plan.method, &mut sw) {
-                Err(e @ Error::TooCostly { over, .. }) => {
-                    match coarser(call, &plan, over, S::BACKEND)? {
-                        Some(p) => plan = p,
-                        None => return Err(e),
-                    }
-                }
+                Err(e @ Error::TooCostly { .. }) => match coarser(call, &plan, S::BACKEND)? {
+                    Some(p) => plan = p,
+                    None => return Err(e),
+                },
                 r => break r?,
             }
         };

@@ -162,7 +162,7 @@ def test_a_fitted_map_past_the_work_bound_runs_again_coarser(closed_room):
     # 1 024 samples inside a closed room: the work bound the fitted maps are
     # planned under (a prediction) gives 334x324 at 640x480, whose kernel
     # passes the visits' limit; stopped there, the call runs again on maps
-    # coarser by the overrun it estimated (131x127; 19.5 s on 2 cores in all),
+    # 0.35 as fine a side (116x113; 17.9 s on 2 cores in all),
     # and is not refused: the user set no size.
     img = _room_call(closed_room, 640, 480, method=ss.Bitmask(samples=1024))
     w, h = img.method.occluder_resolution

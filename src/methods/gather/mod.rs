@@ -50,9 +50,6 @@ pub(super) fn visibility_map<A: Accumulator>(
         k.set_plane(inputs.receiver);
     }
     let w = k.rec_width;
-    if let Some(m) = &k.meter {
-        m.plan(w.div_ceil(TILE_W) * (inputs.grid.len() / w.max(1)).div_ceil(ROWS_PER_GROUP));
-    }
     let mut out = vec![1f32; inputs.grid.len()];
     out.par_chunks_mut(w * ROWS_PER_GROUP)
         .zip(inputs.receiver.par_chunks(w * ROWS_PER_GROUP))
@@ -150,9 +147,6 @@ pub(super) fn visibility_points<A: Accumulator>(
     hierarchy: Option<Hierarchy>,
 ) -> Vec<f32> {
     let k = Kernel::new(inputs, hierarchy, A::CORNERS);
-    if let Some(m) = &k.meter {
-        m.plan(points.len().div_ceil(LANES));
-    }
     // Shade neighbours together: sort the points by the texel they fall in,
     // so that each group's union of extents stays small.
     let order = point_order(&inputs.occluder_grid, points);

@@ -111,15 +111,8 @@ pub fn visit_limit(method: Method, receivers: usize) -> u64 {
 }
 
 /// The refusal of a call of `method` whose kernel passed `visit_limit`,
-/// naming `arg`, the option whose map size drove the visits; `estimated`:
-/// the raw visits the whole call was estimated at (`meter::Count`).
-pub fn refusal(
-    method: Method,
-    inputs: &ShadowInputs,
-    receivers: usize,
-    arg: &str,
-    estimated: f64,
-) -> Error {
+/// naming `arg`, the option whose map size drove the visits.
+pub fn refusal(method: Method, inputs: &ShadowInputs, receivers: usize, arg: &str) -> Error {
     let limit = visit_limit(method, receivers) as f64;
     let og = &inputs.occluder_grid;
     Error::too_costly(
@@ -133,7 +126,6 @@ pub fn refusal(
              samples, or use method=\"exact\"",
             og.width, og.height, limit,
         ),
-        estimated / limit,
     )
 }
 
