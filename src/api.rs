@@ -12,15 +12,16 @@
 use crate::backend::{Backend, BackendChoice};
 use crate::error::{Error, Result};
 use crate::error_estimate::Draw;
-use crate::eye::{EyeCall, EyeImage, Lighting, Shaded};
+use crate::eye::albedo::{albedo_image, Material};
+use crate::eye::{EyeCall, EyeImage, Lighting, Shaded, MAX_LIGHTS};
 use crate::frame::{orthographic_maps, MapSettings, ShadowResult};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::geom::light_space::{Light, LightSpace};
+use crate::geom::light_space::{sphere_has_no_space, Light, LightSpace};
 use crate::geom::mesh::MeshRef;
 use crate::methods::config::{check_resolution, CallContext};
-use crate::methods::AutoConfig;
 use crate::methods::MethodConfig;
+use crate::methods::{AutoConfig, ExactConfig};
 use crate::pipeline;
 use crate::threads;
 use crate::timing::Timings;
@@ -39,6 +40,55 @@ fn pick(choice: BackendChoice, method: &MethodConfig, gpu: CallContext, light_ok
                 Backend::Cpu
             }
         }
+    }
+}
+
+/// The config a call on `light` runs. A rectangle or the sun take every
+/// method; a disk or a sphere take those that can shade them
+/// (`Method::refuses_shape`; a sphere has no light space, so not
+/// ShadowMapping either): "auto" without a target runs `traced` (the
+/// view's `exact` default), a method that cannot is refused naming
+/// `method` and why. A target stays in the eye view (`plan_eye` plans
+/// `exact` for it) and is refused in the light view, whose planner plans
+/// maps.
+fn for_light(
+    method: MethodConfig,
+    light: &Light,
+    traced: ExactConfig,
+    eye: bool,
+) -> Result<MethodConfig> {
+    let shape = light.kernel_shape();
+    if matches!(shape, LightShape::Rect { .. }) {
+        return Ok(method);
+    }
+    let name = light.name();
+    match method {
+        MethodConfig::Auto(a) if a.target.is_none() => Ok(MethodConfig::Exact(traced)),
+        // A target is checked against the run's error estimate, which a
+        // sphere's rays do not make (`pipeline::eye_view::render_sphere`).
+        MethodConfig::Auto(_) if matches!(light, Light::Sphere(_)) => Err(Error::invalid(
+            "method",
+            "Auto with a target checks the image's error estimate, which a SphereLight's rays \
+             do not make in this version; pass method=\"exact\" (Exact(samples=...))",
+        )),
+        MethodConfig::Auto(_) if eye => Ok(method),
+        MethodConfig::Auto(_) => Err(Error::invalid(
+            "method",
+            format!(
+                "Auto with a target plans light-view maps, which a {name} does not take; pass \
+                 method=\"exact\" (Exact(samples=...))"
+            ),
+        )),
+        MethodConfig::ShadowMapping(_) if matches!(light, Light::Sphere(_)) => {
+            Err(sphere_has_no_space())
+        }
+        m => match m.kernel().refuses_shape(&shape) {
+            Some(why) => Err(Error::invalid(
+                "method",
+                format!("{:?} cannot shade a {name}: it {why}", m.name()),
+            )),
+            None => Ok(m),
+        },
     }
 }
 
@@ -89,6 +139,10 @@ pub struct MeshCall<'a> {
 /// Meshes -> light-view maps -> visibility, on the chosen backend.
 pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
     let (w, h) = check_resolution("resolution", call.resolution)?;
+    let call = &MeshCall {
+        method: for_light(call.method, call.light, ExactConfig::default(), false)?,
+        ..*call
+    };
     let cap = threads::resolve(call.threads)?;
     let ctx = CallContext {
         backend: Backend::Cpu,
@@ -221,6 +275,10 @@ pub struct SceneCall<'a> {
 /// does not cover yet).
 pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
     let (w, h) = check_resolution("resolution", call.resolution)?;
+    let call = &SceneCall {
+        method: for_light(call.method, call.light, ExactConfig::default(), false)?,
+        ..*call
+    };
     let cap = threads::resolve(call.threads)?;
     if call.backend == BackendChoice::Gpu {
         return Err(Error::invalid(
@@ -392,6 +450,20 @@ pub fn sample_points(
 /// takes any light).
 pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
     let cap = threads::resolve(call.threads)?;
+    if let Light::Sphere(s) = call.light {
+        if !s.is_outside(call.camera.eye) {
+            return Err(Error::invalid(
+                "light",
+                format!(
+                    "the camera's eye {:?} lies inside the SphereLight (centre {:?}, radius {}): \
+                     it would see only the light",
+                    call.camera.eye.to_array(),
+                    s.center.to_array(),
+                    s.radius
+                ),
+            ));
+        }
+    }
     if let Some(r) = call.map_resolution {
         check_resolution("map_resolution", r)?;
     }
@@ -407,15 +479,16 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         call.backend,
         &call.method,
         gpu,
-        hard_ok || !call.light.is_hard(),
+        (hard_ok || !call.light.is_hard()) && !matches!(call.light, Light::Sphere(_)),
     );
     // The default call (`Auto`, nothing given) traces (`eye_default`).
     let default = MethodConfig::Auto(AutoConfig::default());
+    let traced = crate::methods::auto_config::eye_default(backend);
     let call = &EyeCall {
         method: if call.method == default {
-            MethodConfig::Exact(crate::methods::auto_config::eye_default(backend))
+            MethodConfig::Exact(traced)
         } else {
-            call.method
+            for_light(call.method, call.light, traced, true)?
         },
         ..*call
     };
@@ -429,6 +502,11 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
                 target: Default::default(),
                 ..a
             }),
+            call.light.name(),
+            MethodConfig::Auto(a)
+                .kernel()
+                .refuses_shape(&call.light.kernel_shape())
+                .is_none(),
         )),
         _ => None,
     };
@@ -536,32 +614,95 @@ fn probed(m: MethodConfig, planned: bool, backend: Backend) -> MethodConfig {
 /// `lighting` is checked against the call's light and meshes
 /// (`Lighting::new`).
 pub fn render_shaded(call: &EyeCall, lighting: &Lighting) -> Result<(Run<EyeImage>, Shaded)> {
-    if lighting.albedo.len() != call.meshes.len() {
+    let mut runs = render_lights(call, &[(*call.light, lighting.clone())], &[])?;
+    Ok(runs.remove(0))
+}
+
+/// Several lights seen through one camera: each light's call (`call` with
+/// that light) run as `render` runs one, planned on its own (its own
+/// method, maps focused on what it lights), the first light's first hits
+/// shared by the others (`EyeCall::gbuffer`); then each shaded (shading.rs)
+/// on the CPU whatever the backend, timed as `shading`, with one albedo
+/// image: each mesh's material where `materials` has one (albedo.rs,
+/// checked here, named `materials[k]`), else its `Lighting::albedo`. One
+/// image per light, in order; the caller sums their shading. Refuses an
+/// empty list or more than `MAX_LIGHTS` lights, naming `lights`.
+pub fn render_lights(
+    call: &EyeCall,
+    lights: &[(Light, Lighting)],
+    materials: &[Option<Material>],
+) -> Result<Vec<(Run<EyeImage>, Shaded)>> {
+    if lights.is_empty() || lights.len() > MAX_LIGHTS {
+        return Err(Error::invalid(
+            "lights",
+            format!("must hold 1 to {MAX_LIGHTS} lights, got {}", lights.len()),
+        ));
+    }
+    for (_, lighting) in lights {
+        if lighting.albedo.len() != call.meshes.len() {
+            return Err(Error::shape(
+                "albedo",
+                format!(
+                    "{} albedos for {} meshes",
+                    lighting.albedo.len(),
+                    call.meshes.len()
+                ),
+            ));
+        }
+    }
+    if !materials.is_empty() && materials.len() != call.meshes.len() {
         return Err(Error::shape(
-            "albedo",
+            "materials",
             format!(
-                "{} albedos for {} meshes",
-                lighting.albedo.len(),
+                "{} materials for {} meshes",
+                materials.len(),
                 call.meshes.len()
             ),
         ));
     }
+    for (k, (m, mesh)) in materials.iter().zip(call.meshes).enumerate() {
+        if let Some(m) = m {
+            m.check(&format!("materials[{k}]"), mesh)?;
+        }
+    }
     let cap = threads::resolve(call.threads)?;
-    let mut run = render(call)?;
+    let mut runs: Vec<Run<EyeImage>> = Vec::with_capacity(lights.len());
+    for (light, _) in lights {
+        let shared = runs.first().map(|r| &r.output.gbuffer);
+        let c = EyeCall {
+            light,
+            gbuffer: shared,
+            ..*call
+        };
+        let one = render(&c)?;
+        runs.push(one);
+    }
     let t0 = std::time::Instant::now();
-    let img = &run.output;
-    let (shaded, _) = threads::run_capped(cap, || {
-        Ok(crate::eye::shading::shade(
-            call.light,
-            lighting,
-            &img.gbuffer,
-            &img.visibility,
-        ))
+    let g = &runs[0].output.gbuffer;
+    let (albedo, _) = threads::run_capped(cap, || {
+        Ok(albedo_image(g, call.meshes, &lights[0].1.albedo, materials))
     })?;
-    run.output
-        .timings
-        .push(("shading", t0.elapsed().as_secs_f64()));
-    Ok((run, shaded))
+    let albedo_seconds = t0.elapsed().as_secs_f64();
+    let mut out = Vec::with_capacity(runs.len());
+    for (mut run, (light, lighting)) in runs.into_iter().zip(lights) {
+        let t0 = std::time::Instant::now();
+        let img = &run.output;
+        let (shaded, _) = threads::run_capped(cap, || {
+            Ok(crate::eye::shading::shade(
+                light,
+                lighting.emission,
+                &albedo,
+                &img.gbuffer,
+                &img.visibility,
+                img.weighted.as_deref(),
+            ))
+        })?;
+        let seconds =
+            t0.elapsed().as_secs_f64() + if out.is_empty() { albedo_seconds } else { 0.0 };
+        run.output.timings.push(("shading", seconds));
+        out.push((run, shaded));
+    }
+    Ok(out)
 }
 
 /// The error estimate, reported in a plan (`at`: "pixels" or "texels").

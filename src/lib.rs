@@ -8,18 +8,18 @@
 //! ```
 //! use softshadow::api::{shadow_map, MeshCall};
 //! use softshadow::geom::mesh::MeshRef;
-//! use softshadow::{BackendChoice, BitmaskConfig, Light, MethodConfig, RectLight};
+//! use softshadow::{BackendChoice, BitmaskConfig, Light, MethodConfig, AreaLight};
 //!
 //! // A unit plate at height 2 over a floor at 0, lit by a unit light 4 above:
 //! // its umbra on the floor is one unit wide.
 //! let quad = |y: f64, h: f64| [[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
 //! let faces = [[0u32, 1, 2], [0, 2, 3]];
 //! let (plate, floor) = (quad(2.0, 0.5), quad(0.0, 4.0));
-//! let light = RectLight::new([0.0, 4.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0])?;
+//! let light = AreaLight::rect([0.0, 4.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0])?;
 //! let run = shadow_map(&MeshCall {
 //!     occluders: MeshRef { vertices: &plate, faces: &faces },
 //!     receivers: MeshRef { vertices: &floor, faces: &faces },
-//!     light: &Light::Rect(light),
+//!     light: &Light::Area(light),
 //!     resolution: (64, 64),
 //!     extent: None,
 //!     method: MethodConfig::Bitmask(BitmaskConfig::new(Some(64), None, None, None, None)?),
@@ -68,7 +68,7 @@ mod python;
 
 pub use backend::{Backend, BackendChoice};
 pub use error::{Error, Result};
-pub use geom::light::{MapGrid, RectLight};
+pub use geom::light::{AreaLight, MapGrid};
 pub use geom::light_space::{Light, LightSpace};
 pub use geom::sun::DirectionalLight;
 pub use methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};

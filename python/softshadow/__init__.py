@@ -12,7 +12,8 @@ What is exported here lives in modules that say what they hold:
 :mod:`.api` (the calls: ``soft_shadow_map``, ``soft_shadow_map_from_depth``,
 ``render``, ``gpu_available``, ``gpu_info``), :mod:`.results` (``ShadowMap``,
 ``Image``, ``Plan``, ``Decision``, ``ErrorEstimate``), :mod:`.lights` (``RectLight``,
-``DirectionalLight``), :mod:`.scene` (``Scene``, ``Camera``), :mod:`.methods`
+``DiskLight``, ``SphereLight``, ``DirectionalLight``), :mod:`.scene` (``Scene``, ``Camera``), :mod:`.materials`
+(``Material``, the colours ``Scene.from_trimesh`` reads), :mod:`.methods`
 (the configs, ``capabilities``, ``limits``) and :mod:`.errors`. Built-in
 scenes are in :mod:`softshadow.scenes`, files in :mod:`softshadow.io`, error
 metrics in :mod:`softshadow.metrics`, Mitsuba references in
@@ -28,7 +29,8 @@ from ._core import *  # noqa: F403
 from ._core import __version__
 from .api import gpu_available, gpu_info, render, soft_shadow_map, soft_shadow_map_from_depth
 from .errors import GpuUnavailableError, TooLargeError
-from .lights import DirectionalLight, RectLight
+from .lights import DirectionalLight, DiskLight, RectLight, SphereLight
+from .materials import Material
 from .methods import *  # noqa: F403
 from .results import Decision, ErrorEstimate, Image, Plan, ShadowMap
 from .scene import Camera, Scene
@@ -37,13 +39,16 @@ __all__ = [
     "Camera",
     "Decision",
     "DirectionalLight",
+    "DiskLight",
     "ErrorEstimate",
     "GpuUnavailableError",
     "Image",
+    "Material",
     "Plan",
     "RectLight",
     "Scene",
     "ShadowMap",
+    "SphereLight",
     "TooLargeError",
     "gpu_available",
     "gpu_info",

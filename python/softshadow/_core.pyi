@@ -48,6 +48,8 @@ _Light = (
     tuple[_Vec3, _Vec3, _Vec3, tuple[float, float]]
     | tuple[_Vec3, _Vec3, tuple[float, float]]
     | tuple[_Vec3, _Vec3, tuple[float, float], _Vec3, float]
+    | tuple[_Vec3, _Vec3, float]
+    | tuple[_Vec3, float]
 )
 _Resolution = int | tuple[int, int]
 # A grey value or RGB channels.
@@ -334,6 +336,69 @@ class RectLight:
     def __getnewargs_ex__(self) -> tuple[tuple[Any, ...], dict[str, Any]]: ...
 
 @final
+class DiskLight:
+    """A disk-shaped area light (conventions in src/geom/light.rs)."""
+
+    def __new__(
+        cls,
+        center: npt.ArrayLike,
+        normal: npt.ArrayLike,
+        radius: float,
+        *,
+        radiance: _Color | npt.ArrayLike | None = None,
+    ) -> DiskLight: ...
+    @property
+    def center(self) -> tuple[float, float, float]: ...
+    @property
+    def normal(self) -> tuple[float, float, float]: ...
+    @property
+    def radius(self) -> float: ...
+    @property
+    def radiance(self) -> tuple[float, float, float]: ...
+    @property
+    def u(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def v(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def n(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def area(self) -> float: ...
+    def irradiance_at(self, points: npt.ArrayLike, normals: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The unshadowed irradiance (N, 3), RGB: the disk's form factor."""
+    def _core_args(self) -> tuple[_Vec3, _Vec3, float]: ...
+    def _emission(self) -> tuple[float, float, float]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __hash__(self) -> int: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[Any, ...], dict[str, Any]]: ...
+
+@final
+class SphereLight:
+    """A spherical area light (conventions in src/geom/sphere_light.rs)."""
+
+    def __new__(
+        cls,
+        center: npt.ArrayLike,
+        radius: float,
+        *,
+        radiance: _Color | npt.ArrayLike | None = None,
+    ) -> SphereLight: ...
+    @property
+    def center(self) -> tuple[float, float, float]: ...
+    @property
+    def radius(self) -> float: ...
+    @property
+    def radiance(self) -> tuple[float, float, float]: ...
+    @property
+    def area(self) -> float: ...
+    def irradiance_at(self, points: npt.ArrayLike, normals: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The unshadowed irradiance (N, 3), RGB: the visible cap's form factor."""
+    def _core_args(self) -> tuple[_Vec3, float]: ...
+    def _emission(self) -> tuple[float, float, float]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __hash__(self) -> int: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[Any, ...], dict[str, Any]]: ...
+
+@final
 class DirectionalLight:
     """A directional light, the sun (conventions in src/geom/sun.rs)."""
 
@@ -502,6 +567,8 @@ class EyeResult:
     @property
     def unshadowed(self) -> npt.NDArray[np.float32]: ...
     @property
+    def albedo(self) -> npt.NDArray[np.float32]: ...
+    @property
     def depth(self) -> npt.NDArray[np.float32]: ...
     @property
     def position(self) -> npt.NDArray[np.float64]: ...
@@ -560,7 +627,7 @@ class ErrorEstimate:
 
 def render(
     meshes: list[tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]],
-    light: _Light,
+    lights: list[_Light],
     camera: Camera,
     method: _MethodArg,
     *,
@@ -574,15 +641,17 @@ def render(
     precision: str | None = None,
     backend: str = ...,  # "cpu" (shown as ... by the extension: a converted default)
     threads: int | None = None,
-    emission: _Color | None = None,
+    emission: list[_Color | None] | None = None,
     albedo: _Color | list[_Color] | None = None,
     estimate_error: str | None = None,
     prepared: Prepared | None = None,
-) -> EyeResult:
-    """The eye view: first hits, then each pixel's visibility with every mesh
-    casting and receiving, then the shading (``emission`` the light's
-    radiance or irradiance, ``albedo`` per mesh; the core's defaults for
-    None); ``prepared`` keeps what the meshes alone make for the next call."""
+    materials: list[tuple[str, tuple[float, float, float], Any, Any] | None] | None = None,
+) -> list[EyeResult]:
+    """The eye view, one result per light (the first hits shared): first
+    hits, then each pixel's visibility with every mesh casting and
+    receiving, then the shading (``emission`` each light's radiance or
+    irradiance, ``albedo`` per mesh; the core's defaults for None);
+    ``prepared`` keeps what the meshes alone make for the next call."""
 
 @final
 class Prepared:

@@ -33,7 +33,7 @@ import numpy as np
 
 from . import _core
 from . import _validate as check
-from .lights import DirectionalLight, RectLight
+from .lights import LIGHT_TYPES, DirectionalLight, Light, RectLight
 from .methods import MethodConfig
 from .results import Image, ShadowMap, plan_from_core
 from .scene import Camera, Scene
@@ -41,7 +41,7 @@ from .scene import Camera, Scene
 
 def soft_shadow_map(
     scene: Scene,
-    light: RectLight | DirectionalLight,
+    light: Light,
     *,
     resolution: int | tuple[int, int] = 256,
     extent: float | tuple[float, float] | None = None,
@@ -168,8 +168,8 @@ def soft_shadow_map(
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
-    if not isinstance(light, (RectLight, DirectionalLight)):
-        raise TypeError(f"light: must be a softshadow.RectLight or DirectionalLight, got {type(light).__name__}")
+    if not isinstance(light, LIGHT_TYPES):
+        raise TypeError(f"light: must be a softshadow light, got {type(light).__name__}")
     ext = None if extent is None else check.pair("extent", extent)
     (ov, of), (rv, rf) = scene.occluder_mesh, scene.receiver_mesh
     loose: dict[str, Any] = dict(
@@ -322,7 +322,7 @@ def soft_shadow_map_from_depth(
 
 def render(
     scene: Scene,
-    light: RectLight | DirectionalLight,
+    light: Light | list[Light] | tuple[Light, ...],
     camera: Camera,
     method: str | MethodConfig = "auto",
     *,
@@ -340,6 +340,13 @@ def render(
     estimate_error: bool | Literal["timed", "fixed"] = False,
 ) -> Image:
     """Renders the visibility and shaded images of ``scene`` under ``light`` seen by ``camera``.
+
+    ``light`` is one light, or a list of up to ``limits()["lights"]`` lights.
+    With a list each light is rendered as a call with it alone would render
+    it (its own method plan, maps focused on what it lights; the first hits
+    are computed once), ``img.visibility`` is (L, H, W), one channel per
+    light in order, ``shaded`` and ``unshadowed`` are the sums over the
+    lights, and ``img.parts`` holds each light's own image.
 
     Every mesh casts and receives shadows, its own included (the far side of
     a closed mesh is in its own umbra). A :class:`RectLight` lights its
@@ -405,13 +412,13 @@ def render(
     draw = _draw(estimate_error)
     if not isinstance(scene, Scene):
         raise TypeError(f"scene: must be a softshadow.Scene, got {type(scene).__name__}")
-    if not isinstance(light, (RectLight, DirectionalLight)):
-        raise TypeError(f"light: must be a softshadow.RectLight or DirectionalLight, got {type(light).__name__}")
+    several = not isinstance(light, LIGHT_TYPES)
+    lights = _lights(light)
     if not isinstance(camera, Camera):
         raise TypeError(f"camera: must be a softshadow.Camera, got {type(camera).__name__}")
-    r = _core.render(
+    runs = _core.render(
         scene.meshes,
-        light._core_args(),
+        [lt._core_args() for lt in lights],
         camera,
         method,
         map_resolution=map_resolution,
@@ -424,11 +431,49 @@ def render(
         precision=precision,
         backend=backend,
         threads=threads,
-        emission=light._emission(),
+        emission=[lt._emission() for lt in lights],
         albedo=check.color(albedo),
         estimate_error=draw,
         prepared=scene.prepared,
+        materials=_materials(scene),
     )
+    parts = tuple(_image(r, lt, camera) for r, lt in zip(runs, lights, strict=True))
+    if not several:
+        return parts[0]
+    return _sum_of(parts, camera)
+
+
+def _materials(scene: Scene) -> list[Any] | None:
+    """The meshes' materials as the core takes them (a mesh appended to
+    ``scene.meshes`` after the scene was made has none); None when no mesh
+    has one. The core checks each against its mesh, naming
+    ``materials[k]``."""
+    materials = list(scene.materials[: len(scene.meshes)])
+    materials += [None] * (len(scene.meshes) - len(materials))
+    if all(m is None for m in materials):
+        return None
+    return [None if m is None else m.to_core() for m in materials]
+
+
+def _lights(value: Any) -> list[Light]:
+    """One light, or a list or tuple of them, as a list; TypeError or
+    ValueError naming ``light`` (``light[k]``) otherwise."""
+    if isinstance(value, LIGHT_TYPES):
+        return [value]
+    if not isinstance(value, (list, tuple)):
+        raise TypeError(f"light: must be a light or a list of lights, got {type(value).__name__}")
+    if not value:
+        raise ValueError("light: the list of lights is empty")
+    if len(value) > _core.limits()["lights"]:
+        raise ValueError(f"light: at most {_core.limits()['lights']} lights in one call, got {len(value)}")
+    for k, lt in enumerate(value):
+        if not isinstance(lt, LIGHT_TYPES):
+            raise TypeError(f"light[{k}]: must be a softshadow light, got {type(lt).__name__}")
+    return list(value)
+
+
+def _image(r: Any, light: Light, camera: Camera) -> Image:
+    """One light's image from the core's result."""
     return Image(
         visibility=r.visibility,
         shaded=r.shaded,
@@ -449,6 +494,37 @@ def render(
         depth_range=r.depth_range,
         plan=plan_from_core(r.plan, r.method, r.planned_method),
         error_estimate=r.error_estimate,
+        albedo=r.albedo,
+    )
+
+
+def _sum_of(parts: tuple[Image, ...], camera: Camera) -> Image:
+    """Several lights' images as one: visibility (L, H, W), the shading
+    summed (in float64, rounded once), the first part's G-buffer (they share
+    it), timings summed per stage."""
+    timings: dict[str, float] = {}
+    for p in parts:
+        for stage, seconds in p.timings.items():
+            timings[stage] = timings.get(stage, 0.0) + seconds
+    first = parts[0]
+    return Image(
+        visibility=np.stack([p.visibility for p in parts]),
+        shaded=np.sum([p.shaded for p in parts], axis=0, dtype=np.float64).astype(np.float32),
+        unshadowed=np.sum([p.unshadowed for p in parts], axis=0, dtype=np.float64).astype(np.float32),
+        depth=first.depth,
+        position=first.position,
+        normal=first.normal,
+        mesh_id=first.mesh_id,
+        shadow_maps=(),
+        map_extent=None,
+        method=tuple(p.method for p in parts),  # type: ignore[arg-type]
+        camera=camera,
+        light=tuple(p.light for p in parts),  # type: ignore[arg-type]
+        timings=timings,
+        backend=first.backend,
+        threads=first.threads,
+        albedo=first.albedo,
+        parts=parts,
     )
 
 

@@ -47,7 +47,8 @@ def limits() -> dict[str, Any]:
     ``max_extent`` (tangent half-extent), ``max_passes``, ``max_samples``
     (``exact``), ``max_threads`` (``threads=``), ``gpu_max_side`` (0
     without a GPU backend), ``max_emission`` (a light's ``radiance`` or
-    ``irradiance`` per channel: the largest float32), and the cost limits:
+    ``irradiance`` per channel: the largest float32), ``lights`` (the most
+    lights one :func:`softshadow.render` call takes), and the cost limits:
     ``visits_per_receiver`` (the weighted occluder texels a gather kernel,
     ``ssm`` or ``bitmask``, may visit per receiver it shades, counted as it
     runs), ``pcss_reads_per_receiver`` (PCSS's texel reads, bounded before

@@ -25,7 +25,7 @@ import numpy as np
 
 from . import _core
 from ._core import ErrorEstimate
-from .lights import DirectionalLight, RectLight
+from .lights import DirectionalLight, Light, RectLight
 from .methods import MethodConfig
 from .scene import Camera
 
@@ -131,8 +131,13 @@ class ShadowMap:
     @property
     def resolution(self) -> tuple[int, int]:
         """(W, H)."""
-        h, w = self.visibility.shape
+        h, w = self.visibility.shape[-2:]
         return w, h
+
+    @property
+    def lights(self) -> tuple[Light, ...]:
+        """The lights, in order (one for a single light)."""
+        return self.light if isinstance(self.light, tuple) else (self.light,)
 
     @property
     def passes(self) -> int | None:
@@ -248,17 +253,19 @@ class Image:
 
     visibility: np.ndarray
     """float32: the fraction of the light (area, or directions of the sun)
-    seen from the surface in each pixel; 1 where the pixel sees no surface."""
+    seen from the surface in each pixel; 1 where the pixel sees no surface.
+    (H, W) for one light; (L, H, W), one per light in order, when
+    :func:`softshadow.render` was given a list of lights."""
     shaded: np.ndarray
     """float32 (H, W, 3) RGB radiance toward the camera, ``unshadowed *
-    visibility``; 0 where no surface. An approximation of the shadowed
-    direct light: the exact one weights each visible part of the light by
-    its cosine (and 1/r^2), the visibility weights them alike (see
-    docs/shading.md for its measured size)."""
+    visibility`` summed over the lights; 0 where no surface. An
+    approximation of the shadowed direct light: the exact one weights each
+    visible part of the light by its cosine (and 1/r^2), the visibility
+    weights them alike (see docs/shading.md for its measured size)."""
     unshadowed: np.ndarray
     """float32 (H, W, 3) RGB radiance toward the camera without shadows,
-    ``albedo / pi * E`` with E the light's irradiance in closed form; 0 where
-    no surface."""
+    ``albedo / pi * E`` with E the lights' irradiance in closed form, summed
+    over the lights; 0 where no surface."""
     depth: np.ndarray
     """float32 distance along the optical axis; inf where no surface."""
     position: np.ndarray
@@ -273,10 +280,10 @@ class Image:
     orthographic depth from ``depth_origin``."""
     map_extent: tuple[float, float] | None
     """Their half-extents: tangents, or world units for the sun."""
-    method: MethodConfig
-    """The config that ran."""
+    method: MethodConfig | tuple[MethodConfig, ...]
+    """The config that ran (one per light for a list of lights)."""
     camera: Camera
-    light: RectLight | DirectionalLight
+    light: Light | tuple[Light, ...]
     timings: dict[str, float] = field(default_factory=dict)
     """Seconds per stage, in the order they ran."""
     backend: str = "cpu"
@@ -292,6 +299,17 @@ class Image:
     """The image's error estimated from exact rays at a subset of its pixels
     (``estimate_error=True``, always for ``Auto`` with a target), else
     ``None``."""
+    albedo: np.ndarray | None = None
+    """float32 (H, W, 3) the diffuse albedo each pixel was shaded with
+    (``render``'s ``albedo=``, else the meshes' colours); 0 where no
+    surface."""
+    parts: tuple[Image, ...] = ()
+    """For a list of lights: one image per light, as :func:`softshadow.render`
+    returns for that light alone (its visibility (H, W), shading, method,
+    maps, plan, timings and error estimate); empty for one light. The image
+    itself then holds the lights (``light``) and configs (``method``) as
+    tuples, no maps, plan or estimate of its own, and timings summed over
+    the parts."""
 
     @property
     def mask(self) -> np.ndarray:
@@ -301,8 +319,13 @@ class Image:
     @property
     def resolution(self) -> tuple[int, int]:
         """(W, H)."""
-        h, w = self.visibility.shape
+        h, w = self.visibility.shape[-2:]
         return w, h
+
+    @property
+    def lights(self) -> tuple[Light, ...]:
+        """The lights, in order (one for a single light)."""
+        return self.light if isinstance(self.light, tuple) else (self.light,)
 
     def __repr__(self) -> str:
         w, h = self.resolution
@@ -316,11 +339,19 @@ class Image:
 
     def channels(self) -> dict[str, np.ndarray]:
         """Every (H, W) channel by name, as :meth:`write_exr` writes them."""
-        out: dict[str, np.ndarray] = {"V": self.visibility}
+        out: dict[str, np.ndarray] = {}
+        if self.visibility.ndim == 3:
+            for i, v in enumerate(self.visibility):
+                out[f"V.{i}"] = v
+        else:
+            out["V"] = self.visibility
         for k, c in enumerate("RGB"):
             out[f"shaded.{c}"] = self.shaded[..., k]
         for k, c in enumerate("RGB"):
             out[f"unshadowed.{c}"] = self.unshadowed[..., k]
+        if self.albedo is not None:
+            for k, c in enumerate("RGB"):
+                out[f"albedo.{c}"] = self.albedo[..., k]
         out["depth"] = self.depth
         for k, axis in enumerate("xyz"):
             out[f"position.{axis}"] = self.position[..., k]
@@ -332,22 +363,23 @@ class Image:
     def write_exr(self, path: str | os.PathLike[str]) -> None:
         """Writes every channel (``V``, ``shaded.RGB``, ``unshadowed.RGB``,
         ``depth``, ``position.xyz``, ``normal.xyz``, ``mesh_id``, ``mask``)
-        as one float32 EXR file.
+        as one float32 EXR file (``V.0``, ``V.1``, ... and ``albedo.RGB`` for
+        several lights and an albedo).
         Needs ``OpenEXR`` (``pip install softshadow[io]``)."""
         from .io import write_exr
 
         write_exr(path, self.channels())
 
     def plot(self, ax: Any = None, *, title: str | None = None) -> Any:
-        """Shows the visibility (background grey) with matplotlib (the
-        ``plot`` extra); returns the axes."""
+        """Shows the visibility (background grey; for several lights their
+        mean) with matplotlib (the ``plot`` extra); returns the axes."""
         try:
             import matplotlib.pyplot as plt
         except ImportError as e:  # pragma: no cover - depends on the environment
             raise ImportError("Image.plot needs matplotlib: pip install softshadow[plot]") from e
         if ax is None:
             _, ax = plt.subplots()
-        shown = np.where(self.mask, self.visibility, 0.5)
+        shown = np.where(self.mask, self._visibility_shown(), 0.5)
         ax.imshow(shown, cmap="gray", vmin=0.0, vmax=1.0, interpolation="nearest")
         ax.set_title(title if title is not None else f"{self.method!r}")
         ax.set_axis_off()
@@ -355,9 +387,14 @@ class Image:
 
     def _repr_png_(self) -> bytes | None:
         """The visibility as a small grey PNG, which Jupyter shows for the
-        image: ``round(255 V)`` per pixel, mid grey (128) where the pixel sees
-        no surface (subsampled beyond 512 a side, enlarged below 256; see
-        ``softshadow._preview``)."""
+        image: ``round(255 V)`` per pixel (for several lights the mean V),
+        mid grey (128) where the pixel sees no surface (subsampled beyond 512
+        a side, enlarged below 256; see ``softshadow._preview``)."""
         from . import _preview
 
-        return _preview.png(self.visibility, self.mask)
+        return _preview.png(self._visibility_shown(), self.mask)
+
+    def _visibility_shown(self) -> np.ndarray:
+        """(H, W): the visibility, or its mean over several lights."""
+        v = self.visibility
+        return v if v.ndim == 2 else v.mean(axis=0, dtype=np.float32)

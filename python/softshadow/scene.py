@@ -1,6 +1,7 @@
 """What is seen, and from where: the :class:`Scene` (meshes that all cast
 and receive shadows, or the paper's split: occluders cast shadows, receivers
-catch them) and the eye view's pinhole :class:`Camera`.
+catch them; with the colours their files carry, :mod:`.materials`) and the
+eye view's pinhole :class:`Camera`.
 
 ``Camera`` is the core's class (frozen, compared by value, picklable): its
 conventions and every value check live in ``src/geom/camera.rs``
@@ -16,6 +17,7 @@ import numpy as np
 
 from . import _core
 from ._core import Camera
+from .materials import Material
 
 Mesh = tuple[np.ndarray, np.ndarray]
 
@@ -72,7 +74,9 @@ class Scene:
 
     Each argument is one mesh or an iterable of meshes; a mesh is a
     ``trimesh.Trimesh`` (or anything with ``vertices`` and ``faces``) or a
-    ``(vertices (n, 3), faces (m, 3))`` pair.
+    ``(vertices (n, 3), faces (m, 3))`` pair. The constructor keeps the
+    geometry only (``materials`` is all None); :meth:`from_trimesh` also
+    keeps the colours.
     """
 
     def __init__(self, occluders: Any = None, receivers: Any = None, *, meshes: Any = None) -> None:
@@ -100,7 +104,16 @@ class Scene:
         self._occ = _concat(self.occluders)
         # Every mesh casts and receives: one mesh serves as both.
         self._rec = _concat(self.receivers) if self.split else self._occ
+        self._materials: tuple[Material | None, ...] = (None,) * len(self.meshes)
         self._prepared = _core.Prepared()
+
+    @property
+    def materials(self) -> tuple[Material | None, ...]:
+        """One :class:`~softshadow.materials.Material` (or None: no colour in
+        the file) per mesh of ``meshes``, in its order: the colours
+        :meth:`from_trimesh` read (vertex, face, material and texture
+        colours); all None for a scene built from meshes directly."""
+        return self._materials
 
     @property
     def prepared(self) -> _core.Prepared:
@@ -117,6 +130,8 @@ class Scene:
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
+        # A scene pickled before materials existed has none.
+        state.setdefault("_materials", (None,) * len(state["meshes"]))
         self.__dict__.update(state)
         self._prepared = _core.Prepared()
 
@@ -127,7 +142,16 @@ class Scene:
         ``trimesh.Trimesh``, or a path trimesh can load. Geometry without
         faces (paths, point clouds) is skipped; a scene with no triangles
         raises ValueError; without trimesh, MissingExtraError naming the
-        ``io`` extra."""
+        ``io`` extra.
+
+        The colours come along: ``materials`` holds each mesh's
+        :class:`~softshadow.materials.Material` (vertex or face colours, a
+        glTF ``baseColorFactor`` or OBJ ``Kd``, a base-colour texture with
+        its UVs; None where the mesh has trimesh's default grey), an
+        instanced mesh's repeated for every node. A path is loaded with
+        ``trimesh.load(path)``, which keeps the materials and textures (no
+        ``skip_materials``). Colours whose shape does not match their mesh
+        raise ValueError naming ``meshes[k]``."""
         import os
 
         from ._extras import require
@@ -136,20 +160,30 @@ class Scene:
         if isinstance(obj, (str, os.PathLike)):
             obj = trimesh.load(os.fspath(obj))
         if isinstance(obj, trimesh.Trimesh):
-            return cls(meshes=[obj])
+            scene = cls(meshes=[obj])
+            scene._materials = (Material.from_trimesh(obj, "meshes[0]"),)
+            return scene
         if not isinstance(obj, trimesh.Scene):
             raise TypeError(f"obj: must be a trimesh.Scene, a trimesh.Trimesh or a path, got {type(obj).__name__}")
-        meshes = []
+        meshes: list[Mesh] = []
+        materials: list[Material | None] = []
+        # One Material per geometry, shared by the nodes that instance it.
+        read: dict[str, Material | None] = {}
         for node in obj.graph.nodes_geometry:
             transform, name = obj.graph[node]
             geom = obj.geometry[name]
             if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
                 continue
+            if name not in read:
+                read[name] = Material.from_trimesh(geom, f"meshes[{len(meshes)}]")
             v = trimesh.transform_points(np.asarray(geom.vertices, dtype=np.float64), transform)
             meshes.append((v, np.asarray(geom.faces)))
+            materials.append(read[name])
         if not meshes:
             raise ValueError("obj: the trimesh scene has no triangle meshes")
-        return cls(meshes=meshes)
+        scene = cls(meshes=meshes)
+        scene._materials = tuple(materials)
+        return scene
 
     @staticmethod
     def _meshes(value: Any, name: str) -> list[Mesh]:

@@ -604,9 +604,9 @@ pub fn square_samples(n: u32, max: u32) -> u32 {
 /// its measured error law asks for. A time budget runs the rule (budgets
 /// are planned for light-view maps only). `rule`: the call's `Auto`
 /// without its target (the eye view sizes the rule's maps itself).
-pub fn plan_eye(target: &Target, rule: MethodConfig) -> Plan {
+pub fn plan_eye(target: &Target, rule: MethodConfig, light: &str, maps_ok: bool) -> Plan {
     let (config, why) = match target.error {
-        Some(Real(e)) if e >= EYE_RULE_ERROR => (
+        Some(Real(e)) if e >= EYE_RULE_ERROR && maps_ok => (
             rule,
             format!(
                 "the rule's maps: their error estimate within {EYE_RULE_ERROR} on every \
@@ -624,15 +624,29 @@ pub fn plan_eye(target: &Target, rule: MethodConfig) -> Plan {
             } else {
                 String::new()
             };
+            let no_maps = if maps_ok {
+                format!(
+                    "no map setting measured within {e} in the eye view (the rule's maps: \
+                     {EYE_RULE_ERROR})"
+                )
+            } else {
+                format!("the map methods do not shade a {light}")
+            };
             (
                 MethodConfig::Exact(ExactConfig::of(first)),
                 format!(
-                    "no map setting measured within {e} in the eye view (the rule's maps: \
-                     {EYE_RULE_ERROR}); exact with {n} samples a pixel (its error estimate \
-                     within {EYE_EXACT}/sqrt(samples) on every calibration scene){then}"
+                    "{no_maps}; exact with {n} samples a pixel (its error estimate within \
+                     {EYE_EXACT}/sqrt(samples) on every calibration scene){then}"
                 ),
             )
         }
+        None if !maps_ok => (
+            MethodConfig::Exact(ExactConfig::of(crate::methods::config::DEFAULT_SAMPLES)),
+            format!(
+                "time budgets are planned for light-view maps only, which do not shade a \
+                 {light}: exact with its default samples"
+            ),
+        ),
         None => (
             rule,
             "time budgets are planned for light-view maps only: the rule's maps (the eye \
@@ -875,20 +889,45 @@ mod tests {
     #[test]
     fn the_eye_view_takes_the_rule_for_loose_targets_and_exact_below() {
         let rule = MethodConfig::Auto(crate::methods::AutoConfig::default());
-        let pick = |e: f64| plan_eye(&Target::new(Some(e), None).unwrap(), rule).config;
+        let pick = |e: f64| {
+            plan_eye(
+                &Target::new(Some(e), None).unwrap(),
+                rule,
+                "RectLight",
+                true,
+            )
+            .config
+        };
         assert_eq!(pick(EYE_RULE_ERROR), rule);
         assert!(matches!(pick(0.05), MethodConfig::Exact(c) if c.samples == 6));
         // Below 1/9 of the rule's error the law asks more than the pilot:
         // the pilot runs first, and the decision names the law's count.
         for (e, n) in [(0.01, 144), (0.005, 576)] {
-            let p = plan_eye(&Target::new(Some(e), None).unwrap(), rule);
+            let p = plan_eye(
+                &Target::new(Some(e), None).unwrap(),
+                rule,
+                "RectLight",
+                true,
+            );
             assert!(matches!(p.config, MethodConfig::Exact(c) if c.samples == EYE_PILOT));
             assert!(p.decisions[0]
                 .why
                 .contains(&format!("exact with {n} samples")));
         }
-        let budget = plan_eye(&Target::new(None, Some(1.0)).unwrap(), rule);
+        let budget = plan_eye(
+            &Target::new(None, Some(1.0)).unwrap(),
+            rule,
+            "RectLight",
+            true,
+        );
         assert_eq!(budget.config, rule);
+        // A light the maps cannot shade (a disk) plans exact at every target.
+        let disk = |t: Target| plan_eye(&t, rule, "DiskLight", false);
+        let loose = disk(Target::new(Some(EYE_RULE_ERROR), None).unwrap());
+        assert!(matches!(loose.config, MethodConfig::Exact(_)));
+        assert!(loose.decisions[0].why.contains("do not shade a DiskLight"));
+        let budget = disk(Target::new(None, Some(1.0)).unwrap());
+        assert!(matches!(budget.config, MethodConfig::Exact(_)));
     }
 
     #[test]

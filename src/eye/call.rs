@@ -14,6 +14,11 @@ use crate::geom::mesh::MeshRef;
 use crate::methods::MethodConfig;
 use crate::timing::Timings;
 
+/// The most lights one call renders: each is a render of its own (its
+/// cost bounded as one light's is), so the call's bound is this many times
+/// one light's.
+pub const MAX_LIGHTS: usize = 32;
+
 /// An image to render.
 #[derive(Debug, Clone, Copy)]
 pub struct EyeCall<'a> {
@@ -33,6 +38,9 @@ pub struct EyeCall<'a> {
     /// read and filled by this one; None: everything is built for this
     /// call alone.
     pub prepared: Option<&'a Prepared>,
+    /// The first hits of this camera on these meshes, from another light's
+    /// run of the same call (several lights share them); None: computed.
+    pub gbuffer: Option<&'a GBuffer>,
 }
 
 impl EyeCall<'_> {
@@ -54,10 +62,17 @@ pub struct EyeImage {
     pub gbuffer: GBuffer,
     /// (H, W) visibility; 1 where no surface.
     pub visibility: Vec<f32>,
+    /// (H, W) the share of the light's irradiance each pixel's surface sees
+    /// (each light point weighted by cos θ cos θ' / r²: shading.rs), where
+    /// the method measured it (`exact` on the CPU); None: the shading takes
+    /// `visibility`.
+    pub weighted: Option<Vec<f32>>,
     /// The map methods' light-view maps (None for `exact`).
     pub maps: Option<EyeMaps>,
     /// The light space they are in.
-    pub light_space: LightSpace,
+    /// The light space they are in (None for a sphere, which has none:
+    /// geom/sphere_light.rs).
+    pub light_space: Option<LightSpace>,
     pub timings: Timings,
     /// The error estimate, when the call asked for one.
     pub estimate: Option<ErrorEstimate>,

@@ -126,7 +126,7 @@ fn least(n: DVec3, lo: DVec3, hi: DVec3) -> f64 {
 /// the light meets the plane.
 fn lit_side(light: &Light, p0: DVec3, n: DVec3, tol: f64) -> Option<DVec3> {
     match light {
-        Light::Rect(l) => l.strict_side(p0, n, tol),
+        Light::Area(l) => l.strict_side(p0, n, tol),
         Light::Sun(s) => {
             // Directions toward the sun: -s.n within its half-angles.
             let to_sun = -s.n;
@@ -141,13 +141,15 @@ fn lit_side(light: &Light, p0: DVec3, n: DVec3, tol: f64) -> Option<DVec3> {
                 None
             }
         }
+        // Traced whole (sphere_light.rs): every triangle may cast.
+        Light::Sphere(_) => None,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::light::RectLight;
+    use crate::geom::light::AreaLight;
     use crate::geom::mesh::MeshRef;
 
     fn quad(y: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
@@ -176,7 +178,7 @@ mod tests {
 
     /// A unit square 4 above the ground, facing down.
     fn light() -> Light {
-        RectLight::new(
+        AreaLight::rect(
             [0.0, 4.0, 0.0],
             [0.0, -1.0, 0.0],
             [0.0, 0.0, 1.0],

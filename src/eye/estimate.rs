@@ -270,7 +270,7 @@ mod tests {
     use crate::eye::gbuffer::SceneTriangles;
     use crate::eye::{Bias, CpuEye, EyeCall, EyeStages};
     use crate::geom::camera::Camera;
-    use crate::geom::light::RectLight;
+    use crate::geom::light::AreaLight;
     use crate::geom::light_space::Light;
     use crate::geom::mesh::MeshRef;
     use crate::methods::{ExactConfig, MethodConfig};
@@ -297,8 +297,8 @@ mod tests {
                 faces: &faces,
             },
         ];
-        let light = Light::Rect(
-            RectLight::new(
+        let light = Light::Area(
+            AreaLight::rect(
                 [0.5, 4.0, 0.3],
                 [0.0, -1.0, 0.0],
                 [0.0, 0.0, 1.0],
@@ -325,6 +325,7 @@ mod tests {
             threads: None,
             estimate_error: Some(Draw::Timed),
             prepared: None,
+            gbuffer: None,
         };
         let scene = SceneTriangles::new(&meshes).unwrap();
         let g = CpuEye.first_hits(&camera, &scene).unwrap();

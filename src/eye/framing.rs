@@ -11,7 +11,7 @@ use crate::backend::Backend;
 use crate::error::Result;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::geom::light_space::{Light, LightSpace};
+use crate::geom::light_space::{sphere_has_no_space, Light, LightSpace};
 use crate::geom::sun::SunSpace;
 use crate::geom::units::{check_unit, depth_unit};
 use crate::methods::config::CallContext;
@@ -70,7 +70,7 @@ pub fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Fram
     let points: Vec<[f64; 3]> = hits.par_iter().map(|&k| g.position[k]).collect();
     let normals: Vec<[f32; 3]> = hits.par_iter().map(|&k| g.normal[k]).collect();
     let space = match call.light {
-        Light::Rect(l) => LightSpace::Rect(*l),
+        Light::Area(l) => LightSpace::Area(*l),
         Light::Sun(s) => {
             let focus: Vec<DVec3> = points.iter().map(|p| DVec3::from_array(*p)).collect();
             let focus = if focus.is_empty() {
@@ -84,6 +84,7 @@ pub fn frame(call: &EyeCall, scene: &SceneTriangles, g: &GBuffer) -> Result<Fram
                 focus.into_iter(),
             )?)
         }
+        Light::Sphere(_) => return Err(sphere_has_no_space()),
     };
     // Kernel light space, in the depth unit of the visible points.
     let pts_ls: Vec<DVec3> = points
@@ -238,7 +239,7 @@ pub fn map_grid(
             .map(|(&k, q)| {
                 let world = g.depth[k] as f64 / call.camera.focal;
                 match f.space {
-                    LightSpace::Rect(_) => world / q.z,
+                    LightSpace::Area(_) => world / q.z,
                     LightSpace::Sun(s) => world / s.lateral_scale(),
                 }
             })

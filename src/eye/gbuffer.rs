@@ -36,7 +36,15 @@ pub struct GBuffer {
     pub normal: Vec<[f32; 3]>,
     /// Index of the mesh hit, -1 where none.
     pub mesh_id: Vec<i32>,
+    /// Index of the face hit within its mesh; `NO_FACE` where none.
+    pub face: Vec<u32>,
+    /// The hit's barycentric coordinates (b1, b2) on that face: the point
+    /// is `(1 - b1 - b2) p0 + b1 p1 + b2 p2` of the face's corners in order.
+    pub bary: Vec<[f32; 2]>,
 }
+
+/// `GBuffer::face` where a pixel sees no surface.
+pub const NO_FACE: u32 = u32::MAX;
 
 impl GBuffer {
     pub fn len(&self) -> usize {
@@ -65,6 +73,8 @@ pub struct SceneTriangles {
     /// the faces into it (the rasterizers set up each vertex once).
     pub vertices: Vec<DVec3>,
     pub faces: Vec<[u32; 3]>,
+    /// Each mesh's first triangle in these lists.
+    pub first_face: Vec<u32>,
 }
 
 impl SceneTriangles {
@@ -86,7 +96,9 @@ impl SceneTriangles {
         let nv = meshes.iter().map(|m| m.vertices.len()).sum();
         let (mut corners, mut mesh_of) = (Vec::with_capacity(nf), Vec::with_capacity(nf));
         let (mut vertices, mut faces) = (Vec::with_capacity(nv), Vec::with_capacity(nf));
+        let mut first_face = Vec::with_capacity(meshes.len());
         for (k, m) in meshes.iter().enumerate() {
+            first_face.push(faces.len() as u32);
             m.validate(&format!("meshes[{k}]"))?;
             corners.par_extend(
                 m.faces
@@ -103,6 +115,7 @@ impl SceneTriangles {
             mesh_of,
             vertices,
             faces,
+            first_face,
         })
     }
 
@@ -177,6 +190,8 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
         position: vec![[f64::NAN; 3]; n],
         normal: vec![[0.0; 3]; n],
         mesh_id: vec![-1; n],
+        face: vec![NO_FACE; n],
+        bary: vec![[0.0; 2]; n],
     };
     // Each row written in place (no per-pixel tuples to unzip).
     g.depth
@@ -184,29 +199,41 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
         .zip(g.position.par_chunks_mut(w))
         .zip(g.normal.par_chunks_mut(w))
         .zip(g.mesh_id.par_chunks_mut(w))
+        .zip(g.face.par_chunks_mut(w).zip(g.bary.par_chunks_mut(w)))
         .zip(hit.par_chunks(w))
         .enumerate()
-        .for_each(|(j, ((((depth, position), normal), mesh_id), hit))| {
-            for (i, tri) in hit.iter().enumerate() {
-                let Some(tri) = *tri else {
-                    continue;
-                };
-                let d = camera.pixel_direction(i, j);
-                let [a, b, c] = scene.corners[tri as usize];
-                let nrm = (b - a).cross(c - a);
-                let den = nrm.dot(d);
-                // The f32 hit refined in f64 on the triangle's plane.
-                let t = nrm.dot(a - eye) / den;
-                if !(t.is_finite() && t > 0.0) {
-                    continue;
+        .for_each(
+            |(j, (((((depth, position), normal), mesh_id), (face, bary)), hit))| {
+                for (i, tri) in hit.iter().enumerate() {
+                    let Some(tri) = *tri else {
+                        continue;
+                    };
+                    let d = camera.pixel_direction(i, j);
+                    let [a, b, c] = scene.corners[tri as usize];
+                    let nrm = (b - a).cross(c - a);
+                    let den = nrm.dot(d);
+                    // The f32 hit refined in f64 on the triangle's plane.
+                    let t = nrm.dot(a - eye) / den;
+                    if !(t.is_finite() && t > 0.0) {
+                        continue;
+                    }
+                    // Barycentrics of q = a + b1 (b - a) + b2 (c - a):
+                    // (q - a) x (c - a) = b1 N and (b - a) x (q - a) = b2 N.
+                    let q = eye + t * d;
+                    let nn = nrm.length_squared();
+                    let b1 = nrm.dot((q - a).cross(c - a)) / nn;
+                    let b2 = nrm.dot((b - a).cross(q - a)) / nn;
+                    let nrm = nrm.normalize();
+                    let nrm = if den > 0.0 { -nrm } else { nrm };
+                    depth[i] = (t * d.dot(camera.forward)) as f32;
+                    position[i] = q.to_array();
+                    normal[i] = nrm.as_vec3().to_array();
+                    let mesh = scene.mesh_of[tri as usize];
+                    mesh_id[i] = mesh;
+                    face[i] = tri - scene.first_face[mesh as usize];
+                    bary[i] = [b1 as f32, b2 as f32];
                 }
-                let nrm = nrm.normalize();
-                let nrm = if den > 0.0 { -nrm } else { nrm };
-                depth[i] = (t * d.dot(camera.forward)) as f32;
-                position[i] = (eye + t * d).to_array();
-                normal[i] = nrm.as_vec3().to_array();
-                mesh_id[i] = scene.mesh_of[tri as usize];
-            }
-        });
+            },
+        );
     g
 }

@@ -90,7 +90,7 @@ fn texel_world(space: &LightSpace, grid: &MapGrid, z_world: f64) -> f64 {
     // The coarser of the texel's two sides, in tangent units.
     let t = (2.0 * grid.tx / grid.width as f64).max(2.0 * grid.ty / grid.height as f64);
     match space {
-        LightSpace::Rect(_) => t * z_world,
+        LightSpace::Area(_) => t * z_world,
         LightSpace::Sun(s) => t * s.lateral_scale(),
     }
 }
@@ -98,7 +98,7 @@ fn texel_world(space: &LightSpace, grid: &MapGrid, z_world: f64) -> f64 {
 /// The point moved by the biases, in world space.
 fn biased(space: &LightSpace, p: DVec3, n: DVec3, texel: f64, bias: &Bias) -> DVec3 {
     let toward = match space {
-        LightSpace::Rect(l) => (l.center - p).normalize_or_zero(),
+        LightSpace::Area(l) => (l.center - p).normalize_or_zero(),
         LightSpace::Sun(s) => -s.light.n,
     };
     // Slope-scaled: a surface at angle θ to the light rises tan θ per

@@ -20,6 +20,7 @@
 //! Lambertian direct lighting, unshadowed and times the visibility), so
 //! both backends shade a visibility alike.
 
+pub mod albedo;
 pub mod budget;
 pub mod call;
 mod casters;
@@ -33,10 +34,11 @@ pub mod prepared;
 pub mod rays;
 pub mod shading;
 pub mod shadow_mapping;
+pub mod sphere_rays;
 pub mod stages;
 pub mod tangent_plane;
 
-pub use call::{EyeCall, EyeImage};
+pub use call::{EyeCall, EyeImage, MAX_LIGHTS};
 pub use framing::Framed;
 pub use gbuffer::GBuffer;
 pub use maps::{Bias, EyeMaps, DEFAULT_BIAS, MAX_BIAS};

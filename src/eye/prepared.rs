@@ -30,6 +30,7 @@ use crate::error::Result;
 use crate::geom::light_space::Light;
 use crate::geom::mesh::MeshRef;
 use crate::methods::bvh::Topology;
+use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
@@ -54,8 +55,10 @@ struct Orientation {
 impl Orientation {
     fn of(light: &Light) -> Orientation {
         let (sun, u, v, n) = match light {
-            Light::Rect(l) => (false, l.u, l.v, l.n),
+            Light::Area(l) => (false, l.u, l.v, l.n),
             Light::Sun(s) => (true, s.u, s.v, s.n),
+            // A sphere's rays are traced in the world's axes.
+            Light::Sphere(_) => (false, DVec3::X, DVec3::Y, DVec3::Z),
         };
         let c = [u, v, n].map(|a| a.to_array().map(f64::to_bits));
         Orientation {
@@ -216,11 +219,11 @@ fn hash_words(words: impl Iterator<Item = u64>) -> [u64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::light::RectLight;
+    use crate::geom::light::AreaLight;
     use crate::methods::exact::Bvh;
 
     fn light(n: [f64; 3]) -> Light {
-        Light::Rect(RectLight::new([0.0, 3.0, 0.0], n, [0.0, 0.0, 1.0], [1.0, 1.0]).unwrap())
+        Light::Area(AreaLight::rect([0.0, 3.0, 0.0], n, [0.0, 0.0, 1.0], [1.0, 1.0]).unwrap())
     }
 
     #[test]

@@ -14,8 +14,8 @@
 use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::methods::exact::Bvh;
-use crate::methods::probe::probed_visibilities;
-use crate::methods::shadow_rays::{tile_order, visibilities, Jitter, RayOrigin, Sampling};
+use crate::methods::probe::probed_visibilities_weighted;
+use crate::methods::shadow_rays::{tile_order, visibilities_weighted, Jitter, RayOrigin, Sampling};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -28,7 +28,7 @@ pub const RAY_EPSILON: f64 = 1500.0 / (1u64 << 24) as f64;
 /// behind a rectangle's plane (it emits on its n side only).
 pub fn plane_side(space: &LightSpace, unit: f64, p: DVec3, n: DVec3) -> Option<[f64; 3]> {
     match space {
-        LightSpace::Rect(l) => {
+        LightSpace::Area(l) => {
             if (p - l.center).dot(l.n) <= 0.0 {
                 return None;
             }
@@ -96,6 +96,19 @@ impl RayOrigin for RayStart {
     fn origin(&self, x: f32, y: f32) -> Vec3 {
         RayStart::origin(self, x, y)
     }
+    const WEIGHTED: bool = true;
+    /// The light point (x, y, 0)'s share of the irradiance at the surface
+    /// point p (kernel space, the origins' midpoint), for a planar light
+    /// sampled uniformly over its area: cos θ cos θ' / r², with
+    /// cos θ = n · (y − p) / r = side(x, y) / r (0 below the horizon) and
+    /// cos θ' = p_z / r (the light faces +Z): side · p_z / r⁴.
+    #[inline(always)]
+    fn weight(&self, x: f32, y: f32) -> f32 {
+        let p = 0.5 * (self.above + self.below);
+        let side = self.side[0] + x * self.side[1] + y * self.side[2];
+        let r2 = (Vec3::new(x, y, 0.0) - p).length_squared();
+        side.max(0.0) * p.z / (r2 * r2)
+    }
 }
 
 /// Visibility at ray starts `starts`, every triangle of `triangles`
@@ -148,6 +161,25 @@ pub fn visibility_in(
     samples: u32,
     probe: Option<Probe>,
 ) -> Vec<f32> {
+    visibility_weighted(bvh, light_shape, starts, key, order, samples, probe)
+        .into_iter()
+        .map(|[v, _]| v)
+        .collect()
+}
+
+/// `visibility_in` with each point's weighted visibility beside it: the
+/// share of the light's irradiance its clear samples carry
+/// (`RayStart::weight`, `shadow_rays::visibilities_weighted`), of a planar
+/// light; a sun's samples (directions) weigh alike.
+pub fn visibility_weighted(
+    bvh: &Bvh,
+    light_shape: LightShape,
+    starts: &[Option<RayStart>],
+    key: impl Fn(usize) -> u64 + Sync,
+    order: &[usize],
+    samples: u32,
+    probe: Option<Probe>,
+) -> Vec<[f32; 2]> {
     let sampling = |n, jitter| Sampling {
         light: light_shape.samples(n),
         t0: 0.0,
@@ -157,9 +189,9 @@ pub fn visibility_in(
     match probe {
         Some(p) => {
             let coarse = sampling(p.samples, Jitter::PerReceiver);
-            probed_visibilities(bvh, starts, key, order, &fine, &coarse, 0.0, p.size)
+            probed_visibilities_weighted(bvh, starts, key, order, &fine, &coarse, 0.0, p.size)
         }
-        None => visibilities(bvh, starts, key, order, &fine, 0.0),
+        None => visibilities_weighted(bvh, starts, key, order, &fine, 0.0),
     }
 }
 

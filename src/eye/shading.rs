@@ -6,7 +6,7 @@
 //! `L_o = ρ/π · E` toward the camera, where E is the irradiance at x:
 //!
 //! * Area light of radiance L, emitting on its n_l side only: `E = L · F`,
-//!   F its unoccluded form factor at x for normal n (`RectLight::irradiance`;
+//!   F its unoccluded form factor at x for normal n (`AreaLight::irradiance`;
 //!   each shape's formula is in geom/light_shape/, for a rectangle
 //!   Lambert's polygon formula after horizon clipping). E = 0 when x is at
 //!   or behind the light's plane, and a point light (size 0) has no area.
@@ -162,7 +162,7 @@ pub fn albedo(value: Option<&ColorValue>, meshes: usize) -> Result<Vec<[f64; 3]>
 /// `irradiance`.
 pub fn emission_arg(light: &Light) -> &'static str {
     match light {
-        Light::Rect(_) => "radiance",
+        Light::Area(_) | Light::Sphere(_) => "radiance",
         Light::Sun(_) => "irradiance",
     }
 }
@@ -202,8 +202,9 @@ pub fn sun_irradiance(s: &DirectionalLight, n: DVec3) -> f64 {
 /// Irradiance per unit emission at `x` with unit normal `n`, no shadows.
 pub fn irradiance(light: &Light, x: DVec3, n: DVec3) -> f64 {
     match light {
-        Light::Rect(l) => l.irradiance(x, n),
+        Light::Area(l) => l.irradiance(x, n),
         Light::Sun(s) => sun_irradiance(s, n),
+        Light::Sphere(s) => s.irradiance(x, n),
     }
 }
 
@@ -260,11 +261,27 @@ pub struct Shaded {
     pub shaded: Vec<[f32; 3]>,
     /// `albedo/π · E`: the outgoing radiance without shadows.
     pub unshadowed: Vec<[f32; 3]>,
+    /// The albedo each pixel was shaded with.
+    pub albedo: Vec<[f32; 3]>,
 }
 
 /// Shades every pixel of `g` that sees a surface (the G-buffer's position
-/// and camera-facing geometric normal) with its visibility `visibility`.
-pub fn shade(light: &Light, lighting: &Lighting, g: &GBuffer, visibility: &[f32]) -> Shaded {
+/// and camera-facing geometric normal) under `light` of `emission`, with
+/// its albedo `albedo` (albedo.rs) and its visibility `visibility`: the
+/// weighted one where the method measured it (an area light's; module
+/// doc), else the plain one.
+pub fn shade(
+    light: &Light,
+    emission: [f64; 3],
+    albedo: &[[f32; 3]],
+    g: &GBuffer,
+    visibility: &[f32],
+    weighted: Option<&[f32]>,
+) -> Shaded {
+    let visibility = match (light, weighted) {
+        (Light::Area(_) | Light::Sphere(_), Some(w)) => w,
+        _ => visibility,
+    };
     /// Pixels per parallel task: a few rows of a 640-wide image.
     const CHUNK: usize = 2048;
     let n = g.len();
@@ -273,6 +290,7 @@ pub fn shade(light: &Light, lighting: &Lighting, g: &GBuffer, visibility: &[f32]
     let mut out = Shaded {
         shaded: vec![[0.0; 3]; n],
         unshadowed: vec![[0.0; 3]; n],
+        albedo: albedo.to_vec(),
     };
     out.unshadowed
         .par_chunks_mut(CHUNK)
@@ -282,16 +300,16 @@ pub fn shade(light: &Light, lighting: &Lighting, g: &GBuffer, visibility: &[f32]
             let start = chunk * CHUNK;
             for (i, (u, s)) in unshadowed.iter_mut().zip(shaded).enumerate() {
                 let k = start + i;
-                let Ok(mesh) = usize::try_from(g.mesh_id[k]) else {
+                if g.mesh_id[k] < 0 {
                     continue;
-                };
+                }
                 let x = DVec3::from_array(g.position[k]);
                 let normal = DVec3::from_array(g.normal[k].map(f64::from)).normalize_or_zero();
                 let e = irradiance(light, x, normal) / std::f64::consts::PI;
                 let v = f64::from(visibility[k]);
-                let rho = lighting.albedo[mesh];
+                let rho = albedo[k];
                 for c in 0..3 {
-                    let o = rho[c] * lighting.emission[c] * e;
+                    let o = f64::from(rho[c]) * emission[c] * e;
                     u[c] = o as f32;
                     s[c] = (o * v) as f32;
                 }

@@ -17,7 +17,7 @@ use super::{EyeCall, EyeImage};
 use crate::error::{Error, Result};
 use crate::geom::body::{extend_toward_light, view_body, Aabb};
 use crate::geom::light_space::Light;
-use crate::geom::light_space::LightSpace;
+use crate::geom::light_space::{sphere_has_no_space, LightSpace};
 use crate::geom::shadow_projection::{ShadowProjection, ViewVector, MIN_SIN_GAMMA};
 use crate::geom::sun::SunSpace;
 use crate::methods::shadow_mapping::blur::blur;
@@ -39,8 +39,9 @@ pub struct ShadowMapInfo {
 
 fn toward(light: &Light) -> Toward {
     match light {
-        Light::Rect(l) => Toward::Point(l.center),
+        Light::Area(l) => Toward::Point(l.center),
         Light::Sun(s) => Toward::Direction(-s.n),
+        Light::Sphere(s) => Toward::Point(s.center),
     }
 }
 
@@ -83,7 +84,9 @@ fn projection(
         Toward::Point(c) => ((c - p).normalize_or_zero(), (c - p).length()),
     });
     match call.light {
-        Light::Rect(l) => ShadowProjection::perspective(l.center, l.n, l.u, l.v, &extended),
+        // Refused before (`check_light`): no light space.
+        Light::Sphere(_) => None,
+        Light::Area(l) => ShadowProjection::perspective(l.center, l.n, l.u, l.v, &extended),
         Light::Sun(s) => {
             let l = s.n;
             // The uniform map (and LiSPSM's fallback) follows the camera's
@@ -146,8 +149,9 @@ fn unlit(light: &Light, tw: &Toward, g: &GBuffer, k: usize) -> bool {
     let p = DVec3::from_array(g.position[k]);
     let n = glam::Vec3::from_array(g.normal[k]).as_dvec3();
     let in_front = match light {
-        Light::Rect(l) => (p - l.center).dot(l.n) > 0.0,
+        Light::Area(l) => (p - l.center).dot(l.n) > 0.0,
         Light::Sun(_) => true,
+        Light::Sphere(s) => s.is_outside(p),
     };
     !in_front || n.dot(tw.at(p)) <= 0.0
 }
@@ -174,7 +178,7 @@ pub(crate) fn prepare(
     g: &GBuffer,
     sw: &mut Stopwatch,
 ) -> Result<std::result::Result<Prepared, Vec<f32>>> {
-    if let (Some(_), Light::Rect(_)) = (cfg.warp, call.light) {
+    if let (Some(_), Light::Area(_)) = (cfg.warp, call.light) {
         return Err(Error::invalid(
             "warp",
             "LiSPSM warps directional lights only (Scherzer 2005 centres on them, §6): a \
@@ -286,14 +290,16 @@ pub(crate) fn image(
     timings: Timings,
 ) -> Result<EyeImage> {
     let light_space = match call.light {
-        Light::Rect(l) => LightSpace::Rect(*l),
+        Light::Area(l) => LightSpace::Area(*l),
         Light::Sun(s) => LightSpace::Sun(SunSpace::fit(*s, scene.points())?),
+        Light::Sphere(_) => return Err(sphere_has_no_space()),
     };
     Ok(EyeImage {
         gbuffer,
         visibility,
+        weighted: None,
         maps: None,
-        light_space,
+        light_space: Some(light_space),
         timings,
         estimate: None,
     })

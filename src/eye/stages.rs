@@ -46,7 +46,9 @@ pub trait EyeStages {
     /// stratified shadow rays through `bvh` (the triangles that can shadow
     /// a visible point, built once a call: the error estimate and `Auto`'s
     /// further runs trace it too); with a `probe` of so many samples, only
-    /// at the points a first pass is unsure of (`methods/probe.rs`).
+    /// at the points a first pass is unsure of (`methods/probe.rs`). Beside
+    /// it, where the backend weights its samples (the CPU), each point's
+    /// weighted visibility (`rays::visibility_weighted`).
     fn trace(
         &mut self,
         f: &Framed,
@@ -55,7 +57,7 @@ pub trait EyeStages {
         samples: u32,
         probe: Option<u32>,
         sw: &mut Stopwatch,
-    ) -> Result<Vec<f32>>;
+    ) -> Result<(Vec<f32>, Option<Vec<f32>>)>;
 
     /// The map methods: the occluder layers of `tris` on `grid`, and the
     /// visibility of each visible point of `f` read from them.
@@ -106,11 +108,11 @@ impl EyeStages for CpuEye {
         samples: u32,
         probe: Option<u32>,
         _sw: &mut Stopwatch,
-    ) -> Result<Vec<f32>> {
+    ) -> Result<(Vec<f32>, Option<Vec<f32>>)> {
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
         let order = rays::tiled(&f.hits, camera.width, camera.height);
         // Each point's jitter key is its pixel (as on the GPU).
-        Ok(rays::visibility_in(
+        let both = rays::visibility_weighted(
             bvh,
             f.light_shape,
             &starts,
@@ -121,7 +123,9 @@ impl EyeStages for CpuEye {
                 samples,
                 size: (camera.width, camera.height),
             }),
-        ))
+        );
+        Ok(both.into_iter().map(|[v, w]| (v, w)).unzip())
+            .map(|(v, w): (Vec<f32>, Vec<f32>)| (v, Some(w)))
     }
 
     fn shade_maps(

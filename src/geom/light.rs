@@ -15,18 +15,20 @@
 //! shape in f32); maps and kernels work in f32 once coordinates are light-relative.
 
 use crate::error::{Error, Result};
-use crate::geom::light_shape::{rect_corners, LightShape, Placement};
+use crate::geom::light_shape::{LightShape, Placement};
 use glam::DVec3;
 
-/// A rectangular area light with its orthonormal frame.
+/// A planar area light (a rectangle or a disk, `LightShape`) with its
+/// orthonormal frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RectLight {
+pub struct AreaLight {
     pub center: DVec3,
     pub u: DVec3,
     pub v: DVec3,
     pub n: DVec3,
-    /// Full width along u, full height along v.
-    pub size: [f64; 2],
+    /// Its shape in its plane, centred on `center` (a rectangle's full
+    /// width along u and height along v, a disk's radius).
+    pub shape: LightShape,
 }
 
 /// A finite 3-vector, or an error naming `arg`.
@@ -35,6 +37,20 @@ pub(crate) fn finite3(arg: &str, a: [f64; 3]) -> Result<DVec3> {
         Ok(DVec3::from_array(a))
     } else {
         Err(Error::invalid(arg, format!("must be finite, got {a:?}")))
+    }
+}
+
+/// The `up` of a disk facing `normal`: the world axis with the smallest
+/// component along it (never parallel to a non-zero normal; ties go to the
+/// first axis, so the frame is the same for the same normal).
+pub(crate) fn disk_up(normal: DVec3) -> [f64; 3] {
+    let a = normal.abs();
+    if a.x <= a.y && a.x <= a.z {
+        [1.0, 0.0, 0.0]
+    } else if a.y <= a.z {
+        [0.0, 1.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
     }
 }
 
@@ -72,16 +88,10 @@ pub(crate) fn light_frame(
     Ok((n.cross(v), v, n))
 }
 
-impl RectLight {
-    /// The rectangle's corners, counter-clockwise seen from the side it
-    /// lights (−u−v, +u−v, +u+v, −u+v).
-    pub fn corners(&self) -> [DVec3; 4] {
-        rect_corners(self.size, &self.placement())
-    }
-
-    /// The light's shape: the rectangle `size`.
+impl AreaLight {
+    /// The light's shape in its plane.
     pub fn shape(&self) -> LightShape {
-        LightShape::rect(self.size)
+        self.shape
     }
 
     /// Where its shape lies in the world: its centre and frame.
@@ -109,25 +119,44 @@ impl RectLight {
         self.shape().strict_side(&self.placement(), p0, n, tol)
     }
 
-    /// Builds the light frame, refusing degenerate input.
-    pub fn new(center: [f64; 3], normal: [f64; 3], up: [f64; 3], size: [f64; 2]) -> Result<Self> {
+    /// A rectangle of full width and height `size` (both 0: a point light),
+    /// refusing degenerate input.
+    pub fn rect(center: [f64; 3], normal: [f64; 3], up: [f64; 3], size: [f64; 2]) -> Result<Self> {
+        AreaLight::new(center, normal, up, LightShape::rect(size), "size")
+    }
+
+    /// A disk of `radius` (> 0, finite) facing `normal`. A disk looks the
+    /// same turned about its axis, so its frame's `up` is chosen here: the
+    /// world axis least aligned with the normal (`disk_up`).
+    pub fn disk(center: [f64; 3], normal: [f64; 3], radius: f64) -> Result<Self> {
+        let up = disk_up(finite3("normal", normal)?);
+        AreaLight::new(center, normal, up, LightShape::disk(radius), "radius")
+    }
+
+    /// The light of `shape` (checked, named `shape_arg`) in the frame of
+    /// `normal` and `up` at `center`.
+    fn new(
+        center: [f64; 3],
+        normal: [f64; 3],
+        up: [f64; 3],
+        shape: LightShape,
+        shape_arg: &str,
+    ) -> Result<Self> {
         let c = finite3("center", center)?;
         let (u, v, n) = light_frame("normal", normal, up)?;
-        // Both sides > 0, or both 0: a point light (hard shadows).
-        LightShape::rect(size).check("size")?;
-        Ok(RectLight {
+        Ok(AreaLight {
             center: c,
             u,
             v,
             n,
-            size,
+            shape: shape.check(shape_arg)?,
         })
     }
 
     /// A light in the canonical frame: center at the origin, n = +z, v = +y (so u = -x).
     /// Used when the user hands us depth maps and no light position.
     pub fn canonical(size: [f64; 2]) -> Result<Self> {
-        RectLight::new([0.0; 3], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], size)
+        AreaLight::rect([0.0; 3], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], size)
     }
 
     /// World point -> light space (X, Y, Z), in f64.
@@ -278,7 +307,7 @@ mod tests {
 
     #[test]
     fn frame_is_orthonormal_and_follows_the_convention() {
-        let l = RectLight::new(
+        let l = AreaLight::rect(
             [0.0, 4.0, 0.0],
             [0.0, -2.0, 0.0],
             [0.0, 0.3, 1.0],
@@ -298,12 +327,12 @@ mod tests {
     #[test]
     fn degenerate_lights_are_refused() {
         let ok = ([0.0; 3], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 1.0]);
-        assert!(RectLight::new(ok.0, [0.0; 3], ok.2, ok.3).is_err());
-        assert!(RectLight::new(ok.0, ok.1, [0.0, 0.0, 5.0], ok.3).is_err());
-        assert!(RectLight::new(ok.0, ok.1, ok.2, [0.0, 1.0]).is_err());
-        assert!(RectLight::new(ok.0, ok.1, ok.2, [-0.0, 0.0]).is_ok()); // a point light
-        assert!(RectLight::new(ok.0, ok.1, ok.2, [1.0, f64::NAN]).is_err());
-        assert!(RectLight::new([f64::INFINITY, 0.0, 0.0], ok.1, ok.2, ok.3).is_err());
+        assert!(AreaLight::rect(ok.0, [0.0; 3], ok.2, ok.3).is_err());
+        assert!(AreaLight::rect(ok.0, ok.1, [0.0, 0.0, 5.0], ok.3).is_err());
+        assert!(AreaLight::rect(ok.0, ok.1, ok.2, [0.0, 1.0]).is_err());
+        assert!(AreaLight::rect(ok.0, ok.1, ok.2, [-0.0, 0.0]).is_ok()); // a point light
+        assert!(AreaLight::rect(ok.0, ok.1, ok.2, [1.0, f64::NAN]).is_err());
+        assert!(AreaLight::rect([f64::INFINITY, 0.0, 0.0], ok.1, ok.2, ok.3).is_err());
     }
 
     #[test]

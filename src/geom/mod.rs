@@ -11,5 +11,6 @@ pub mod light_space;
 pub mod mesh;
 pub mod plane_gradient;
 pub mod shadow_projection;
+pub mod sphere_light;
 pub mod sun;
 pub mod units;

@@ -2,7 +2,7 @@
 //! place that owns their conventions.
 //!
 //! * Frame: `n = normalize(direction)` is the direction the light travels,
-//!   `v = normalize(up - (up.n) n)`, `u = n x v` (as for `RectLight`).
+//!   `v = normalize(up - (up.n) n)`, `u = n x v` (as for `AreaLight`).
 //! * The light is the set of travel directions `n + x u + y v` with
 //!   `|x| <= tan(a_u/2)`, `|y| <= tan(a_v/2)`, uniform in (x, y): a rectangle
 //!   at infinity. `angular_size = (a_u, a_v)` are full angles in degrees;

@@ -4,7 +4,7 @@
 
 use crate::backend::Backend;
 use crate::frame::{MapSettings, ShadowResult};
-use crate::geom::light::RectLight;
+use crate::geom::light::AreaLight;
 use crate::geom::light_shape::LightShape;
 use crate::geom::mesh::MeshRef;
 use crate::methods::Method;
@@ -66,7 +66,7 @@ fn run(gpu: bool, passes: u32, method: Method) -> ShadowResult {
 fn run_at(gpu: bool, passes: u32, method: Method, (width, height): (usize, usize)) -> ShadowResult {
     let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
     let (rv, rf) = floor();
-    let light = RectLight::new(
+    let light = AreaLight::rect(
         [0.0, 4.0, 0.0],
         [0.0, -1.0, 0.0],
         [0.0, 0.0, 1.0],
@@ -219,7 +219,7 @@ fn gpu_bitmask_is_the_cpus_bit_for_bit_both_gaps_every_mask() {
                 };
                 let (ov, of) = sphere([0.1, 1.0, -0.2], 0.5, 24);
                 let (rv, rf) = floor();
-                let light = RectLight::new(
+                let light = AreaLight::rect(
                     [0.0, 4.0, 0.0],
                     [0.0, -1.0, 0.0],
                     [0.0, 0.0, 1.0],
@@ -447,7 +447,7 @@ mod eye {
     use crate::eye::gbuffer::{self, SceneTriangles};
     use crate::eye::{EyeCall, EyeImage, DEFAULT_BIAS};
     use crate::geom::camera::Camera;
-    use crate::geom::light::RectLight;
+    use crate::geom::light::AreaLight;
     use crate::geom::light_space::Light;
     use crate::geom::mesh::MeshRef;
     use crate::geom::sun::DirectionalLight;
@@ -506,7 +506,7 @@ mod eye {
         [
             (
                 "rect",
-                RectLight::new(
+                AreaLight::rect(
                     [0.3, 4.0, 0.2],
                     [0.0, -1.0, 0.0],
                     [0.0, 0.0, 1.0],
@@ -571,6 +571,7 @@ mod eye {
             threads: None,
             estimate_error: None,
             prepared: None,
+            gbuffer: None,
         })
     }
 
@@ -889,7 +890,7 @@ mod eye {
         }
         let meshes = scene();
         let cam = camera((64, 48));
-        let light: Light = RectLight::new(
+        let light: Light = AreaLight::rect(
             [0.3, 2.5, 0.2],
             [0.0, -1.0, 0.0],
             [0.0, 0.0, 1.0],
@@ -929,6 +930,7 @@ mod eye {
                     threads: None,
                     estimate_error: None,
                     prepared: None,
+                    gbuffer: None,
                 })
                 .unwrap()
             };
@@ -961,7 +963,7 @@ mod eye {
         }
         let meshes = scene();
         let cam = camera((48, 36));
-        let point: Light = RectLight::new(
+        let point: Light = AreaLight::rect(
             [0.3, 4.0, 0.2],
             [0.0, -1.0, 0.0],
             [0.0, 0.0, 1.0],
@@ -1168,6 +1170,7 @@ mod eye {
                         threads: None,
                         estimate_error: None,
                         prepared: None,
+                        gbuffer: None,
                     };
                     let mut sw = Stopwatch::new();
                     let (cv, info) = sm::render(&call, &cfg, &scene, &gb, &mut sw).unwrap();
@@ -1314,6 +1317,7 @@ mod eye {
                 threads: None,
                 estimate_error: None,
                 prepared: None,
+                gbuffer: None,
             };
             let mut sw = Stopwatch::new();
             let p = match sm::prepare(&call, &cfg, &scene, &gb, &mut sw).unwrap() {

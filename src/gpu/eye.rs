@@ -192,7 +192,7 @@ impl EyeStages for GpuEye {
         samples: u32,
         probe: Option<u32>,
         sw: &mut Stopwatch,
-    ) -> Result<Vec<f32>> {
+    ) -> Result<(Vec<f32>, Option<Vec<f32>>)> {
         // `ExactConfig::resolve` refuses a probe on the GPU.
         if probe.is_some() {
             return Err(Error::invalid(
@@ -206,7 +206,8 @@ impl EyeStages for GpuEye {
             .collect();
         let (v, t) = exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
-        Ok(v)
+        // The device counts clear rays only: its shading multiplies by V.
+        Ok((v, None))
     }
 
     fn shade_maps(

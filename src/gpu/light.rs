@@ -22,6 +22,11 @@ pub struct GpuLightSamples {
     pub nb: u32,
     pub size_x: f32,
     pub size_y: f32,
+    /// 1 for a disk (`LightSamples::disk`).
+    pub disk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 impl GpuLightSamples {
@@ -32,6 +37,8 @@ impl GpuLightSamples {
             nb,
             size_x,
             size_y,
+            disk: u32::from(s.disk),
+            ..Default::default()
         }
     }
 }
@@ -68,7 +75,11 @@ mod tests {
                 na,
                 nb,
                 size_x,
-                size_y
+                size_y,
+                disk,
+                _pad0,
+                _pad1,
+                _pad2
             }),
         );
     }

@@ -154,7 +154,7 @@ mod tests {
     use super::*;
     use crate::backend::Backend;
     use crate::frame::{frame_scene, MapSettings};
-    use crate::geom::light::RectLight;
+    use crate::geom::light::AreaLight;
     use crate::geom::light_space::Light;
     use crate::geom::mesh::MeshRef;
     use crate::methods::{ExactConfig, MethodConfig};
@@ -187,8 +187,8 @@ mod tests {
                 faces: &faces,
             },
         );
-        let light = Light::Rect(
-            RectLight::new(
+        let light = Light::Area(
+            AreaLight::rect(
                 [0.2, 4.0, 0.1],
                 [0.0, -1.0, 0.0],
                 [0.0, 0.0, 1.0],

@@ -39,6 +39,7 @@ pub mod smoothies;
 pub mod ssm;
 pub mod target;
 
+use crate::geom::light_shape::LightShape;
 pub use auto_config::{auto_rule, AutoConfig};
 pub use bitmask::{BitmaskConfig, HIERARCHY_DEFAULT_BITMASK};
 pub use exact::ExactConfig;
@@ -148,6 +149,29 @@ impl Method {
     /// tangent plane already, and ShadowMapping has its own.)
     pub fn tests_planes(&self) -> bool {
         matches!(self, Method::Pcss { .. } | Method::Smoothies { .. })
+    }
+
+    /// Why the method cannot shade a light of `shape`, or None where it
+    /// can. The map methods take the light as the rectangle of its
+    /// half-extents: `ssm` and `bitmask` clip each micro-patch's
+    /// back-projection to it (`HalfLight`), PCSS's search box and the
+    /// smoothies' width are its sides; a disk would be shaded as the
+    /// square around it. `exact` samples any shape, and ShadowMapping's
+    /// hard shadow reads the light's centre only.
+    pub fn refuses_shape(&self, shape: &LightShape) -> Option<&'static str> {
+        let rect = matches!(shape, LightShape::Rect { .. });
+        match self {
+            Method::Exact { .. } | Method::ShadowMapping(_) => None,
+            _ if rect => None,
+            Method::Ssm { .. } | Method::Bitmask { .. } => Some(
+                "clips each occluder texel's back-projection to a rectangular light; a disk or \
+                 a sphere runs with \"exact\"",
+            ),
+            Method::Pcss { .. } | Method::Smoothies { .. } => Some(
+                "sizes its penumbrae from a rectangular light's sides; a disk or a sphere runs \
+                 with \"exact\"",
+            ),
+        }
     }
 
     /// Whether the method reads `input`.

@@ -24,7 +24,7 @@
 //! the user gave have no neighbours and trace every sample.
 
 use super::bvh::Bvh;
-use super::shadow_rays::{visibilities, RayOrigin, Sampling};
+use super::shadow_rays::{visibilities, visibilities_weighted, RayOrigin, Sampling};
 use rayon::prelude::*;
 
 /// The visibility of each receiver of `receivers`, as
@@ -43,6 +43,26 @@ pub(crate) fn probed_visibilities<R: RayOrigin + Copy>(
     absent: f32,
     size: (usize, usize),
 ) -> Vec<f32> {
+    probed_visibilities_weighted(bvh, receivers, key, order, fine, coarse, absent, size)
+        .into_iter()
+        .map(|[v, _]| v)
+        .collect()
+}
+
+/// `probed_visibilities` with the weighted fractions beside them
+/// (`shadow_rays::visibilities_weighted`): a certain receiver's are its
+/// probe's 0 or 1, both.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn probed_visibilities_weighted<R: RayOrigin + Copy>(
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    key: impl Fn(usize) -> u64 + Sync,
+    order: &[usize],
+    fine: &Sampling,
+    coarse: &Sampling,
+    absent: f32,
+    size: (usize, usize),
+) -> Vec<[f32; 2]> {
     let probe = visibilities(bvh, receivers, &key, order, coarse, absent);
     let certain = certain(receivers, &key, &probe, size);
     let unsure: Vec<Option<R>> = receivers
@@ -50,13 +70,20 @@ pub(crate) fn probed_visibilities<R: RayOrigin + Copy>(
         .zip(&certain)
         .map(|(r, &c)| if c { None } else { *r })
         .collect();
-    let traced = visibilities(bvh, &unsure, &key, order, fine, absent);
+    let traced = visibilities_weighted(bvh, &unsure, &key, order, fine, absent);
     probe
         .into_iter()
         .zip(traced)
         .zip(certain)
-        .map(|((p, t), c)| if c { p } else { t })
+        .map(|((p, t), c)| if c { [p; 2] } else { t })
         .collect()
+}
+
+/// `certain` for receivers that are the pixels `pixels` (flat indices of
+/// an image of `size`, each its own key), every one a receiver.
+pub(crate) fn certain_by_pixel(pixels: &[usize], probe: &[f32], size: (usize, usize)) -> Vec<bool> {
+    let receivers = vec![Some(()); pixels.len()];
+    certain(&receivers, |k| pixels[k] as u64, probe, size)
 }
 
 /// Which receivers are certain: a probe of 0 or 1 that every neighbour

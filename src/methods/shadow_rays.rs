@@ -98,6 +98,16 @@ fn unit(h: u64) -> f32 {
 pub(crate) trait RayOrigin: Sync {
     fn bounds(&self) -> (Vec3, Vec3);
     fn origin(&self, x: f32, y: f32) -> Vec3;
+    /// Whether `weight` varies (else every sample weighs 1, and a clear
+    /// region's samples are counted without computing their points).
+    const WEIGHTED: bool = false;
+    /// The weight of the light point (x, y) in the receiver's irradiance
+    /// (`visibilities_weighted`), up to a factor common to its samples; 1
+    /// where the receiver has no surface (the light view's points).
+    #[inline(always)]
+    fn weight(&self, _x: f32, _y: f32) -> f32 {
+        1.0
+    }
 }
 
 /// A receiver point (the light view).
@@ -217,11 +227,43 @@ pub(crate) fn visibilities<R: RayOrigin>(
     s: &Sampling,
     absent: f32,
 ) -> Vec<f32> {
+    visibilities_weighted(bvh, receivers, key, order, s, absent)
+        .into_iter()
+        .map(|[v, _]| v)
+        .collect()
+}
+
+/// `visibilities`, each receiver's with the weighted fraction beside it:
+/// `[V, V_w]`, V_w = Σ clear w_i / Σ w_i over its samples, w_i its
+/// `RayOrigin::weight` at sample i's light point (the same rays: V_w is V
+/// with each sample weighted by what it adds to the irradiance, the ratio
+/// estimator of Heitz, Hill and McGuire 2018). A receiver whose shaft is
+/// clear, or whose samples weigh nothing (the light below its horizon),
+/// has V_w = V.
+pub(crate) fn visibilities_weighted<R: RayOrigin>(
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    key: impl Fn(usize) -> u64 + Sync,
+    order: &[usize],
+    s: &Sampling,
+    absent: f32,
+) -> Vec<[f32; 2]> {
     debug_assert_eq!(order.len(), receivers.len());
     let light = s.rect(0, s.light.grid.0, 0, s.light.grid.1);
+    // The shared pattern's points, every receiver's: computed once a call,
+    // not once a packet (its two permutations' walks and four hashes ran 8
+    // times a sample in `trace_packet` once, 16% of a profile of Exact(64)
+    // on bench_scale's mesh_125k).
+    let (na, nb) = s.light.grid;
+    let shared: Option<Vec<(f32, f32)>> = (s.jitter == Jitter::Shared).then(|| {
+        (0..nb)
+            .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
+            .map(|(sa, sb)| s.sample(0, sa, sb))
+            .collect()
+    });
     // A cancelled call's remaining packets are skipped (`crate::cancel`).
     let stop = crate::cancel::current();
-    let traced: Vec<Vec<(usize, f32)>> = order
+    let traced: Vec<Vec<(usize, [f32; 2])>> = order
         .par_chunks(CHUNK)
         .map(|chunk| {
             let mut out = Vec::with_capacity(chunk.len());
@@ -235,7 +277,7 @@ pub(crate) fn visibilities<R: RayOrigin>(
                 let (lo, hi) = r.bounds();
                 if is_clear(bvh, lo, hi, light) {
                     // Every sample would be counted: the same 1.0 as tracing.
-                    out.push((k, 1.0));
+                    out.push((k, [1.0; 2]));
                 } else {
                     pending.push((key(k), r));
                     keys.push(k);
@@ -245,13 +287,13 @@ pub(crate) fn visibilities<R: RayOrigin>(
                 if stop.is_cancelled() {
                     break;
                 }
-                let v = trace_packet(bvh, group, s);
+                let v = trace_packet(bvh, group, s, shared.as_deref());
                 out.extend(keys.iter().copied().zip(v));
             }
             out
         })
         .collect();
-    let mut v = vec![absent; receivers.len()];
+    let mut v = vec![[absent; 2]; receivers.len()];
     for (k, x) in traced.into_iter().flatten() {
         v[k] = x;
     }
@@ -259,8 +301,14 @@ pub(crate) fn visibilities<R: RayOrigin>(
 }
 
 /// The visibility of up to `LANES` receivers `(key, origin)`, their rays
-/// traced together.
-fn trace_packet<R: RayOrigin>(bvh: &Bvh, group: &[(u64, &R)], s: &Sampling) -> [f32; LANES] {
+/// traced together, and their weighted visibility; `shared`: the shared
+/// pattern's points, row-major by stratum (None: a pattern per receiver).
+fn trace_packet<R: RayOrigin>(
+    bvh: &Bvh,
+    group: &[(u64, &R)],
+    s: &Sampling,
+    shared: Option<&[(f32, f32)]>,
+) -> [[f32; 2]; LANES] {
     let m = group.len();
     debug_assert!((1..=LANES).contains(&m));
     let valid: Mask = if m == LANES { ALL } else { (1 << m) - 1 };
@@ -290,28 +338,42 @@ fn trace_packet<R: RayOrigin>(bvh: &Bvh, group: &[(u64, &R)], s: &Sampling) -> [
     }
 
     let mut seen = [0u32; LANES];
+    // Each lane's weights: of its clear samples, and of all of them (f64:
+    // 16 384 samples of weights spanning decades).
+    let mut w_seen = [0f64; LANES];
+    let mut w_all = [0f64; LANES];
     let mut cache: Option<u32> = None;
     for sb in 0..nb {
         for sa in 0..na {
-            if clear[((sb / sb_r) * ra + sa / sa_r) as usize] {
-                for n in seen.iter_mut() {
-                    *n += 1;
+            let region_clear = clear[((sb / sb_r) * ra + sa / sa_r) as usize];
+            if region_clear && !R::WEIGHTED {
+                for i in 0..LANES {
+                    seen[i] += 1;
+                    w_seen[i] += 1.0;
+                    w_all[i] += 1.0;
                 }
                 continue;
             }
             let hs = hash(((sb * na + sa) as u64) << 1);
-            // The shared pattern's point is every lane's: computed once,
-            // not once per lane (its two permutations' walks and four
-            // hashes ran 8 times in this function, 16% of a profile of
-            // Exact(64) on bench_scale's mesh_125k; not timed apart).
-            let shared = (s.jitter == Jitter::Shared).then(|| s.point(0, hs, sa, sb));
+            // The shared pattern's point is every lane's.
+            let shared = shared.map(|t| t[(sb * na + sa) as usize]);
             let mut o = [Vec3::ZERO; LANES];
             let mut d = [Vec3::ZERO; LANES];
+            let mut w = [0f64; LANES];
             for i in 0..LANES {
                 let (key, r) = lane(i);
                 let (x, y) = shared.unwrap_or_else(|| s.point(key, hs, sa, sb));
                 o[i] = r.origin(x, y);
                 d[i] = Vec3::new(x, y, 0.0) - o[i];
+                w[i] = f64::from(r.weight(x, y));
+                w_all[i] += w[i];
+            }
+            if region_clear {
+                for i in 0..LANES {
+                    seen[i] += 1;
+                    w_seen[i] += w[i];
+                }
+                continue;
             }
             let rays = Rays::new(o, d);
             let mut open = valid;
@@ -326,11 +388,23 @@ fn trace_packet<R: RayOrigin>(bvh: &Bvh, group: &[(u64, &R)], s: &Sampling) -> [
                 }
             }
             for (i, n) in seen.iter_mut().enumerate() {
-                *n += ((open >> i) & 1) as u32;
+                let lit = (open >> i) & 1;
+                *n += lit as u32;
+                if lit == 1 {
+                    w_seen[i] += w[i];
+                }
             }
         }
     }
-    seen.map(|n| n as f32 / (na * nb) as f32)
+    std::array::from_fn(|i| {
+        let v = seen[i] as f32 / (na * nb) as f32;
+        let vw = if w_all[i] > 0.0 {
+            (w_seen[i] / w_all[i]) as f32
+        } else {
+            v
+        };
+        [v, vw]
+    })
 }
 
 /// The indices of a width x height grid in tiles of 4 x 2 (row-major

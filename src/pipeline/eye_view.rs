@@ -21,8 +21,11 @@ use crate::eye::framing::{
 };
 use crate::eye::gbuffer::{GBuffer, SceneTriangles};
 use crate::eye::prepared::Found;
+use crate::eye::sphere_rays::{sphere_bvh, sphere_visibility};
 use crate::eye::{shadow_mapping, CpuEye, EyeCall, EyeImage, EyeStages};
 use crate::geom::light::MapGrid;
+use crate::geom::light_space::Light;
+use crate::geom::sphere_light::SphereLight;
 use crate::memory::{check_fits, map_bytes};
 use crate::methods::config::MAX_SAMPLES;
 use crate::methods::exact::Bvh;
@@ -58,6 +61,19 @@ fn scene_of(call: &EyeCall) -> Result<(Arc<SceneTriangles>, Option<Found>)> {
             Ok((found.scene.clone(), Some(found)))
         }
         None => Ok((Arc::new(SceneTriangles::new(call.meshes)?), None)),
+    }
+}
+
+/// The first hits of `call`'s camera: another light's (`call.gbuffer`,
+/// several lights in one call share them), or cast now on `stages`.
+fn first_hits<S: EyeStages>(
+    stages: &mut S,
+    call: &EyeCall,
+    scene: &SceneTriangles,
+) -> Result<GBuffer> {
+    match call.gbuffer {
+        Some(g) => Ok(g.clone()),
+        None => stages.first_hits(call.camera, scene),
     }
 }
 
@@ -110,7 +126,7 @@ pub fn render_with<S: EyeStages>(
         let method = resolve_at_camera(call, S::BACKEND)?;
         let mut sw = Stopwatch::new();
         let (scene, _) = scene_of(call)?;
-        let g = stages.first_hits(call.camera, &scene)?;
+        let g = first_hits(stages, call, &scene)?;
         sw.lap("first_hits");
         let mut visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
         if cfg.blur.is_some() {
@@ -140,13 +156,16 @@ pub fn render_with<S: EyeStages>(
         image.estimate = estimate;
         return Ok((image, method));
     }
+    if let Light::Sphere(s) = call.light {
+        return render_sphere(stages, call, s);
+    }
     stages.check(call)?;
     if call.method.kernel().traces() {
         return render_traced(stages, call, reuse, start);
     }
     let mut sw = Stopwatch::new();
     let (scene, _) = scene_of(call)?;
-    let g = stages.first_hits(call.camera, &scene)?;
+    let g = first_hits(stages, call, &scene)?;
     sw.lap("first_hits");
     let mut f = frame(call, &scene, &g)?;
     sw.lap("transform");
@@ -211,13 +230,67 @@ pub fn render_with<S: EyeStages>(
         EyeImage {
             gbuffer: g,
             visibility,
+            weighted: None,
             maps,
-            light_space: f.space,
+            light_space: Some(f.space),
             timings,
             estimate,
         },
         method,
     ))
+}
+
+/// `exact` under a sphere (`eye::sphere_rays`): the first hits, then
+/// stratified rays over the cap each pixel sees, through one BVH of every
+/// triangle. A sphere has no light space, so no framing: its rays run on
+/// the CPU, and the error estimate (which frames its rays) is not made.
+fn render_sphere<S: EyeStages>(
+    stages: &mut S,
+    call: &EyeCall,
+    light: &SphereLight,
+) -> Result<(EyeImage, MethodConfig)> {
+    if S::BACKEND == Backend::Gpu {
+        return Err(Error::invalid(
+            "backend",
+            "a SphereLight's rays are traced on the CPU in this version; use backend=\"cpu\" \
+             (\"auto\" takes it)",
+        ));
+    }
+    if call.estimate_error.is_some() {
+        return Err(Error::invalid(
+            "estimate_error",
+            "is not made for a SphereLight in this version",
+        ));
+    }
+    let method = resolve_at_camera(call, S::BACKEND)?;
+    let (samples, probe) = exact_samples(call, &method);
+    let mut sw = Stopwatch::new();
+    let (scene, _) = scene_of(call)?;
+    let g = first_hits(stages, call, &scene)?;
+    sw.lap("first_hits");
+    let bvh = sphere_bvh(light, &scene.corners);
+    crate::cancel::current().check()?;
+    sw.lap("bvh");
+    let hits = g.hits();
+    let v = sphere_visibility(&bvh, light, &g, &hits, samples, probe);
+    crate::cancel::current().check()?;
+    sw.lap("shadow");
+    let mut visibility = vec![1f32; g.len()];
+    let mut weighted = vec![1f32; g.len()];
+    for (&k, [v, w]) in hits.iter().zip(v) {
+        visibility[k] = v;
+        weighted[k] = w;
+    }
+    let image = EyeImage {
+        gbuffer: g,
+        visibility,
+        weighted: Some(weighted),
+        maps: None,
+        light_space: None,
+        timings: stages.timings(sw.timings),
+        estimate: None,
+    };
+    Ok((image, method))
 }
 
 /// Refuses, before any map is allocated, occluder maps of `grid` that
@@ -270,7 +343,7 @@ fn render_traced<S: EyeStages>(
                 traced_bytes(triangles, vertices, w.saturating_mul(h)),
             )?;
             let (scene, found) = scene_of(call)?;
-            let g = stages.first_hits(call.camera, &scene)?;
+            let g = first_hits(stages, call, &scene)?;
             sw.lap("first_hits");
             let f = frame(call, &scene, &g)?;
             sw.lap("transform");
@@ -297,7 +370,7 @@ fn render_traced<S: EyeStages>(
             Traced { g, f, bvh }
         }
     };
-    let v = stages.trace(&f, &bvh, call.camera, samples, probe, &mut sw)?;
+    let (v, vw) = stages.trace(&f, &bvh, call.camera, samples, probe, &mut sw)?;
     sw.lap("shadow");
     // `exact` against itself with four times its samples, through the same
     // tree: its own sampling error.
@@ -311,6 +384,13 @@ fn render_traced<S: EyeStages>(
     for (&k, v) in f.hits.iter().zip(v) {
         visibility[k] = v;
     }
+    let weighted = vw.map(|vw| {
+        let mut image = vec![1f32; g.len()];
+        for (&k, v) in f.hits.iter().zip(vw) {
+            image[k] = v;
+        }
+        image
+    });
     if let Some((p, found)) = keep_for {
         // The shape moves out of the tree when no later run reads it (a
         // copy took 30 ms on 2 000 000 triangles).
@@ -333,8 +413,9 @@ fn render_traced<S: EyeStages>(
     let image = EyeImage {
         gbuffer,
         visibility,
+        weighted,
         maps: None,
-        light_space,
+        light_space: Some(light_space),
         timings,
         estimate,
     };

@@ -52,7 +52,7 @@ pub fn from_scene(
             let [a, b, c] = f.map(|i| DVec3::from_array(scene.vertices[i as usize]));
             let n = (b - a).cross(c - a).normalize_or_zero();
             let toward = match light {
-                LightSpace::Rect(l) => l.center - p,
+                LightSpace::Area(l) => l.center - p,
                 LightSpace::Sun(s) => -s.light.n,
             };
             let n = if n.dot(toward) < 0.0 { -n } else { n };

@@ -189,6 +189,7 @@ pub fn limits(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("max_threads", l.max_threads)?;
     d.set_item("gpu_max_side", l.gpu_max_side)?;
     d.set_item("max_emission", crate::eye::shading::MAX_EMISSION)?;
+    d.set_item("lights", crate::eye::MAX_LIGHTS)?;
     d.set_item("min_receivers", l.min_receivers)?;
     d.set_item("visits_per_receiver", l.visits_per_receiver)?;
     d.set_item("pcss_reads_per_receiver", l.pcss_reads_per_receiver)?;

@@ -2,9 +2,10 @@
 //! the argument), values by the core (ValueError from its `Error`).
 
 use crate::backend::BackendChoice;
-use crate::geom::light::RectLight;
-use crate::geom::light_space::{Light as CoreLight, LightSpace};
+use crate::geom::light::AreaLight;
+use crate::geom::light_space::{sphere_has_no_space, Light as CoreLight, LightSpace};
 use crate::geom::mesh::MeshRef;
+use crate::geom::sphere_light::SphereLight;
 use crate::geom::sun::{DirectionalLight, SunSpace};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -12,22 +13,29 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyInt, PyTuple};
 
 /// A light as the package passes it: a rectangle (center, normal, up,
-/// size), a sun (direction, up, angular_size), or a sun with the
-/// orthographic space of the map it made (..., depth origin, depth range).
+/// size), a sun (direction, up, angular_size), a sun with the
+/// orthographic space of the map it made (..., depth origin, depth range),
+/// a disk (center, normal, radius) or a sphere (center, radius).
 #[derive(FromPyObject)]
 pub enum Light {
     Rect(([f64; 3], [f64; 3], [f64; 3], [f64; 2])),
     Sun(([f64; 3], [f64; 3], [f64; 2])),
     SunSpace(([f64; 3], [f64; 3], [f64; 2], [f64; 3], f64)),
+    /// A disk: (center, normal, radius).
+    Disk(([f64; 3], [f64; 3], f64)),
+    /// A sphere: (center, radius).
+    Sphere(([f64; 3], f64)),
 }
 
 /// The light a user passed.
 pub fn light_of(l: Light) -> PyResult<CoreLight> {
     Ok(match l {
-        Light::Rect(l) => CoreLight::Rect(RectLight::new(l.0, l.1, l.2, l.3)?),
+        Light::Rect(l) => CoreLight::Area(AreaLight::rect(l.0, l.1, l.2, l.3)?),
         Light::Sun((d, up, a)) | Light::SunSpace((d, up, a, _, _)) => {
             CoreLight::Sun(DirectionalLight::new(d, up, a)?)
         }
+        Light::Disk((c, n, r)) => CoreLight::Area(AreaLight::disk(c, n, r)?),
+        Light::Sphere((c, r)) => CoreLight::Sphere(SphereLight::new(c, r)?),
     })
 }
 
@@ -35,7 +43,7 @@ pub fn light_of(l: Light) -> PyResult<CoreLight> {
 /// its depth origin and range.
 pub fn space_of(l: Light) -> PyResult<LightSpace> {
     Ok(match l {
-        Light::Rect(l) => LightSpace::Rect(RectLight::new(l.0, l.1, l.2, l.3)?),
+        Light::Rect(l) => LightSpace::Area(AreaLight::rect(l.0, l.1, l.2, l.3)?),
         Light::SunSpace((d, up, a, origin, range)) => {
             let sun = DirectionalLight::new(d, up, a)?;
             let origin = crate::geom::light::finite3("depth_origin", origin)?;
@@ -51,6 +59,8 @@ pub fn space_of(l: Light) -> PyResult<LightSpace> {
                 "light: a directional light's map needs its depth origin and range",
             ))
         }
+        Light::Disk((c, n, r)) => LightSpace::Area(AreaLight::disk(c, n, r)?),
+        Light::Sphere(_) => return Err(sphere_has_no_space().into()),
     })
 }
 

@@ -12,7 +12,7 @@ use crate::api::{self, DepthCall, MeshCall, SceneCall};
 use crate::error_estimate::Draw;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::geom::light_space::Light as CoreLight;
+use crate::geom::light_space::{sphere_has_no_space, Light as CoreLight};
 use crate::methods::MethodConfig;
 use crate::pipeline::{self, OccluderSource};
 use numpy::ndarray::Array2;
@@ -25,8 +25,9 @@ use pyo3::prelude::*;
 pub fn light_frame(light: Light) -> PyResult<([f64; 3], [f64; 3], [f64; 3])> {
     errors::guard(|| {
         Ok(match light_of(light)? {
-            CoreLight::Rect(l) => (l.u.to_array(), l.v.to_array(), l.n.to_array()),
+            CoreLight::Area(l) => (l.u.to_array(), l.v.to_array(), l.n.to_array()),
             CoreLight::Sun(l) => (l.u.to_array(), l.v.to_array(), l.n.to_array()),
+            CoreLight::Sphere(_) => return Err(sphere_has_no_space().into()),
         })
     })
 }

@@ -13,12 +13,13 @@ use super::prepared::PyPrepared;
 use super::results::{map, sun_depth};
 use crate::api::Run;
 use crate::error_estimate::Draw;
+use crate::eye::albedo::{Material, Varies};
 use crate::eye::shading::{self, ColorValue};
 use crate::eye::{Bias, EyeCall, EyeImage, Lighting, Shaded};
 use crate::geom::mesh::MeshRef;
 use crate::timing::Timings;
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -97,12 +98,12 @@ pub fn irradiance<'py>(
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.
 #[pyfunction]
-#[pyo3(signature = (meshes, light, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend=Backend::CPU, threads=None, emission=None, albedo=None, estimate_error=None, prepared=None))]
+#[pyo3(signature = (meshes, lights, camera, method, *, map_resolution=None, normal_offset=None, depth_bias=None, passes=None, samples=None, occluder_resolution=None, hierarchy=None, precision=None, backend=Backend::CPU, threads=None, emission=None, albedo=None, estimate_error=None, prepared=None, materials=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
     meshes: Vec<(PyReadonlyArray2<'py, f64>, PyReadonlyArray2<'py, u32>)>,
-    light: Light,
+    lights: Vec<Light>,
     camera: &PyCamera,
     method: &Bound<'py, PyAny>,
     map_resolution: Option<Bound<'py, PyAny>>,
@@ -115,13 +116,46 @@ pub fn render<'py>(
     precision: Option<Bound<'py, PyAny>>,
     backend: Backend,
     threads: Option<Bound<'py, PyAny>>,
-    emission: Option<Bound<'py, PyAny>>,
+    emission: Option<Vec<Option<Bound<'py, PyAny>>>>,
     albedo: Option<Bound<'py, PyAny>>,
     estimate_error: Option<Bound<'py, PyAny>>,
     prepared: Option<Bound<'py, PyPrepared>>,
-) -> PyResult<EyeResult> {
+    materials: Option<Vec<Option<MaterialArgs<'py>>>>,
+) -> PyResult<Vec<EyeResult>> {
     errors::guard(|| {
-        let light = light_of(light)?;
+        let lights = lights
+            .into_iter()
+            .map(light_of)
+            .collect::<PyResult<Vec<_>>>()?;
+        let emission = emission.unwrap_or_default();
+        if !emission.is_empty() && emission.len() != lights.len() {
+            return Err(PyValueError::new_err(format!(
+                "emission: {} emissions for {} lights",
+                emission.len(),
+                lights.len()
+            )));
+        }
+        let albedo = opt_color("albedo", albedo.as_ref())?;
+        let lit = lights
+            .iter()
+            .enumerate()
+            .map(|(k, light)| {
+                let arg = shading::emission_arg(light);
+                let e = emission.get(k).and_then(|e| e.as_ref());
+                let lighting = Lighting::new(
+                    light,
+                    opt_color(arg, e)?.as_ref(),
+                    albedo.as_ref(),
+                    meshes.len(),
+                )?;
+                Ok((*light, lighting))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let Some((first, _)) = lit.first() else {
+            return Err(PyValueError::new_err(
+                "lights: must hold at least one light",
+            ));
+        };
         let loose = Loose {
             passes,
             samples,
@@ -136,7 +170,7 @@ pub fn render<'py>(
             .collect::<PyResult<_>>()?;
         let call = EyeCall {
             meshes: &refs,
-            light: &light,
+            light: first,
             camera: &camera.0,
             method: method_arg(method, &loose)?,
             map_resolution: opt_resolution("map_resolution", map_resolution.as_ref())?,
@@ -151,18 +185,138 @@ pub fn render<'py>(
                 .map(Draw::parse)
                 .transpose()?,
             prepared: prepared.as_ref().map(|p| &p.get().0),
+            gbuffer: None,
         };
-        let arg = shading::emission_arg(&light);
-        let lighting = Lighting::new(
-            &light,
-            opt_color(arg, emission.as_ref())?.as_ref(),
-            opt_color("albedo", albedo.as_ref())?.as_ref(),
-            refs.len(),
-        )?;
-        let (run, shaded) =
-            super::interrupt::run(py, || crate::api::render_shaded(&call, &lighting))?;
-        EyeResult::new(py, run, shaded)
+        // `albedo=` overrides the meshes' own colours.
+        let held = match (&albedo, materials) {
+            (None, Some(m)) => m
+                .into_iter()
+                .enumerate()
+                .map(|(k, m)| {
+                    m.map(|m| held_material(&format!("materials[{k}]"), m))
+                        .transpose()
+                })
+                .collect::<PyResult<Vec<_>>>()?,
+            _ => vec![],
+        };
+        let mats: Vec<Option<Material>> = held
+            .iter()
+            .map(|h| h.as_ref().map(HeldMaterial::material).transpose())
+            .collect::<PyResult<_>>()?;
+        let runs = super::interrupt::run(py, || crate::api::render_lights(&call, &lit, &mats))?;
+        runs.into_iter()
+            .map(|(run, shaded)| EyeResult::new(py, run, shaded))
+            .collect()
     })
+}
+
+/// A mesh's material as the package passes it (`Material.to_core()`):
+/// kind, linear colour, then its arrays (colours, or UVs and texture).
+type MaterialArgs<'py> = (
+    String,
+    [f64; 3],
+    Option<Bound<'py, PyAny>>,
+    Option<Bound<'py, PyAny>>,
+);
+
+/// A material's arrays, held (borrowed from NumPy) while the call runs.
+enum HeldMaterial<'py> {
+    Constant([f64; 3]),
+    Vertex([f64; 3], PyReadonlyArray2<'py, f32>),
+    Face([f64; 3], PyReadonlyArray2<'py, f32>),
+    Texture(
+        [f64; 3],
+        PyReadonlyArray2<'py, f32>,
+        PyReadonlyArray3<'py, u8>,
+    ),
+}
+
+/// The arrays of a material `(kind, color, a, b)`, named `arg` in errors.
+fn held_material<'py>(
+    arg: &str,
+    (kind, color, a, b): MaterialArgs<'py>,
+) -> PyResult<HeldMaterial<'py>> {
+    let array = |what: &str, v: Option<Bound<'py, PyAny>>| {
+        v.ok_or_else(|| {
+            PyValueError::new_err(format!("{arg}: a {kind:?} material needs its {what}"))
+        })
+    };
+    let rows = |what: &str,
+                v: Option<Bound<'py, PyAny>>,
+                cols: usize|
+     -> PyResult<PyReadonlyArray2<'py, f32>> {
+        let a: PyReadonlyArray2<'py, f32> = array(what, v)?.extract().map_err(|_| {
+            PyTypeError::new_err(format!("{arg}: {what} must be a 2-d float32 array"))
+        })?;
+        if a.shape()[1] != cols || !a.is_c_contiguous() {
+            return Err(PyValueError::new_err(format!(
+                "{arg}: {what} must be C-contiguous (N, {cols}), got {:?}",
+                a.shape()
+            )));
+        }
+        Ok(a)
+    };
+    Ok(match kind.as_str() {
+        "constant" => HeldMaterial::Constant(color),
+        "vertex" => HeldMaterial::Vertex(color, rows("colours", a, 3)?),
+        "face" => HeldMaterial::Face(color, rows("colours", a, 3)?),
+        "texture" => {
+            let uv = rows("UVs", a, 2)?;
+            let t: PyReadonlyArray3<'py, u8> = array("texture", b)?.extract().map_err(|_| {
+                PyTypeError::new_err(format!("{arg}: texture must be a (H, W, 3) uint8 array"))
+            })?;
+            if t.shape()[2] != 3 || !t.is_c_contiguous() {
+                return Err(PyValueError::new_err(format!(
+                    "{arg}: texture must be C-contiguous (H, W, 3), got {:?}",
+                    t.shape()
+                )));
+            }
+            HeldMaterial::Texture(color, uv, t)
+        }
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "{arg}: unknown material kind {other:?}"
+            )))
+        }
+    })
+}
+
+impl HeldMaterial<'_> {
+    /// The core's view of the arrays.
+    fn material(&self) -> PyResult<Material<'_>> {
+        fn slice2<'a>(a: &'a PyReadonlyArray2<'_, f32>) -> PyResult<&'a [f32]> {
+            a.as_slice()
+                .map_err(|e| PyValueError::new_err(e.to_string()))
+        }
+        Ok(match self {
+            HeldMaterial::Constant(color) => Material {
+                color: *color,
+                varies: Varies::Constant,
+            },
+            HeldMaterial::Vertex(color, c) => Material {
+                color: *color,
+                varies: Varies::Vertex(slice2(c)?.as_chunks::<3>().0),
+            },
+            HeldMaterial::Face(color, c) => Material {
+                color: *color,
+                varies: Varies::Face(slice2(c)?.as_chunks::<3>().0),
+            },
+            HeldMaterial::Texture(color, uv, t) => {
+                let texels = t
+                    .as_slice()
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                Material {
+                    color: *color,
+                    varies: Varies::Texture {
+                        uv: slice2(uv)?.as_chunks::<2>().0,
+                        texels: texels.as_chunks::<3>().0,
+                        width: t.shape()[1],
+                        height: t.shape()[0],
+                    },
+                }
+            }
+        })
+    }
 }
 
 /// An image: visibility, G-buffer, the light-view maps, and what ran it.
@@ -178,6 +332,9 @@ pub struct EyeResult {
     /// (H, W, 3) float32 outgoing radiance without shadows; 0 where no surface.
     #[pyo3(get)]
     unshadowed: Py<PyAny>,
+    /// (H, W, 3) float32 albedo each pixel was shaded with; 0 where no surface.
+    #[pyo3(get)]
+    albedo: Py<PyAny>,
     /// (H, W) float32 distance along the optical axis; inf where no surface.
     #[pyo3(get)]
     depth: Py<PyAny>,
@@ -252,7 +409,9 @@ impl EyeResult {
         let (w, h) = (g.width, g.height);
         let (map_extent, shadow_maps) = match img.maps {
             Some(m) => {
-                let e = img.light_space.user_extent([m.grid.tx, m.grid.ty]);
+                let e = img.light_space.map_or([m.grid.tx, m.grid.ty], |s| {
+                    s.user_extent([m.grid.tx, m.grid.ty])
+                });
                 let grid = m.grid;
                 let layers = m
                     .layers
@@ -263,11 +422,12 @@ impl EyeResult {
             }
             None => (None, vec![]),
         };
-        let (depth_origin, depth_range) = sun_depth(&img.light_space);
+        let (depth_origin, depth_range) = sun_depth(img.light_space.as_ref());
         Ok(EyeResult {
             visibility: image2(py, h, w, img.visibility)?,
             shaded: image3(py, h, w, shaded.shaded.into_flattened())?,
             unshadowed: image3(py, h, w, shaded.unshadowed.into_flattened())?,
+            albedo: image3(py, h, w, shaded.albedo.into_flattened())?,
             depth: image2(py, h, w, g.depth)?,
             position: image3(py, h, w, g.position.into_flattened())?,
             normal: image3(py, h, w, g.normal.into_flattened())?,

@@ -13,7 +13,8 @@ use super::convert::vector;
 use super::convert::Light;
 use super::errors;
 use super::eye::{irradiance, light_emission};
-use crate::geom::light::RectLight;
+use crate::geom::light::AreaLight;
+use crate::geom::sphere_light::SphereLight;
 use crate::geom::sun::DirectionalLight;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyReadonlyArray2};
@@ -106,18 +107,26 @@ fn newargs<'py>(
     let (last, positional) = fields.split_last().expect("a light has fields");
     let args = positional
         .iter()
-        .map(|(_, v)| PyTuple::new(py, *v))
+        .map(|(_, v)| value(py, v))
         .collect::<PyResult<Vec<_>>>()?;
     let kw = PyDict::new(py);
-    kw.set_item(last.0, PyTuple::new(py, last.1)?)?;
+    kw.set_item(last.0, value(py, last.1)?)?;
     Ok((PyTuple::new(py, args)?, kw))
 }
 
-/// `Class(name=(x, y, z), ...)`, each tuple as Python writes it.
+/// A field as Python holds it: a number (a radius), or a tuple.
+fn value<'py>(py: Python<'py>, v: &[f64]) -> PyResult<Bound<'py, PyAny>> {
+    match v {
+        [x] => Ok(pyo3::types::PyFloat::new(py, *x).into_any()),
+        _ => Ok(PyTuple::new(py, v)?.into_any()),
+    }
+}
+
+/// `Class(name=(x, y, z), ...)`, each value as Python writes it.
 fn repr(py: Python<'_>, class: &str, fields: &Fields) -> PyResult<String> {
     let parts = fields
         .iter()
-        .map(|(name, v)| Ok(format!("{name}={}", PyTuple::new(py, *v)?.repr()?)))
+        .map(|(name, v)| Ok(format!("{name}={}", value(py, v)?.repr()?)))
         .collect::<PyResult<Vec<_>>>()?;
     Ok(format!("{class}({})", parts.join(", ")))
 }
@@ -147,7 +156,7 @@ pub struct PyRectLight {
     up: [f64; 3],
     size: [f64; 2],
     radiance: [f64; 3],
-    pub light: RectLight,
+    pub light: AreaLight,
 }
 
 #[pymethods]
@@ -168,7 +177,7 @@ impl PyRectLight {
             Some(s) => pair("size", s)?,
             None => [1.0, 1.0],
         };
-        let light = errors::guard(|| Ok(RectLight::new(c, n, u, s)?))?;
+        let light = errors::guard(|| Ok(AreaLight::rect(c, n, u, s)?))?;
         let radiance = light_emission("radiance", color(radiance)?)?;
         Ok(PyRectLight {
             center: c,
@@ -437,4 +446,261 @@ impl PyDirectionalLight {
             ("irradiance", &self.irradiance),
         ]
     }
+}
+
+/// A disk-shaped area light that emits uniformly over its whole disk.
+///
+/// The disk of ``radius`` about ``center``, perpendicular to ``normal``,
+/// which points from the light into the scene. Its light-view maps' frame
+/// (``u``, ``v``) is chosen by the core: ``up`` is the world axis least
+/// aligned with ``normal`` (a disk looks the same turned about its axis).
+///
+/// ``radiance`` (keyword-only) is the radiance it emits, uniform and
+/// Lambertian, on its ``n`` side only: a number (grey) or an RGB triple, each
+/// finite and >= 0; ``None`` takes the core's default, 1.0.
+///
+/// Raises ValueError for a non-finite center, a zero-length or non-finite
+/// ``normal``, a radius that is not finite and > 0, or a negative or
+/// non-finite ``radiance``.
+#[pyclass(frozen, module = "softshadow._core", name = "DiskLight")]
+#[derive(Clone)]
+pub struct PyDiskLight {
+    center: [f64; 3],
+    normal: [f64; 3],
+    radius: [f64; 1],
+    radiance: [f64; 3],
+    pub light: AreaLight,
+}
+
+#[pymethods]
+impl PyDiskLight {
+    #[new]
+    #[pyo3(signature = (center, normal, radius, *, radiance=None))]
+    fn new(
+        center: &Bound<'_, PyAny>,
+        normal: &Bound<'_, PyAny>,
+        radius: &Bound<'_, PyAny>,
+        radiance: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let c = vector::<3>("center", center)?;
+        let n = vector::<3>("normal", normal)?;
+        let r = number("radius", radius)?;
+        let light = errors::guard(|| Ok(AreaLight::disk(c, n, r)?))?;
+        let radiance = light_emission("radiance", color(radiance)?)?;
+        Ok(PyDiskLight {
+            center: c,
+            normal: n,
+            radius: [r],
+            radiance,
+            light,
+        })
+    }
+
+    #[getter]
+    fn center(&self) -> (f64, f64, f64) {
+        self.center.into()
+    }
+    #[getter]
+    fn normal(&self) -> (f64, f64, f64) {
+        self.normal.into()
+    }
+    #[getter]
+    fn radius(&self) -> f64 {
+        self.radius[0]
+    }
+    #[getter]
+    fn radiance(&self) -> (f64, f64, f64) {
+        self.radiance.into()
+    }
+    /// The frame's first unit vector in the disk's plane (map columns grow
+    /// along it).
+    #[getter]
+    fn u<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.u)
+    }
+    /// The frame's second unit vector in the disk's plane (map rows grow
+    /// against it).
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.v)
+    }
+    /// Unit normal from the disk into the scene.
+    #[getter]
+    fn n<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array3(py, self.light.n)
+    }
+    /// pi radius^2.
+    #[getter]
+    fn area(&self) -> f64 {
+        self.light.shape.area()
+    }
+    /// The unshadowed irradiance (N, 3) float64, RGB, radiance included, at
+    /// world ``points`` (N, 3) on surfaces with ``normals`` (N, 3; any
+    /// length, not zero): the disk's form factor, clipped to each point's
+    /// upper hemisphere (0 at or behind its plane). See docs/shading.md.
+    fn irradiance_at<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: &Bound<'py, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let p = rows3("points", points)?;
+        let n = rows3("normals", normals)?;
+        let e = self.radiance.into_pyobject(py)?.into_any();
+        irradiance(py, Light::Disk(self._core_args()), p, n, Some(e))
+    }
+    fn _core_args(&self) -> ([f64; 3], [f64; 3], f64) {
+        (self.center, self.normal, self.radius[0])
+    }
+    fn _emission(&self) -> (f64, f64, f64) {
+        self.radiance.into()
+    }
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<PyDiskLight>()
+            .is_ok_and(|o| key(&self.fields()) == key(&o.get().fields()))
+    }
+    fn __hash__(&self) -> u64 {
+        hash_of(&self.fields())
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        newargs(py, &self.fields())
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        repr(py, "DiskLight", &self.fields())
+    }
+}
+
+impl PyDiskLight {
+    fn fields(&self) -> [(&'static str, &[f64]); 4] {
+        [
+            ("center", &self.center),
+            ("normal", &self.normal),
+            ("radius", &self.radius),
+            ("radiance", &self.radiance),
+        ]
+    }
+}
+
+/// A spherical area light that emits uniformly over its whole surface.
+///
+/// Seen from a point outside it, it is the cap of directions within
+/// ``asin(radius / d)`` of its centre, d the distance to the centre. It has
+/// no plane to project light-view maps in: its shadows are traced
+/// (``render`` with ``exact``, or ``auto``, which takes ``exact``); the map
+/// methods refuse it with the reason.
+///
+/// ``radiance`` (keyword-only): as for :class:`RectLight`.
+///
+/// Raises ValueError for a non-finite center, a radius that is not finite
+/// and > 0, or a negative or non-finite ``radiance``.
+#[pyclass(frozen, module = "softshadow._core", name = "SphereLight")]
+#[derive(Clone)]
+pub struct PySphereLight {
+    center: [f64; 3],
+    radius: [f64; 1],
+    radiance: [f64; 3],
+}
+
+#[pymethods]
+impl PySphereLight {
+    #[new]
+    #[pyo3(signature = (center, radius, *, radiance=None))]
+    fn new(
+        center: &Bound<'_, PyAny>,
+        radius: &Bound<'_, PyAny>,
+        radiance: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let c = vector::<3>("center", center)?;
+        let r = number("radius", radius)?;
+        errors::guard(|| Ok(SphereLight::new(c, r)?))?;
+        let radiance = light_emission("radiance", color(radiance)?)?;
+        Ok(PySphereLight {
+            center: c,
+            radius: [r],
+            radiance,
+        })
+    }
+
+    #[getter]
+    fn center(&self) -> (f64, f64, f64) {
+        self.center.into()
+    }
+    #[getter]
+    fn radius(&self) -> f64 {
+        self.radius[0]
+    }
+    #[getter]
+    fn radiance(&self) -> (f64, f64, f64) {
+        self.radiance.into()
+    }
+    /// 4 pi radius^2.
+    #[getter]
+    fn area(&self) -> f64 {
+        4.0 * std::f64::consts::PI * self.radius[0] * self.radius[0]
+    }
+    /// The unshadowed irradiance (N, 3) float64, RGB, radiance included, at
+    /// world ``points`` (N, 3) on surfaces with ``normals`` (N, 3; any
+    /// length, not zero): the visible cap's form factor, clipped to each
+    /// point's upper hemisphere (0 inside the sphere). See docs/shading.md.
+    fn irradiance_at<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: &Bound<'py, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let p = rows3("points", points)?;
+        let n = rows3("normals", normals)?;
+        let e = self.radiance.into_pyobject(py)?.into_any();
+        irradiance(py, Light::Sphere(self._core_args()), p, n, Some(e))
+    }
+    fn _core_args(&self) -> ([f64; 3], f64) {
+        (self.center, self.radius[0])
+    }
+    fn _emission(&self) -> (f64, f64, f64) {
+        self.radiance.into()
+    }
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<PySphereLight>()
+            .is_ok_and(|o| key(&self.fields()) == key(&o.get().fields()))
+    }
+    fn __hash__(&self) -> u64 {
+        hash_of(&self.fields())
+    }
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
+        newargs(py, &self.fields())
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        repr(py, "SphereLight", &self.fields())
+    }
+}
+
+impl PySphereLight {
+    fn fields(&self) -> [(&'static str, &[f64]); 3] {
+        [
+            ("center", &self.center),
+            ("radius", &self.radius),
+            ("radiance", &self.radiance),
+        ]
+    }
+}
+
+/// A real number (not a bool), or a TypeError naming `arg`.
+fn number(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let py = value.py();
+    let real = py.import("numbers")?.getattr("Real")?;
+    if value.is_instance(&real)? && !value.is_instance_of::<pyo3::types::PyBool>() {
+        return value.extract();
+    }
+    Err(PyTypeError::new_err(format!(
+        "{arg}: must be a number, got {}",
+        value.get_type().name()?
+    )))
 }

@@ -51,6 +51,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     configs.extend(shadow_configs::register(m)?);
     m.add_class::<camera::PyCamera>()?;
     m.add_class::<lights::PyRectLight>()?;
+    m.add_class::<lights::PyDiskLight>()?;
+    m.add_class::<lights::PySphereLight>()?;
     m.add_class::<lights::PyDirectionalLight>()?;
     m.add_class::<results::MeshShadowResult>()?;
     m.add_class::<results::DepthShadowResult>()?;

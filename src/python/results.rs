@@ -21,10 +21,10 @@ pub fn map(py: Python<'_>, grid: &MapGrid, v: Vec<f32>) -> PyResult<Py<PyAny>> {
 }
 
 /// A sun's orthographic maps' depth origin and range (None for a rectangle).
-pub fn sun_depth(space: &LightSpace) -> (Option<(f64, f64, f64)>, Option<f64>) {
+pub fn sun_depth(space: Option<&LightSpace>) -> (Option<(f64, f64, f64)>, Option<f64>) {
     match space {
-        LightSpace::Sun(s) => (Some(s.origin.into()), Some(s.depth_range)),
-        LightSpace::Rect(_) => (None, None),
+        Some(LightSpace::Sun(s)) => (Some(s.origin.into()), Some(s.depth_range)),
+        _ => (None, None),
     }
 }
 
@@ -132,8 +132,8 @@ impl MeshShadowResult {
                 .map(|m| map(py, &og, m))
                 .collect::<PyResult<_>>()?,
             extent: (ex, ey),
-            depth_origin: sun_depth(&r.light_space).0,
-            depth_range: sun_depth(&r.light_space).1,
+            depth_origin: sun_depth(Some(&r.light_space)).0,
+            depth_range: sun_depth(Some(&r.light_space)).1,
             timings: r.timings,
             method: configs::to_py(py, &run.method)?,
             backend: run.backend.name(),

@@ -117,7 +117,23 @@ def test_shaded_is_unshadowed_times_visibility_with_each_mesh_albedo(light, meth
     e = light.irradiance_at(img.position[m], img.normal[m].astype(np.float64))
     albedo = np.array([ALBEDO[0], (ALBEDO[1],) * 3])[img.mesh_id[m]]
     np.testing.assert_allclose(img.unshadowed[m], albedo / np.pi * e, rtol=1e-6, atol=1e-9)
-    np.testing.assert_allclose(img.shaded, img.unshadowed * img.visibility[..., None], rtol=1e-6, atol=1e-9)
+    if method == "exact" and isinstance(light, ss.RectLight):
+        # Each of exact's samples weighs what it adds to the irradiance:
+        # shaded = unshadowed * V_w, V_w equal to V where V is 0 or 1 and
+        # near it in penumbrae (the light's near part weighs more).
+        full = m & ((img.visibility == 0.0) | (img.visibility == 1.0))
+        np.testing.assert_allclose(
+            img.shaded[full], (img.unshadowed * img.visibility[..., None])[full], rtol=1e-6, atol=1e-9
+        )
+        lit = m & (img.unshadowed[..., 0] > 1e-3)
+        ratio = img.shaded[lit, 0] / img.unshadowed[lit, 0]
+        assert np.all((ratio >= 0.0) & (ratio <= 1.0 + 1e-6))
+        penumbra = (img.visibility[lit] > 0.0) & (img.visibility[lit] < 1.0)
+        assert penumbra.sum() > 20
+        diff = ratio[penumbra] - img.visibility[lit][penumbra]
+        assert np.abs(diff).max() < 0.3 and np.abs(diff).mean() > 1e-3
+    else:
+        np.testing.assert_allclose(img.shaded, img.unshadowed * img.visibility[..., None], rtol=1e-6, atol=1e-9)
     # Some pixels are shadowed, some lit, and the lit ones are not black.
     assert np.any(m & (img.visibility < 0.5)) and np.any(img.shaded[m].max(axis=1) > 0.01)
     assert "shading" in img.timings

@@ -47,25 +47,58 @@ is the fraction of that rectangle of (x, y) whose ray from p along
 same stratified jitter over the (x, y) rectangle. ``angular_size = (0, 0)``
 is a hard sun: one ray along ``-n`` per point, and ``samples`` is 1.
 
+Disk light (``center`` c, ``normal``, ``radius`` R)
+---------------------------------------------------
+A one-sided disk emitting toward ``n = normalize(normal)``. The visibility
+of p is the fraction of the disk's *area* (uniform, no cosine) whose segment
+to p is clear, estimated with K samples ``c + s u + t v``: the rectangle's
+stratified jitter drawn over the square [-1, 1]^2 (the same grid, the same
+draw order) and carried onto the unit disk by Shirley and Chiu's concentric
+map, which preserves area (so the strata stay equal-area), then scaled by R.
+(u, v) is any orthonormal pair across n (the disk is symmetric about its
+axis); here ``v`` is the world axis least aligned with n, made orthogonal to
+it, and ``u = n x v``. A point with ``(p - c).n <= 0`` gets 0 and no ray.
+
+Sphere light (``center`` c, ``radius`` R)
+-----------------------------------------
+A sphere emitting over its whole surface. From a point p at distance
+``d = |c - p| > R`` it covers the cone of half-angle ``alpha = asin(R/d)``
+about ``c - p``; the visibility of p is the fraction of that cone's *solid
+angle* whose rays are clear (the sphere is not an occluder). K directions are
+sampled uniformly in solid angle, ``cos theta = 1 - u1 (1 - cos alpha)``,
+``phi = 2 pi u2`` about the axis, with (u1, u2) the rectangle's stratified
+jitter over the unit square; each ray goes to the point where that direction
+first meets the sphere (its near surface), and stops ``ShadowEpsilon`` short
+of it, as a rectangle's ray does before its sample. These targets are
+computed per point in float64 NumPy and rounded to float32. A point at or
+inside the sphere (``d <= R``) gets 0 and no ray.
+
+Parts of a disk or a sphere below a point's horizon (behind its surface) are
+sampled like the rest: the ray leaves through the surface's far side, and
+only other geometry can block it. The visibility is geometric; the cosine
+(and the horizon) belong to the shading.
+
 Shadow rays
 -----------
 Rays start where Mitsuba's ``SurfaceInteraction.spawn_ray_to`` (rectangular
-light: toward the sample point, stopping ``ShadowEpsilon`` short of it) and
-``spawn_ray`` (directional light) start them: the origin is moved off the
-surface along the geometric normal by ``(1 + max|p|) * RayEpsilon``, to the
-side the ray leaves by, so a surface never shadows itself by round-off. The
-first hits' ``p`` and ``n`` are kept as float32 NumPy arrays; each batch of
-shadow rays rebuilds a ``SurfaceInteraction3f`` holding only ``p``, ``n``
-and ``time`` (the fields the spawn functions read; a default-constructed one
-has empty fields, and an empty ``time`` crashes ``ray_test``), each pixel's
-values repeated for its K samples by a Dr.Jit gather, and calls the spawn
-function on it, so the offset is Mitsuba's own code. The jitter (float64,
-NumPy) gives each sample's offsets (s, t) along u and v; the sample point
+and disk lights: toward the sample point; sphere: toward the sample's point
+on the sphere; stopping ``ShadowEpsilon`` short of it) and ``spawn_ray``
+(directional light) start them: the origin is moved off the surface along
+the geometric normal by ``(1 + max|p|) * RayEpsilon``, to the side the ray
+leaves by, so a surface never shadows itself by round-off. The first hits'
+``p`` and ``n`` are kept as float32 NumPy arrays; each batch of shadow rays
+rebuilds a ``SurfaceInteraction3f`` holding only ``p``, ``n`` and ``time``
+(the fields the spawn functions read; a default-constructed one has empty
+fields, and an empty ``time`` crashes ``ray_test``), each pixel's values
+repeated for its K samples by a Dr.Jit gather, and calls the spawn function
+on it, so the offset is Mitsuba's own code. The jitter (float64, NumPy)
+gives each sample's offsets (s, t) along u and v; the sample point
 ``c + s u + t v`` or travel direction ``n + s u + t v`` is formed in float32
-by Dr.Jit, inside the tracing kernel. Rays are traced by
-``Scene.ray_test`` in batches of at most ``_rays.MAX_RAYS_PER_BATCH``; the
-jitter is drawn pixel-major from one NumPy generator seeded by ``seed``, so
-the image is deterministic and does not depend on batching.
+by Dr.Jit, inside the tracing kernel (a sphere's targets, per point, come from
+NumPy). Rays are traced by ``Scene.ray_test`` in batches of at most
+``_rays.MAX_RAYS_PER_BATCH``; the jitter is drawn pixel-major from one NumPy
+generator seeded by ``seed``, so the image is deterministic and does not
+depend on batching.
 
 In the ``scalar_rgb`` variant (no usable libLLVM) the same is done one ray
 per Python call: fine for small images, slow for large ones.
@@ -214,8 +247,150 @@ class _SunSampler:
         return x.astype(np.float32).ravel(), y.astype(np.float32).ravel()
 
 
-#: Either light's sampler: samples ``origin + s u + t v`` (see :func:`_shadow_vector`).
-Sampler: TypeAlias = "_RectSampler | _SunSampler"
+def _concentric_disk(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Shirley and Chiu's concentric map of [-1, 1]^2 onto the unit disk (area-preserving).
+
+    Each square ring ``max(|a|, |b|) = r`` goes to the circle of radius r,
+    its perimeter spread evenly over the angle, so equal areas of the square
+    map to equal areas of the disk (up to the factor pi / 4).
+    """
+    radius = np.where(np.abs(a) > np.abs(b), a, b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        angle = np.where(
+            np.abs(a) > np.abs(b),
+            (np.pi / 4.0) * (b / a),
+            (np.pi / 2.0) - (np.pi / 4.0) * (a / b),
+        )
+    angle = np.where(radius == 0.0, 0.0, angle)  # the centre: a = b = 0
+    return radius * np.cos(angle), radius * np.sin(angle)
+
+
+def _axis_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(u, v)`` across the unit vector ``n``: v is the world axis least
+    aligned with n made orthogonal to it, and ``u = n x v``."""
+    axis = np.zeros(3)
+    axis[int(np.argmin(np.abs(n)))] = 1.0
+    v = axis - np.dot(axis, n) * n
+    v /= np.linalg.norm(v)
+    return np.cross(n, v), v
+
+
+def _radius(light: Any) -> float:
+    try:
+        radius = float(light.radius)
+    except (TypeError, ValueError) as exc:
+        raise TypeError("light.radius must be a number") from exc
+    if not (math.isfinite(radius) and radius > 0.0):
+        raise ValueError(f"light.radius must be positive and finite, got {radius}")
+    return radius
+
+
+class _DiskSampler:
+    """Stratified jittered points ``origin + s u + t v`` on a disk light,
+    uniform over its area (the square's strata through the concentric map)."""
+
+    directional = False
+
+    def __init__(self, light: Any, samples: int) -> None:
+        for attribute in ("center", "normal", "radius"):
+            if not hasattr(light, attribute):
+                raise TypeError(f"light has no attribute {attribute!r}")
+        self.c = _vector3(light.center, "light.center")
+        normal = _vector3(light.normal, "light.normal")
+        self.radius = _radius(light)
+        length = np.linalg.norm(normal)
+        if length == 0.0:
+            raise ValueError("light.normal must be non-zero")
+        self.n = normal / length
+        self.u, self.v = _axis_frame(self.n)
+        self.origin = self.c
+        self.grid = _grid_shape(samples, 1.0, 1.0)
+        self.samples = samples
+
+    def lit_side(self, points: np.ndarray) -> np.ndarray:
+        """Points strictly in front of the disk's plane (the side it emits to)."""
+        result: np.ndarray = (points - self.c) @ self.n > 0.0
+        return result
+
+    def offsets(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """Offsets (s, t) of the samples along u and v, each (count * K,) float32, pixel-major."""
+        a, b = _stratified_offsets(count, self.grid, 2.0, 2.0, rng)
+        s, t = _concentric_disk(a, b)
+        return (self.radius * s).astype(np.float32).ravel(), (self.radius * t).astype(np.float32).ravel()
+
+
+class _SphereSampler:
+    """Stratified jittered directions uniform in solid angle over the cone a
+    sphere light subtends from each point; the targets are the directions'
+    first points on the sphere, a different set per point."""
+
+    directional = False
+
+    def __init__(self, light: Any, samples: int) -> None:
+        for attribute in ("center", "radius"):
+            if not hasattr(light, attribute):
+                raise TypeError(f"light has no attribute {attribute!r}")
+        self.c = _vector3(light.center, "light.center")
+        self.radius = _radius(light)
+        self.grid = _grid_shape(samples, 1.0, 1.0)
+        self.samples = samples
+
+    def lit_side(self, points: np.ndarray) -> np.ndarray:
+        """Points strictly outside the sphere."""
+        result: np.ndarray = np.linalg.norm(points - self.c, axis=1) > self.radius
+        return result
+
+    def targets(self, points: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """The samples' points on the sphere, (count * K, 3) float32, pixel-major.
+
+        ``points`` (count, 3) float64 lie outside the sphere. Computed in
+        float64: ``1 - cos(alpha)`` as ``sin^2 / (1 + cos)`` so that far, small
+        spheres keep their precision.
+        """
+        count = len(points)
+        u1, u2 = _stratified_offsets(count, self.grid, 1.0, 1.0, rng)  # (count, K) in [-1/2, 1/2]
+        u1 += 0.5
+        u2 += 0.5
+        to_center = self.c - points
+        distance = np.linalg.norm(to_center, axis=1)
+        axis = to_center / distance[:, None]
+        sin2_alpha = (self.radius / distance) ** 2
+        one_minus_cos_alpha = sin2_alpha / (1.0 + np.sqrt(1.0 - sin2_alpha))
+        one_minus_cos = u1 * one_minus_cos_alpha[:, None]  # 1 - cos(theta), (count, K)
+        cos_theta = 1.0 - one_minus_cos
+        sin2_theta = np.maximum(one_minus_cos * (2.0 - one_minus_cos), 0.0)
+        sin_theta = np.sqrt(sin2_theta)
+        phi = (2.0 * np.pi) * u2
+        # Per point, an orthonormal pair across the axis (Duff et al. 2017).
+        sign = np.where(axis[:, 2] >= 0.0, 1.0, -1.0)
+        a = -1.0 / (sign + axis[:, 2])
+        b = axis[:, 0] * axis[:, 1] * a
+        e1 = np.stack([1.0 + sign * axis[:, 0] ** 2 * a, sign * b, -sign * axis[:, 0]], axis=1)
+        e2 = np.stack([b, sign + axis[:, 1] ** 2 * a, -axis[:, 1]], axis=1)
+        # Distance along each direction to the sphere's near surface.
+        d = distance[:, None]
+        reach = d * cos_theta - np.sqrt(np.maximum(self.radius**2 - d * d * sin2_theta, 0.0))
+        x, y = sin_theta * np.cos(phi), sin_theta * np.sin(phi)
+        targets = np.empty((count, self.samples, 3), dtype=np.float32)
+        for k in range(3):
+            direction = cos_theta * axis[:, k, None] + x * e1[:, k, None] + y * e2[:, k, None]
+            targets[..., k] = points[:, k, None] + reach * direction
+        return targets.reshape(-1, 3)
+
+
+#: Any light's sampler: samples ``origin + s u + t v`` (see :func:`_shadow_vector`),
+#: or, for a sphere, world targets per point (:meth:`_SphereSampler.targets`).
+Sampler: TypeAlias = "_RectSampler | _SunSampler | _DiskSampler | _SphereSampler"
+
+
+def _sampler(light: Any, samples: int) -> Sampler:
+    """The sampler of ``light``: directional (``direction``), disk (``radius``
+    and ``normal``), sphere (``radius``) or rectangular (the rest)."""
+    if hasattr(light, "direction"):
+        return _SunSampler(light, samples)
+    if hasattr(light, "radius"):
+        return _DiskSampler(light, samples) if hasattr(light, "normal") else _SphereSampler(light, samples)
+    return _RectSampler(light, samples)
 
 
 # --------------------------------------------------------------------------
@@ -268,16 +443,21 @@ def render_visibility(
         pairs (or objects with ``.vertices`` and ``.faces``). Every mesh is
         seen and casts shadows, on itself too.
     light : object
-        A rectangular light (``center``, ``normal``, ``up``, ``size``) or a
+        A rectangular light (``center``, ``normal``, ``up``, ``size``), a
         directional one (``direction``, ``up``, ``angular_size`` in degrees),
-        told apart by ``hasattr(light, "direction")``; see the module
-        docstring for their conventions.
+        a disk (``center``, ``normal``, ``radius``) or a sphere (``center``,
+        ``radius``), e.g. :class:`softshadow.DiskLight` and
+        :class:`softshadow.SphereLight`; told apart by their attributes:
+        ``direction`` a directional light, ``radius`` with ``normal`` a
+        disk, ``radius`` alone a sphere, otherwise a rectangle. See the
+        module docstring for their conventions.
     camera : softshadow.Camera
         The eye; its Mitsuba sensor (:func:`camera_sensor`) shoots one ray
         through each pixel centre.
     samples : int, optional
         Light samples per pixel K, stratified on the grid of
-        :func:`softshadow.reference.visibility_at_points` and jittered
+        :func:`softshadow.reference.visibility_at_points` (a disk's and a
+        sphere's over the unit square, then mapped) and jittered
         independently per pixel. Ignored (1) for a hard sun.
     seed : int, optional
         Seed of the jitter; the image is deterministic for a given seed and
@@ -292,7 +472,7 @@ def render_visibility(
     meshes = _scene_meshes(scene)
     samples = _positive_int(samples, "samples")
     rng = np.random.default_rng(_seed(seed))
-    sampler: Sampler = _SunSampler(light, samples) if hasattr(light, "direction") else _RectSampler(light, samples)
+    sampler = _sampler(light, samples)
     width, height = _resolution(camera)
     eye = _vector3(camera.eye, "camera.eye")
     forward = _vector3(camera.forward, "camera.forward")
@@ -323,8 +503,12 @@ def render_visibility(
     trace = _shadow_scalar if scalar else _shadow_vector
     for first in range(0, len(lit), per_batch):
         chosen = lit[first : first + per_batch]
-        s, t = sampler.offsets(len(chosen), rng)
-        blocked = trace(mi, dr, mitsuba_scene, p32[chosen], n32[chosen], k, sampler, s, t)
+        if isinstance(sampler, _SphereSampler):
+            targets = sampler.targets(position[chosen], rng)
+            blocked = trace(mi, dr, mitsuba_scene, p32[chosen], n32[chosen], k, sampler, None, None, targets)
+        else:
+            s, t = sampler.offsets(len(chosen), rng)
+            blocked = trace(mi, dr, mitsuba_scene, p32[chosen], n32[chosen], k, sampler, s, t)
         visible[chosen] = 1.0 - blocked.reshape(len(chosen), k).mean(axis=1)
     time_shadow = time.perf_counter() - start
 
@@ -434,8 +618,9 @@ def _shadow_vector(
     n: np.ndarray,
     k: int,
     sampler: Sampler,
-    s: np.ndarray,
-    t: np.ndarray,
+    s: np.ndarray | None,
+    t: np.ndarray | None,
+    targets: np.ndarray | None = None,
 ) -> np.ndarray:
     """Blocked flags (count * K,) of the shadow rays of ``count`` points.
 
@@ -443,8 +628,9 @@ def _shadow_vector(
     u and v, pixel-major; the sample is ``origin + s u + t v``, a point on a
     rectangular light or a travel direction of a directional one (the ray
     then goes along minus its normalization). Combined in Dr.Jit (float32,
-    fused into the tracing kernel). The rays are spawned by Mitsuba from a
-    SurfaceInteraction3f holding the points' p and n.
+    fused into the tracing kernel). A sphere light passes ``targets``
+    (count * K, 3) float32 instead, the samples' world points. The rays are
+    spawned by Mitsuba from a SurfaceInteraction3f holding the points' p and n.
     """
     total = len(p) * k
     index = dr.arange(mi.UInt32, total) // k
@@ -453,6 +639,10 @@ def _shadow_vector(
     si.n = dr.gather(mi.Normal3f, mi.Normal3f(np.ascontiguousarray(n.T)), index)
     # A default SurfaceInteraction3f has empty fields; Ray3f needs a time.
     si.time = dr.zeros(mi.Float, total)
+    if targets is not None:
+        ray = si.spawn_ray_to(mi.Point3f(np.ascontiguousarray(targets.T)))
+        return np.asarray(scene.ray_test(ray, coherent=False).numpy(), dtype=bool)
+    assert s is not None and t is not None and not isinstance(sampler, _SphereSampler)
     u, v = mi.Vector3f(*sampler.u.tolist()), mi.Vector3f(*sampler.v.tolist())
     sample = mi.Vector3f(*sampler.origin.tolist()) + mi.Float(s) * u + mi.Float(t) * v
     if sampler.directional:
@@ -472,14 +662,19 @@ def _shadow_scalar(
     n: np.ndarray,
     k: int,
     sampler: Sampler,
-    s: np.ndarray,
-    t: np.ndarray,
+    s: np.ndarray | None,
+    t: np.ndarray | None,
+    targets: np.ndarray | None = None,
 ) -> np.ndarray:
     """:func:`_shadow_vector` one ray per call (scalar variants)."""
     blocked = np.empty(len(p) * k, dtype=bool)
-    # The samples in float32, as the vectorized variant computes them.
-    origin, u, v = (x.astype(np.float32) for x in (sampler.origin, sampler.u, sampler.v))
-    samples = origin + s[:, None] * u + t[:, None] * v
+    if targets is not None:
+        samples = targets
+    else:
+        assert s is not None and t is not None and not isinstance(sampler, _SphereSampler)
+        # The samples in float32, as the vectorized variant computes them.
+        origin, u, v = (x.astype(np.float32) for x in (sampler.origin, sampler.u, sampler.v))
+        samples = origin + s[:, None] * u + t[:, None] * v
     si = mi.SurfaceInteraction3f()
     si.time = 0.0
     for point in range(len(p)):
@@ -487,7 +682,7 @@ def _shadow_scalar(
         si.n = mi.Normal3f(*n[point].tolist())
         for ray_index in range(point * k, (point + 1) * k):
             value = samples[ray_index].tolist()
-            if sampler.directional:
+            if targets is None and sampler.directional:
                 ray = si.spawn_ray(-dr.normalize(mi.Vector3f(*value)))
             else:
                 ray = si.spawn_ray_to(mi.Point3f(*value))

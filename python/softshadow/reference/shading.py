@@ -22,13 +22,46 @@ Lights
   ``radiance``) is a one-sided ``area`` emitter of that radiance on a
   ``rectangle`` shape covering the light (``_mitsuba._light_to_world``: its
   local +z, the side Mitsuba's area emitter lights, is the light's ``n``).
-  The rectangle is a shape of the scene: it blocks the camera rays that
-  reach it (the integrator hides its emission, ``hide_emitters``) and the
-  shadow rays behind it, which our lights do not.
 * A directional light (``direction``, ``up``, ``angular_size``,
   ``irradiance``) is a ``directional`` emitter of that irradiance along
   ``direction``: a delta direction, so compare with a sun of angular size 0
   or tiny.
+* A disk light (``center``, ``normal``, ``radius``, ``radiance``) is a
+  one-sided ``area`` emitter on Mitsuba's ``disk`` shape, the unit disk of
+  its local xy plane lit toward its local +z (:func:`_disk_to_world`: a
+  uniform scale by the radius, a rotation taking +z to the light's ``n``,
+  right-handed so that the lit side stays +z's, and the translation to the
+  centre). Its back side emits nothing: Mitsuba's area emitter lights only
+  the side its shape's normal points to, as softshadow's disk does, so
+  points at or behind its plane get no light, as with the rectangle.
+* A sphere light (``center``, ``radius``, ``radiance``) is an ``area``
+  emitter on Mitsuba's ``sphere`` shape (``center``, ``radius``; outward
+  normals, so it lights the outside). Mitsuba samples the cone of its
+  visible cap, as the reference visibility does.
+
+The light's kind is told by its attributes, as
+:func:`softshadow.reference.render_visibility` tells it: ``direction`` a
+directional light, ``radius`` and ``normal`` a disk, ``radius`` alone a
+sphere, otherwise a rectangle.
+
+The emitters' shapes are geometry of Mitsuba's scene; softshadow's lights
+are not. What that changes:
+
+* Shadow rays: none. A light-sampled ray stops short of its point on the
+  emitter (the near side of a sphere), a BSDF-sampled one counts the first
+  emitter it meets, and with a single light there is nothing behind the
+  emitter to hide, so a sphere never shadows a point it lights.
+* Camera rays: with ``hide_emitters`` (set here), Mitsuba 3.9.1's
+  ``direct`` integrator lets them through the emitter's shape to the surface
+  behind it (measured: a ray through a rectangle, disk or sphere light
+  returns the shading of the floor behind it, and a miss where there is
+  none), as softshadow, whose lights are not geometry, does. Mitsuba 3's
+  earlier ``direct`` integrator only dropped the emission of a directly
+  seen emitter and stopped the camera ray on its shape (black): with
+  another version, keep the light, a sphere above all, out of the camera's
+  view, or mask the pixels whose rays meet it.
+* A sphere is opaque and closed: a surface point inside it, or a mesh
+  crossing it, is lit by nothing, as softshadow gives it (0 inside).
 
 Pixel centres
 -------------
@@ -50,10 +83,10 @@ from typing import Any
 
 import numpy as np
 
-from ._inputs import _positive_int, _seed
+from ._inputs import _positive_int, _seed, _vector3
 from ._mitsuba import _light_to_world, _mitsuba, _mitsuba_mesh
 from .camera import camera_sensor
-from .eye import _resolution, _scene_meshes
+from .eye import _axis_frame, _radius, _resolution, _scene_meshes
 
 __all__ = ["render_direct"]
 
@@ -107,8 +140,34 @@ def _emission(light: Any, name: str) -> list[float]:
     return [float(c) for c in rgb]
 
 
+def _disk_to_world(mi: Any, light: Any) -> Any:
+    """``to_world`` of a Mitsuba ``disk`` matching a softshadow disk light.
+
+    Mitsuba's disk is the unit disk of its local xy plane, its normal (and
+    lit side) local +z. With n the light's unit normal, (u, v) the pair
+    across it of :func:`eye._axis_frame` (``u = n x v``, so ``v x u = n``):
+    x -> v R, y -> u R, z -> n R, a rotation and a uniform scale (no mirror,
+    no shear), then the translation to the centre.
+    """
+    center = _vector3(light.center, "light.center")
+    normal = _vector3(light.normal, "light.normal")
+    radius = _radius(light)
+    length = np.linalg.norm(normal)
+    if length == 0.0:
+        raise ValueError("light.normal must be non-zero")
+    n = normal / length
+    u, v = _axis_frame(n)
+    matrix = np.eye(4)
+    matrix[:3, 0] = v * radius
+    matrix[:3, 1] = u * radius
+    matrix[:3, 2] = n * radius
+    matrix[:3, 3] = center
+    return mi.ScalarTransform4f(matrix)
+
+
 def _emitter(mi: Any, light: Any) -> dict[str, Any]:
-    """The scene entry of ``light``: a rectangle with an area emitter, or a directional emitter."""
+    """The scene entry of ``light``: a rectangle, a disk or a sphere with an
+    area emitter, or a directional emitter."""
     if hasattr(light, "direction"):
         direction = np.asarray(light.direction, dtype=np.float64)
         return {
@@ -116,6 +175,12 @@ def _emitter(mi: Any, light: Any) -> dict[str, Any]:
             "direction": (direction / np.linalg.norm(direction)).tolist(),
             "irradiance": {"type": "rgb", "value": _emission(light, "irradiance")},
         }
+    area = {"type": "area", "radiance": {"type": "rgb", "value": _emission(light, "radiance")}}
+    if hasattr(light, "radius") and hasattr(light, "normal"):
+        return {"type": "disk", "to_world": _disk_to_world(mi, light), "emitter": area}
+    if hasattr(light, "radius"):
+        center = _vector3(light.center, "light.center")
+        return {"type": "sphere", "center": center.tolist(), "radius": _radius(light), "emitter": area}
     return {
         "type": "rectangle",
         "to_world": _light_to_world(mi, light),
@@ -139,9 +204,10 @@ def render_direct(
     scene : object
         Anything with ``meshes`` (``(vertices, faces)`` pairs or objects with
         ``.vertices`` and ``.faces``), e.g. a :class:`softshadow.Scene`.
-    light : softshadow.RectLight or softshadow.DirectionalLight
+    light : softshadow.RectLight, DirectionalLight, DiskLight or SphereLight
         Or any object with their attributes (``radiance`` or
-        ``irradiance`` default to 1).
+        ``irradiance`` default to 1); see the module docstring for the
+        Mitsuba emitter each one becomes.
     camera : softshadow.Camera
         One ray through each pixel centre (:func:`camera_sensor`).
     albedo : optional

@@ -56,20 +56,23 @@
 //! Each quantity is computed here in the order the kernels always did (in
 //! f64, rounded once to f32), so moving it here changed no bit.
 
+pub(crate) mod disk;
 mod placement;
 mod rect;
+pub(crate) mod sphere;
 
 use crate::error::{Error, Result};
 use crate::geom::units::{MAX_RELATIVE_SIZE, MIN_RELATIVE_SIZE};
 use glam::DVec3;
 pub use placement::Placement;
-pub(crate) use rect::rect_corners;
 
 /// The shape of a light in its plane (see the module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LightShape {
     /// Full width along u and full height along v; [0, 0]: a point light.
     Rect { size: [f64; 2] },
+    /// The disk of this radius about the origin (disk.rs).
+    Disk { radius: f64 },
 }
 
 impl LightShape {
@@ -81,10 +84,32 @@ impl LightShape {
         LightShape::Rect { size }
     }
 
+    /// The disk of `radius`, unchecked (`check`).
+    pub const fn disk(radius: f64) -> LightShape {
+        LightShape::Disk { radius }
+    }
+
+    /// What the shape is called in messages ("rectangle", "disk").
+    pub fn name(&self) -> &'static str {
+        match self {
+            LightShape::Rect { .. } => "rectangle",
+            LightShape::Disk { .. } => "disk",
+        }
+    }
+
     /// The shape, or an error naming `arg`: a rectangle's sides both finite
     /// and > 0, or both 0 (a point light).
     pub fn check(self, arg: &str) -> Result<LightShape> {
-        let LightShape::Rect { size } = self;
+        let size = match self {
+            LightShape::Rect { size } => size,
+            LightShape::Disk { radius } if radius.is_finite() && radius > 0.0 => return Ok(self),
+            LightShape::Disk { radius } => {
+                return Err(Error::invalid(
+                    arg,
+                    format!("must be a finite radius > 0, got {radius}"),
+                ))
+            }
+        };
         if size.iter().all(|s| s.is_finite() && *s > 0.0) || size == [0.0, 0.0] {
             Ok(self)
         } else {
@@ -100,8 +125,7 @@ impl LightShape {
 
     /// Whether a (checked) shape is a point light's.
     pub fn is_point(&self) -> bool {
-        let LightShape::Rect { size } = self;
-        *size == [0.0, 0.0]
+        matches!(self, LightShape::Rect { size } if *size == [0.0, 0.0])
     }
 
     /// The shape with every length divided by `unit` (a power of two:
@@ -109,15 +133,18 @@ impl LightShape {
     /// ratio to the receivers' depth outside [MIN_RELATIVE_SIZE,
     /// MAX_RELATIVE_SIZE] makes 2/L or L/2 leave the f32 range.
     pub fn in_unit(&self, arg: &str, unit: f64) -> Result<LightShape> {
-        let LightShape::Rect { size } = *self;
-        let s = [size[0] / unit, size[1] / unit];
         if self.is_point() {
             return Ok(LightShape::POINT);
         }
+        let size = self.extent();
+        let s = [size[0] / unit, size[1] / unit];
         if s.iter()
             .all(|x| (MIN_RELATIVE_SIZE..=MAX_RELATIVE_SIZE).contains(x))
         {
-            return Ok(LightShape::rect(s));
+            return Ok(match *self {
+                LightShape::Rect { .. } => LightShape::rect(s),
+                LightShape::Disk { radius } => LightShape::disk(radius / unit),
+            });
         }
         Err(Error::invalid(
             arg,
@@ -132,15 +159,25 @@ impl LightShape {
 
     /// The full width and height (2 hx, 2 hy) of the light's bounding box.
     pub fn extent(&self) -> [f64; 2] {
-        let LightShape::Rect { size } = *self;
-        size
+        match *self {
+            LightShape::Rect { size } => size,
+            LightShape::Disk { radius } => [2.0 * radius; 2],
+        }
     }
 
     /// The half-extents (hx, hy) = (sx/2, sy/2): every light point has
     /// |x| <= hx, |y| <= hy; the penumbra reach is h (1/z - 1/z_r).
     pub fn half_extent(&self) -> [f64; 2] {
-        let LightShape::Rect { size } = *self;
+        let size = self.extent();
         [0.5 * size[0], 0.5 * size[1]]
+    }
+
+    /// The light's area.
+    pub fn area(&self) -> f64 {
+        match *self {
+            LightShape::Rect { size } => size[0] * size[1],
+            LightShape::Disk { radius } => std::f64::consts::PI * radius * radius,
+        }
     }
 
     /// The larger full side of the bounding box, max(2 hx, 2 hy): the
@@ -153,7 +190,7 @@ impl LightShape {
     /// The stratification a x b = samples, a the largest divisor <= sqrt,
     /// the longer side of the light getting the larger count.
     pub fn sample_grid(&self, samples: u32) -> (u32, u32) {
-        let LightShape::Rect { size } = *self;
+        let size = self.extent();
         let mut a = (samples as f64).sqrt() as u32;
         while a > 1 && !samples.is_multiple_of(a) {
             a -= 1;
@@ -181,16 +218,16 @@ impl LightShape {
 
     /// The f32 sample pattern of `samples` rays per receiver.
     pub fn samples(&self, samples: u32) -> LightSamples {
-        let LightShape::Rect { size } = *self;
         LightSamples {
             grid: self.sample_grid(samples),
-            size: size.map(|s| s as f32),
+            size: self.extent().map(|s| s as f32),
+            disk: matches!(self, LightShape::Disk { .. }),
         }
     }
 
     /// The map kernels' half-light units, in f32.
     pub fn half_light(&self) -> HalfLight {
-        let LightShape::Rect { size } = *self;
+        let size = self.extent();
         HalfLight {
             inv_half: [(2.0 / size[0]) as f32, (2.0 / size[1]) as f32],
             half: [(0.5 * size[0]) as f32, (0.5 * size[1]) as f32],
@@ -200,8 +237,7 @@ impl LightShape {
     /// An f32 tangent x in half-light units, scaled in f64 and rounded once
     /// (`x * 2 / sx`; the kernels' column edges, CPU and GPU alike).
     pub fn x_in_half_light(&self, x: f32) -> f32 {
-        let LightShape::Rect { size } = *self;
-        (x as f64 * 2.0 / size[0]) as f32
+        (x as f64 * 2.0 / self.extent()[0]) as f32
     }
 
     /// The unoccluded irradiance at `x` (unit normal `n`) from this shape of
@@ -210,6 +246,7 @@ impl LightShape {
     pub fn irradiance(&self, at: &Placement, x: DVec3, n: DVec3) -> f64 {
         match *self {
             LightShape::Rect { size } => rect::irradiance(size, at, x, n),
+            LightShape::Disk { radius } => disk::irradiance(radius, at, x, n),
         }
     }
 
@@ -219,6 +256,7 @@ impl LightShape {
     pub fn strict_side(&self, at: &Placement, p0: DVec3, n: DVec3, tol: f64) -> Option<DVec3> {
         match *self {
             LightShape::Rect { size } => rect::strict_side(size, at, p0, n, tol),
+            LightShape::Disk { radius } => disk::strict_side(radius, at, p0, n, tol),
         }
     }
 
@@ -228,6 +266,7 @@ impl LightShape {
     pub fn front_fraction(&self, side: [f64; 3]) -> f64 {
         match self {
             LightShape::Rect { .. } => rect::front_fraction(side, self.half_extent()),
+            LightShape::Disk { radius } => disk::front_fraction(side, *radius),
         }
     }
 }
@@ -238,8 +277,11 @@ impl LightShape {
 pub struct LightSamples {
     /// The strata a x b (`LightShape::sample_grid`).
     pub grid: (u32, u32),
-    /// The rectangle's full width and height.
+    /// The rectangle's full width and height; a disk's diameter, twice.
     pub size: [f32; 2],
+    /// The strata are mapped onto the disk inscribed in `size` (Shirley and
+    /// Chiu's concentric map, disk.rs: equal strata stay equal in area).
+    pub disk: bool,
 }
 
 impl LightSamples {
@@ -247,6 +289,9 @@ impl LightSamples {
     /// (((sa + ja)/a - 1/2) sx, ((sb + jb)/b - 1/2) sy).
     #[inline(always)]
     pub fn point(&self, sa: u32, sb: u32, ja: f32, jb: f32) -> (f32, f32) {
+        if self.disk {
+            return disk::sample_point(0.5 * self.size[0], self.grid, sa, sb, ja, jb);
+        }
         let (na, nb) = self.grid;
         let x = ((sa as f32 + ja) / na as f32 - 0.5) * self.size[0];
         let y = ((sb as f32 + jb) / nb as f32 - 0.5) * self.size[1];
@@ -256,6 +301,13 @@ impl LightSamples {
     /// The box [[x0, x1], [y0, y1]] holding every sample of strata
     /// [a0, a1) x [b0, b1) (the shaft culling's target).
     pub fn region(&self, a0: u32, a1: u32, b0: u32, b1: u32) -> [[f32; 2]; 2] {
+        if self.disk {
+            // The concentric map bends a block of strata into a sector of
+            // an annulus; the disk's box holds it (a looser shaft only
+            // traces more rays, each with the same answer).
+            let r = 0.5 * self.size[0];
+            return [[-r, r], [-r, r]];
+        }
         let (na, nb) = self.grid;
         let x = |a: u32| (a as f32 / na as f32 - 0.5) * self.size[0];
         let y = |b: u32| (b as f32 / nb as f32 - 0.5) * self.size[1];

@@ -217,18 +217,19 @@ pub(super) fn front_fraction(side: [f64; 3], half: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::light::RectLight;
+    use crate::geom::light::AreaLight;
 
     /// Irradiance of a unit-radiance rectangle by a midpoint quadrature over
     /// its area, `∫ cos θ_x max(0, cos θ_l) / r² dA` with θ_x clamped at the
     /// horizon.
-    fn quadrature(l: &RectLight, x: DVec3, n: DVec3, k: usize) -> f64 {
-        let area = l.size[0] * l.size[1];
+    fn quadrature(l: &AreaLight, x: DVec3, n: DVec3, k: usize) -> f64 {
+        let size = l.shape.extent();
+        let area = size[0] * size[1];
         let mut sum = 0.0;
         for i in 0..k {
             for j in 0..k {
-                let s = ((i as f64 + 0.5) / k as f64 - 0.5) * l.size[0];
-                let t = ((j as f64 + 0.5) / k as f64 - 0.5) * l.size[1];
+                let s = ((i as f64 + 0.5) / k as f64 - 0.5) * size[0];
+                let t = ((j as f64 + 0.5) / k as f64 - 0.5) * size[1];
                 let d = l.center + s * l.u + t * l.v - x;
                 let r2 = d.length_squared();
                 let w = d / r2.sqrt();
@@ -240,8 +241,8 @@ mod tests {
         sum * area / (k * k) as f64
     }
 
-    fn light() -> RectLight {
-        RectLight::new(
+    fn light() -> AreaLight {
+        AreaLight::rect(
             [0.0, 2.0, 0.0],
             [0.0, -1.0, 0.0],
             [0.0, 0.0, 1.0],
@@ -306,7 +307,7 @@ mod tests {
                 (f * 0.73).sin() * 2.0,
             );
             let n = DVec3::new((f * 1.3).sin() * 0.4, 1.0, (f * 0.7).cos() * 0.4).normalize();
-            let p = l.corners().map(|c| c - x);
+            let p = rect_corners(l.shape.extent(), &l.placement()).map(|c| c - x);
             if p.iter().all(|&q| n.dot(q) >= 0.0) {
                 let (fast, general) = (unclipped_quad(&p, n), clipped_quad(&p, n));
                 assert!(
@@ -325,7 +326,7 @@ mod tests {
         assert_eq!(l.irradiance(DVec3::new(0.0, 2.5, 0.0), DVec3::Y), 0.0);
         assert_eq!(l.irradiance(DVec3::new(0.0, 2.0, 0.0), -DVec3::Y), 0.0);
         let point =
-            RectLight::new([0.0; 3], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0]).unwrap();
+            AreaLight::rect([0.0; 3], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0]).unwrap();
         assert_eq!(point.irradiance(DVec3::new(0.0, -1.0, 0.0), DVec3::Y), 0.0);
     }
 
