@@ -21,7 +21,7 @@ use crate::geom::light_space::{sphere_has_no_space, Light, LightSpace};
 use crate::geom::mesh::MeshRef;
 use crate::methods::config::{check_resolution, CallContext};
 use crate::methods::MethodConfig;
-use crate::methods::{AutoConfig, ExactConfig};
+use crate::methods::AutoConfig;
 use crate::pipeline;
 use crate::threads;
 use crate::timing::Timings;
@@ -43,18 +43,25 @@ fn pick(choice: BackendChoice, method: &MethodConfig, gpu: CallContext, light_ok
     }
 }
 
+/// What "auto" runs for a disk in the light view: `bitmask`, the map
+/// method that shades a disk.
+fn light_view_disk() -> MethodConfig {
+    MethodConfig::Bitmask(crate::methods::BitmaskConfig::default())
+}
+
 /// The config a call on `light` runs. A rectangle or the sun take every
-/// method; a disk or a sphere take those that can shade them
-/// (`Method::refuses_shape`; a sphere has no light space, so not
-/// ShadowMapping either): "auto" without a target runs `traced` (the
-/// view's `exact` default), a method that cannot is refused naming
-/// `method` and why. A target stays in the eye view (`plan_eye` plans
-/// `exact` for it) and is refused in the light view, whose planner plans
-/// maps.
+/// method; a disk takes those that can shade it (`Method::refuses_shape`),
+/// a sphere, which has no light space, `exact` only: "auto" without a
+/// target runs `auto` (the eye view's `exact` default; in the light view
+/// `bitmask`, the map method that takes a disk), a method that cannot is
+/// refused naming `method` and why. A target stays in the eye view for a
+/// disk (`plan_eye` plans `exact` for it) and is refused in the light view,
+/// whose planner plans the rectangle's maps, and for a sphere, whose rays
+/// make no error estimate.
 fn for_light(
     method: MethodConfig,
     light: &Light,
-    traced: ExactConfig,
+    auto: MethodConfig,
     eye: bool,
 ) -> Result<MethodConfig> {
     let shape = light.kernel_shape();
@@ -62,15 +69,30 @@ fn for_light(
         return Ok(method);
     }
     let name = light.name();
+    if let Light::Sphere(_) = light {
+        return match method {
+            MethodConfig::Exact(_) => Ok(method),
+            MethodConfig::Auto(a) if a.target.is_none() => Ok(auto),
+            // A target is checked against the run's error estimate, which a
+            // sphere's rays do not make (`pipeline::eye_view::render_sphere`).
+            MethodConfig::Auto(_) => Err(Error::invalid(
+                "method",
+                "Auto with a target checks the image's error estimate, which a SphereLight's \
+                 rays do not make in this version; pass method=\"exact\" (Exact(samples=...))",
+            )),
+            MethodConfig::ShadowMapping(_) => Err(sphere_has_no_space()),
+            m => Err(Error::invalid(
+                "method",
+                format!(
+                    "{:?} cannot shade a SphereLight: it projects occluders onto a light's \
+                     plane, which a sphere has not; a sphere runs with \"exact\"",
+                    m.name()
+                ),
+            )),
+        };
+    }
     match method {
-        MethodConfig::Auto(a) if a.target.is_none() => Ok(MethodConfig::Exact(traced)),
-        // A target is checked against the run's error estimate, which a
-        // sphere's rays do not make (`pipeline::eye_view::render_sphere`).
-        MethodConfig::Auto(_) if matches!(light, Light::Sphere(_)) => Err(Error::invalid(
-            "method",
-            "Auto with a target checks the image's error estimate, which a SphereLight's rays \
-             do not make in this version; pass method=\"exact\" (Exact(samples=...))",
-        )),
+        MethodConfig::Auto(a) if a.target.is_none() => Ok(auto),
         MethodConfig::Auto(_) if eye => Ok(method),
         MethodConfig::Auto(_) => Err(Error::invalid(
             "method",
@@ -79,9 +101,6 @@ fn for_light(
                  method=\"exact\" (Exact(samples=...))"
             ),
         )),
-        MethodConfig::ShadowMapping(_) if matches!(light, Light::Sphere(_)) => {
-            Err(sphere_has_no_space())
-        }
         m => match m.kernel().refuses_shape(&shape) {
             Some(why) => Err(Error::invalid(
                 "method",
@@ -140,7 +159,7 @@ pub struct MeshCall<'a> {
 pub fn shadow_map(call: &MeshCall) -> Result<Run<ShadowResult>> {
     let (w, h) = check_resolution("resolution", call.resolution)?;
     let call = &MeshCall {
-        method: for_light(call.method, call.light, ExactConfig::default(), false)?,
+        method: for_light(call.method, call.light, light_view_disk(), false)?,
         ..*call
     };
     let cap = threads::resolve(call.threads)?;
@@ -276,7 +295,7 @@ pub struct SceneCall<'a> {
 pub fn scene_shadow_map(call: &SceneCall) -> Result<Run<ShadowResult>> {
     let (w, h) = check_resolution("resolution", call.resolution)?;
     let call = &SceneCall {
-        method: for_light(call.method, call.light, ExactConfig::default(), false)?,
+        method: for_light(call.method, call.light, light_view_disk(), false)?,
         ..*call
     };
     let cap = threads::resolve(call.threads)?;
@@ -488,7 +507,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         method: if call.method == default {
             MethodConfig::Exact(traced)
         } else {
-            for_light(call.method, call.light, traced, true)?
+            for_light(call.method, call.light, MethodConfig::Exact(traced), true)?
         },
         ..*call
     };

@@ -168,7 +168,7 @@ fn bitmask_resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
         vis[idx] = 1.0;
         return;
     }
-    vis[idx] = 1.0 - f32(hidden_samples(idx)) / f32(gp.samples);
+    vis[idx] = 1.0 - f32(hidden_samples(idx)) / f32(gp.counted);
 }
 
 // Points mode (gather.wgsl): masks need no per-row step.
@@ -203,5 +203,5 @@ fn bitmask_points_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
         vis[idx] = 1.0;
         return;
     }
-    vis[idx] = 1.0 - f32(hidden_samples(idx)) / f32(gp.samples);
+    vis[idx] = 1.0 - f32(hidden_samples(idx)) / f32(gp.counted);
 }

@@ -321,6 +321,36 @@ fn tilted_depth_maps(og: &crate::geom::light::MapGrid) -> (Vec<f32>, Vec<f32>) {
 }
 
 #[test]
+fn gpu_bitmask_under_a_disk_is_the_cpus_bit_for_bit() {
+    if !device_or_skip() {
+        return;
+    }
+    use crate::geom::light::MapGrid;
+    let grid = MapGrid::new(48, 40, [0.6, 0.5]).unwrap();
+    let (front, back) = tilted_depth_maps(&grid);
+    let receiver: Vec<f32> = (0..grid.len())
+        .map(|k| 2.6 + 0.1 * ((k * 7) % 5) as f32)
+        .collect();
+    let light = LightShape::disk(0.4);
+    let maps = pipeline::DepthMaps {
+        grid: &grid,
+        occluder_grid: &grid,
+        light_shape: light,
+        front: &front,
+        back: Some(&back),
+        receiver: &receiver,
+    };
+    // The bitmask's disk pattern (its samples on the disk) is one table
+    // on both backends: the same bits.
+    for method in bitmask_kernels() {
+        let (c, _) = pipeline::from_depth(&maps, method, Backend::Cpu).unwrap();
+        let (g, _) = pipeline::from_depth(&maps, method, Backend::Gpu).unwrap();
+        assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 50);
+        assert_eq!(same_bits(&c, &g), 0, "{method:?}");
+    }
+}
+
+#[test]
 fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
     if !device_or_skip() {
         return;

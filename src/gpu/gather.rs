@@ -157,7 +157,8 @@ pub struct GatherParams {
     pub half_ly: f32,
     pub wx: f32,
     pub rows_per_chunk: u32,
-    pub _pad0: u32,
+    /// The light samples on the light (bitmask): `samples`, or a disk's.
+    pub counted: u32,
     pub _pad1: u32,
 }
 
@@ -420,12 +421,15 @@ pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
     }
 }
 
-/// The method's constant tables, as the shader reads them (bitmask's rank
-/// tables), or None.
-pub fn method_tables(method: Method) -> Option<Vec<u32>> {
+/// The method's constant tables for a light of `light`, as the shader
+/// reads them (bitmask's rank tables: a disk's hold its samples only), or
+/// None.
+pub fn method_tables(method: Method, light: LightShape) -> Option<Vec<u32>> {
     match method {
         Method::Bitmask { samples, gaps, .. } => {
-            let t = crate::methods::bitmask::Bitmask::new(samples, gaps, None).rank_tables();
+            let disk = matches!(light, LightShape::Disk { .. });
+            let t = crate::methods::bitmask::Bitmask::for_shape(samples, gaps, None, disk)
+                .rank_tables();
             // x_ge and y_ge, S + 1 entries each of mask_words words.
             assert_eq!(
                 t.len(),

@@ -71,7 +71,8 @@ struct GatherParams {
     wx: f32,
     // Occluder rows per chunk (of a receiver's rows in reach).
     rows_per_chunk: u32,
-    _pad0: u32,
+    // The light samples on the light (bitmask): samples, or a disk's.
+    counted: u32,
     _pad1: u32,
 }
 

@@ -145,7 +145,7 @@ fn mask_words_are_the_rank_tables_entries_and_cost_their_loop() {
                 gaps,
             };
             // method_tables asserts the length; the words hold every sample.
-            let t = method_tables(m).unwrap();
+            let t = method_tables(m, crate::geom::light_shape::LightShape::rect([1.0, 1.0])).unwrap();
             let words = mask_words(samples) as usize;
             assert_eq!(t.len(), 2 * (samples as usize + 1) * words);
             assert!(32 * words >= samples as usize);
@@ -280,7 +280,7 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             half_ly,
             wx,
             rows_per_chunk,
-            _pad0,
+            counted,
             _pad1
         }),
     );

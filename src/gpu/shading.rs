@@ -87,6 +87,13 @@ pub(super) fn gather_params(
             Method::Bitmask { samples, .. } => samples,
             _ => 0,
         },
+        counted: match method {
+            Method::Bitmask { samples, .. } => crate::methods::bitmask::counted_samples(
+                samples,
+                matches!(light_shape, LightShape::Disk { .. }),
+            ),
+            _ => 0,
+        },
         tx: og.tx as f32,
         ty: og.ty as f32,
         hw: hw as f32,
@@ -159,7 +166,8 @@ impl Shading {
                 wgpu::BufferUsages::COPY_DST,
             ),
             axes: upload(device, "axes", &ax),
-            tables: gather::method_tables(method).map(|t| upload(device, "method tables", &t)),
+            tables: gather::method_tables(method, light_shape)
+                .map(|t| upload(device, "method tables", &t)),
             corners: corners.map(|c| upload(device, "corners", &c.corners)),
             vis: storage(
                 device,

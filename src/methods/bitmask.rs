@@ -38,6 +38,7 @@ use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
+use crate::geom::light_shape::LightShape;
 use glam::Vec4;
 
 /// A set of up to 64 W light samples.
@@ -77,6 +78,8 @@ pub struct Bitmask {
     pattern: Patterns,
     gaps: Gaps,
     hierarchy: Option<Hierarchy>,
+    /// The pattern holds a disk's samples only (`Pattern::new`).
+    disk: bool,
 }
 
 /// The pattern in the narrowest mask that holds it.
@@ -91,9 +94,22 @@ enum Patterns {
 struct Pattern<const W: usize> {
     /// Samples per axis of the coarse grid; n^2 samples in all.
     n: usize,
-    /// `x_ge[k]`: the samples whose x-rank is >= k, k in 0..=n^2.
+    /// `x_ge[k]`: the samples whose x-rank is >= k, k in 0..=n^2 (of the
+    /// samples on the light: for a disk, those inside it).
     x_ge: Vec<Mask<W>>,
     y_ge: Vec<Mask<W>>,
+    /// The samples on the light (n^2 for a rectangle).
+    counted: usize,
+}
+
+/// Whether the sample of ranks (xr, yr) of `s` lies on the disk inscribed
+/// in the light's square: its light coordinates (half-light units, where
+/// `RankBounds` puts rank k at 2 (k + 1/2)/S - 1) within the unit circle.
+/// A disk is the square's samples inside it: ~pi/4 of them (201 of 256),
+/// the rim placed to within a sample's cell.
+fn on_disk(xr: usize, yr: usize, s: usize) -> bool {
+    let t = |k: usize| 2.0 * (k as f64 + 0.5) / s as f64 - 1.0;
+    t(xr).powi(2) + t(yr).powi(2) <= 1.0
 }
 
 fn set<const W: usize>(m: &mut Mask<W>, bit: usize) {
@@ -113,30 +129,52 @@ fn permutation(n: usize, seed: &mut u64) -> Vec<usize> {
     p
 }
 
+/// The samples of the n x n pattern on the light (for a `disk`, those
+/// inside it, `on_disk`): (bit, (x-rank, y-rank)).
+fn sample_ranks(n: usize, disk: bool) -> impl Iterator<Item = (usize, (usize, usize))> {
+    let mut seed = 0x5eed_u64 ^ n as u64;
+    // Cell (i, j): x-rank i n + sigma_i(j), y-rank j n + tau_j(i).
+    let sigma: Vec<Vec<usize>> = (0..n).map(|_| permutation(n, &mut seed)).collect();
+    let tau: Vec<Vec<usize>> = (0..n).map(|_| permutation(n, &mut seed)).collect();
+    (0..n * n)
+        .map(move |bit| {
+            let (i, j) = (bit % n, bit / n);
+            (bit, (i * n + sigma[i][j], j * n + tau[j][i]))
+        })
+        .filter(move |&(_, (xr, yr))| !disk || on_disk(xr, yr, n * n))
+}
+
+/// The samples of `samples` on the light (`sample_ranks`): what a mask's
+/// hidden count is a fraction of, on both backends.
+pub fn counted_samples(samples: u32, disk: bool) -> u32 {
+    let n = (samples as f64).sqrt().round() as usize;
+    sample_ranks(n, disk).count() as u32
+}
+
 impl<const W: usize> Pattern<W> {
-    fn new(n: usize) -> Pattern<W> {
+    /// The n x n pattern; `disk`: only its samples on the inscribed disk
+    /// (`on_disk`) are in the tables.
+    fn new(n: usize, disk: bool) -> Pattern<W> {
         let s = n * n;
         assert!(s <= 64 * W, "{s} samples do not fit {W} words");
-        let mut seed = 0x5eed_u64 ^ n as u64;
-        // Cell (i, j): x-rank i n + sigma_i(j), y-rank j n + tau_j(i).
-        let sigma: Vec<Vec<usize>> = (0..n).map(|_| permutation(n, &mut seed)).collect();
-        let tau: Vec<Vec<usize>> = (0..n).map(|_| permutation(n, &mut seed)).collect();
         let mut x_ge = vec![[0u64; W]; s + 1];
         let mut y_ge = vec![[0u64; W]; s + 1];
-        for j in 0..n {
-            for i in 0..n {
-                let bit = j * n + i;
-                let xr = i * n + sigma[i][j];
-                let yr = j * n + tau[j][i];
-                for m in &mut x_ge[..=xr] {
-                    set(m, bit);
-                }
-                for m in &mut y_ge[..=yr] {
-                    set(m, bit);
-                }
+        let mut counted = 0;
+        for (bit, (xr, yr)) in sample_ranks(n, disk) {
+            counted += 1;
+            for m in &mut x_ge[..=xr] {
+                set(m, bit);
+            }
+            for m in &mut y_ge[..=yr] {
+                set(m, bit);
             }
         }
-        Pattern { n, x_ge, y_ge }
+        Pattern {
+            n,
+            x_ge,
+            y_ge,
+            counted,
+        }
     }
 
     /// Samples per receiver.
@@ -560,7 +598,7 @@ impl<const W: usize, const QUADS: bool> Accumulator for MaskKernel<'_, W, QUADS>
     }
 
     fn occlusion(&self, acc: &Self::State) -> Lanes {
-        let s = self.p.count() as f32;
+        let s = self.p.counted as f32;
         let mut o = [0f32; LANES];
         for (l, o) in o.iter_mut().enumerate() {
             *o = (0..W).map(|q| acc[q][l].count_ones()).sum::<u32>() as f32 / s;
@@ -590,17 +628,44 @@ impl Bitmask {
 
     /// `samples` must be one of SAMPLE_COUNTS (checked by `Method::parse`).
     pub fn new(samples: u32, gaps: Gaps, hierarchy: Option<Hierarchy>) -> Bitmask {
+        Bitmask::for_shape(samples, gaps, hierarchy, false)
+    }
+
+    /// `new`, for a disk light where `disk` (`Pattern::new`).
+    pub fn for_shape(samples: u32, gaps: Gaps, hierarchy: Option<Hierarchy>, disk: bool) -> Bitmask {
         let n = (samples as f64).sqrt().round() as usize;
         let pattern = if n * n <= 256 {
-            Patterns::Small(Pattern::new(n))
+            Patterns::Small(Pattern::new(n, disk))
         } else {
-            Patterns::Large(Pattern::new(n))
+            Patterns::Large(Pattern::new(n, disk))
         };
         Bitmask {
             pattern,
             gaps,
             hierarchy,
+            disk,
         }
+    }
+
+    /// The samples on the light: all of them, or a disk's.
+    pub fn counted(&self) -> usize {
+        match &self.pattern {
+            Patterns::Small(p) => p.counted,
+            Patterns::Large(p) => p.counted,
+        }
+    }
+
+    /// The method for `inputs`' light: itself, or its pattern cut to the
+    /// disk (built per call: a few milliseconds at 1024 samples).
+    fn on(&self, inputs: &ShadowInputs) -> Option<Bitmask> {
+        let disk = matches!(inputs.light_shape, LightShape::Disk { .. });
+        (disk && !self.disk).then(|| {
+            let n = match &self.pattern {
+                Patterns::Small(p) => p.n,
+                Patterns::Large(p) => p.n,
+            };
+            Bitmask::for_shape((n * n) as u32, self.gaps, self.hierarchy, true)
+        })
     }
 }
 
@@ -630,10 +695,16 @@ macro_rules! with_kernel {
 
 impl ShadowMethod for Bitmask {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
+        if let Some(disk) = self.on(inputs) {
+            return disk.visibility_map(inputs);
+        }
         with_kernel!(self, |k| gather::visibility_map(k, inputs, self.hierarchy))
     }
 
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
+        if let Some(disk) = self.on(inputs) {
+            return disk.visibility_points(inputs, points);
+        }
         with_kernel!(self, |k| gather::visibility_points(
             k,
             inputs,
@@ -820,9 +891,9 @@ mod tests {
     #[test]
     fn pattern_is_multi_jittered() {
         for n in [4, 8, 16] {
-            check_pattern(Pattern::<4>::new(n));
+            check_pattern(Pattern::<4>::new(n, false));
         }
-        check_pattern(Pattern::<16>::new(32));
+        check_pattern(Pattern::<16>::new(32, false));
     }
 
     fn check_pattern<const W: usize>(p: Pattern<W>) {
@@ -859,6 +930,28 @@ mod tests {
         // samples lie in one coarse row or column).
         let max = crate::methods::plate_case::max_error(&Bitmask::new(256, Gaps::Open, None), 48);
         assert!(max <= 4.0 * 16.0 / 256.0 + 1e-6, "max error {max}");
+    }
+
+    #[test]
+    fn a_disk_takes_the_samples_inside_it_and_matches_its_closed_form() {
+        // 201 of 256 samples on the inscribed disk (pi/4 of 256 is 201.1).
+        assert_eq!(Bitmask::for_shape(256, Gaps::Open, None, true).counted(), 201);
+        assert_eq!(Bitmask::for_shape(1024, Gaps::Open, None, false).counted(), 1024);
+        // The plate under a disk of radius 1/2: the rim is placed to within
+        // a sample's cell, so the error is larger than the square's but
+        // small on average.
+        let disk = LightShape::disk(0.5);
+        for samples in [256, 1024] {
+            let (mean, max) = crate::methods::plate_case::mean_and_max_error(
+                &Bitmask::new(samples, Gaps::Open, None),
+                48,
+                disk,
+            );
+            assert!(mean < 0.01 && max < 0.08, "{samples}: mean {mean} max {max}");
+        }
+        // The same maps under the square light are shaded as before.
+        let square = crate::methods::plate_case::max_error(&Bitmask::new(256, Gaps::Open, None), 48);
+        assert!(square <= 4.0 * 16.0 / 256.0 + 1e-6);
     }
 
     #[test]

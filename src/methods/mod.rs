@@ -152,24 +152,25 @@ impl Method {
     }
 
     /// Why the method cannot shade a light of `shape`, or None where it
-    /// can. The map methods take the light as the rectangle of its
-    /// half-extents: `ssm` and `bitmask` clip each micro-patch's
+    /// can. `exact` samples any shape, `bitmask` keeps the samples of its
+    /// pattern that lie on a disk (bitmask.rs), and ShadowMapping's hard
+    /// shadow reads the light's centre only. The others take the light as
+    /// the rectangle of its half-extents: `ssm` clips each micro-patch's
     /// back-projection to it (`HalfLight`), PCSS's search box and the
-    /// smoothies' width are its sides; a disk would be shaded as the
-    /// square around it. `exact` samples any shape, and ShadowMapping's
-    /// hard shadow reads the light's centre only.
+    /// smoothies' width are its sides; a disk would be shaded as the square
+    /// around it.
     pub fn refuses_shape(&self, shape: &LightShape) -> Option<&'static str> {
         let rect = matches!(shape, LightShape::Rect { .. });
         match self {
-            Method::Exact { .. } | Method::ShadowMapping(_) => None,
+            Method::Exact { .. } | Method::ShadowMapping(_) | Method::Bitmask { .. } => None,
             _ if rect => None,
-            Method::Ssm { .. } | Method::Bitmask { .. } => Some(
-                "clips each occluder texel's back-projection to a rectangular light; a disk or \
-                 a sphere runs with \"exact\"",
+            Method::Ssm { .. } => Some(
+                "clips each occluder texel's back-projection to a rectangular light; a disk runs \
+                 with \"bitmask\" or \"exact\"",
             ),
             Method::Pcss { .. } | Method::Smoothies { .. } => Some(
-                "sizes its penumbrae from a rectangular light's sides; a disk or a sphere runs \
-                 with \"exact\"",
+                "sizes its penumbrae from a rectangular light's sides; a disk runs with \
+                 \"bitmask\" or \"exact\"",
             ),
         }
     }
@@ -332,6 +333,14 @@ pub(crate) mod plate_case {
     /// The plate's edges fall on texel edges, so the occluder map holds it
     /// exactly and any error is the method's.
     pub fn max_error(method: &dyn ShadowMethod, n: usize) -> f64 {
+        mean_and_max_error(method, n, LightShape::rect([1.0, 1.0])).1
+    }
+
+    /// The mean and largest |V - V_exact| of `method` on the plate of
+    /// `max_error` under a light of `shape`: the unit square, or the disk
+    /// of radius 1/2 (whose occluded part is a rectangle's overlap with
+    /// it, `light_shape::disk::rect_overlap`).
+    pub fn mean_and_max_error(method: &dyn ShadowMethod, n: usize, shape: LightShape) -> (f64, f64) {
         let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
         let (zo, zr, a) = (2.0f64, 4.0f64, 0.25f64);
         let front: Vec<f32> = (0..n * n)
@@ -348,7 +357,7 @@ pub(crate) mod plate_case {
         let inputs = ShadowInputs {
             grid,
             occluder_grid: grid,
-            light_shape: LightShape::rect([1.0, 1.0]),
+            light_shape: shape,
             receiver: &receiver,
             occluder_layers: vec![&front],
             occluder_triangles: None,
@@ -361,13 +370,27 @@ pub(crate) mod plate_case {
         let ov = |c: f64| {
             ((k * (a - c) + 0.5).clamp(0.0, 1.0) - (k * (-a - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
         };
-        let mut max = 0f64;
+        let span = |c: f64| [k * (-a - c), k * (a - c)];
+        let (mut max, mut sum) = (0f64, 0f64);
         for j in 0..n {
             for i in 0..n {
-                let exact = 1.0 - ov(grid.x_of(i)) * ov(grid.y_of(j));
-                max = max.max((v[j * n + i] as f64 - exact).abs());
+                let (x, y) = (grid.x_of(i), grid.y_of(j));
+                let exact = match shape {
+                    LightShape::Disk { radius } => {
+                        let hidden = crate::geom::light_shape::disk::rect_overlap(
+                            radius,
+                            span(x),
+                            span(y),
+                        );
+                        1.0 - hidden / shape.area()
+                    }
+                    LightShape::Rect { .. } => 1.0 - ov(x) * ov(y),
+                };
+                let e = (v[j * n + i] as f64 - exact).abs();
+                max = max.max(e);
+                sum += e;
             }
         }
-        max
+        (sum / (n * n) as f64, max)
     }
 }

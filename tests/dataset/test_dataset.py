@@ -275,7 +275,7 @@ def test_dask_local_cluster_gives_the_same_files_as_local_processes(tmp_path):
     assert sorted(records) == list(range(5)) and all(r["status"] == "done" for r in records.values())
 
 
-@pytest.mark.parametrize("name", ["shadows_ground", "city_sun", "tabletop"])
+@pytest.mark.parametrize("name", ["shadows_ground", "city_sun", "tabletop", "mixed_lights"])
 def test_example_specs_run(tmp_path, name):
     spec = load_spec(ROOT / "examples" / f"{name}.toml")
     summary = run(spec, tmp_path / name, count=2, progress=False)
@@ -284,11 +284,16 @@ def test_example_specs_run(tmp_path, name):
     assert report.ok and report.complete == [0, 1]
     for k in (0, 1):
         record = json.loads((tmp_path / name / "items" / "00000" / f"0000000{k}.json").read_text())
-        v = io.read_exr(tmp_path / name / "items" / "00000" / f"0000000{k}.exr")["V"]
-        mask = io.read_exr(tmp_path / name / "items" / "00000" / f"0000000{k}.exr")["mask"] > 0
+        channels = io.read_exr(tmp_path / name / "items" / "00000" / f"0000000{k}.exr")
+        mask = channels["mask"] > 0
         assert record["objects"], "an example item has objects"
+        # One visibility channel per light (V, or V.0, V.1, ... with several lights per item).
+        lights = record.get("lights", [record.get("light")])
+        names = ["V"] if "light" in record else [f"V.{j}" for j in range(len(lights))]
+        assert sorted(c for c in channels if c == "V" or c.startswith("V.")) == names
         # Shadows are in view: some seen surface is (partly) shadowed, some is lit.
-        assert (v[mask] < 0.5).any() and (v[mask] > 0.99).any()
+        v = np.stack([channels[n] for n in names])
+        assert (v[:, mask] < 0.5).any() and (v[:, mask] > 0.99).any()
 
 
 def test_mitsuba_reference_as_teacher(tmp_path):

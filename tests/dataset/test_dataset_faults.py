@@ -322,7 +322,7 @@ HOSTILE = [
     (_set("+objects", {"kind": "mesh"}), r"objects\[2\].path: missing"),
     (_set("+lights", {"kind": "sun", "size": 1.0}), r'lights\[1\].size: only for kind = "rect"'),
     (_set("+lights", {"kind": "rect", "elevation": [10, 95]}), r"lights\[1\].elevation"),
-    (_set("+lights", {"kind": "lamp"}), r"lights\[1\].kind: must be one of \['rect', 'sun'\]"),
+    (_set("+lights", {"kind": "lamp"}), r"lights\[1\].kind: must be one of \['rect', 'disk', 'sphere', 'sun'\]"),
     (_set("lights.0.target", [0, 0, NAN]), r"lights\[0\].target"),
 ]
 

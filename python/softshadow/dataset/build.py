@@ -4,9 +4,20 @@ Base meshes are centred on their bounding box and scaled so that its
 largest side is 1 (the bunny of :func:`softshadow.scenes.bunny_mesh`, a
 unit box, a sphere of diameter 1, a torus lying flat with outer diameter 1
 and tube radius 0.15, or a mesh file read by trimesh); each process caches
-them. Mesh order in the scene: the instances in the record's order, then
-the ground, so an image's ``mesh_id`` indexes the record's ``objects`` (the
-ground is the last id).
+them (the last 64 files read, with their colours). Mesh order in the scene:
+the instances in the record's order, then the ground, so an image's
+``mesh_id`` indexes the record's ``objects`` (the ground is the last id).
+
+Albedo: every instance and the ground have their sampled ``albedo``. An
+instance whose record says ``"colors": "file"`` (a ``kind = "mesh"`` object
+with ``colors = "file"``, the default, drawing a file that carries colours)
+keeps the file's own colours instead: its :class:`softshadow.Material`
+(vertex or face colours, a material's colour, a texture with its UVs; see
+:meth:`softshadow.Material.from_trimesh`). ``render``'s ``albedo=``
+overrides every material, so a scene with such an instance gives the other
+meshes a constant material of their sampled albedo (``scene.materials``)
+and is rendered without ``albedo=``; a scene without one is rendered with
+``albedo=`` as before (:func:`render_albedo`).
 
 A mesh file the reader refuses raises :class:`MeshError` naming the file
 and the reader's complaint (trimesh's own messages, "Not a ply file!",
@@ -23,7 +34,8 @@ from typing import Any
 import numpy as np
 
 from .._extras import require
-from ..lights import DirectionalLight, RectLight
+from ..lights import DirectionalLight, DiskLight, Light, RectLight, SphereLight
+from ..materials import Material
 from ..scene import Camera, Mesh, Scene
 from ..scenes.primitives import box, bunny_mesh, quad, sphere, torus
 
@@ -45,9 +57,14 @@ def base_mesh(kind: str, path: str | None = None) -> Mesh:
     elif kind == "torus":
         v, f = torus((0.0, 0.0, 0.0), 0.35, 0.15)
     elif kind == "mesh" and path is not None:
-        v, f = _read_mesh(path)
+        return mesh_file(path)[:2]
     else:
         raise ValueError(f"kind: unknown object kind {kind!r}")
+    return _normalized(v, f, None, kind)
+
+
+def _normalized(v: np.ndarray, f: np.ndarray, path: str | None, kind: str = "mesh") -> Mesh:
+    """Centred on its bounding box, its largest side 1; read-only arrays."""
     lo, hi = v.min(axis=0), v.max(axis=0)
     side = float((hi - lo).max())
     if not np.isfinite(side) or side <= 0.0:
@@ -59,7 +76,33 @@ def base_mesh(kind: str, path: str | None = None) -> Mesh:
     return v, f
 
 
-def _read_mesh(path: str) -> Mesh:
+MeshFile = tuple[np.ndarray, np.ndarray, Material | None, str | None]
+"""A mesh file read: its normalized vertices and faces (read-only), its
+colours (None where it has none) and why its colours cannot be used (None
+where they can, or where it has none)."""
+
+
+@functools.lru_cache(maxsize=64)
+def mesh_file(path: str) -> MeshFile:
+    """The mesh file ``path`` read (cached per process): see :data:`MeshFile`."""
+    v, f, material, problem = _read_mesh(path)
+    v, f = _normalized(v, f, path)
+    if material is not None and material.texture is not None:
+        import softshadow as ss
+
+        h, w = material.texture.shape[:2]
+        most = int(ss.limits().get("max_texels", 1 << 28))
+        if h * w > most:
+            material, problem = None, f"its texture has {w}x{h} texels; at most {most}"
+    return v, f, material, problem
+
+
+def file_material(path: str) -> Material | None:
+    """The colours of the mesh file ``path`` (None where it has none or they cannot be used)."""
+    return mesh_file(path)[2]
+
+
+def _read_mesh(path: str) -> tuple[np.ndarray, np.ndarray, Material | None, str | None]:
     trimesh = require("trimesh", "dataset", 'an object of kind = "mesh"')
     try:
         loaded = trimesh.load(path, force="mesh")
@@ -70,12 +113,20 @@ def _read_mesh(path: str) -> Mesh:
     v, f = np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces)
     if f.size and (f.min() < 0 or f.max() >= len(v)):
         raise MeshError(f"{path}: a face indexes vertex {int(f.max())} of {len(v)}")
-    return v, f
+    try:
+        return v, f, Material.from_trimesh(loaded, "its visual"), None
+    except (ValueError, TypeError) as e:
+        return v, f, None, str(e)
 
 
-def check_mesh_file(path: str) -> None:
-    """Reads and normalizes a mesh file as an item would (cached); MeshError if it cannot be used."""
-    base_mesh("mesh", path)
+def check_mesh_file(path: str, *, colors: bool = False) -> bool:
+    """Reads and normalizes a mesh file as an item would (cached); MeshError
+    if it cannot be used (with ``colors``, if its colours cannot be used
+    either). Returns whether it carries colours."""
+    _, _, material, problem = mesh_file(path)
+    if colors and problem is not None:
+        raise MeshError(f'{path}: its colours cannot be used ({problem}); colors = "albedo" uses the geometry alone')
+    return material is not None
 
 
 def _rotation(axis: np.ndarray, degrees: float) -> np.ndarray:
@@ -100,25 +151,71 @@ def place(inst: dict[str, Any], folder: str) -> Mesh:
 
 
 def build_scene(params: dict[str, Any], folder: str) -> tuple[Scene, list[np.ndarray]]:
-    """The scene and each mesh's RGB albedo, in scene order."""
+    """The scene and each mesh's sampled RGB albedo, in scene order. Where an
+    instance keeps its file's colours (``"colors": "file"``), the scene's
+    ``materials`` hold them, and a constant material of its albedo for every
+    other mesh (module docstring); render it without ``albedo=``
+    (:func:`render_albedo`)."""
     meshes = [place(inst, folder) for inst in params["objects"]]
     albedo = [np.asarray(inst["albedo"]) for inst in params["objects"]]
+    own: list[Material | None] = [
+        file_material(os.path.join(folder, inst["file"])) if inst.get("colors") == "file" else None
+        for inst in params["objects"]
+    ]
     if params["ground"] is not None:
         meshes.append(quad((0.0, 0.0, 0.0), 0.5 * params["ground"]["size"]))
         albedo.append(np.asarray(params["ground"]["albedo"]))
-    return Scene(meshes=meshes), albedo
+        own.append(None)
+    scene = Scene(meshes=meshes)
+    if any(m is not None for m in own):
+        # Scene(meshes=...) keeps no colours; from_trimesh sets them so too.
+        scene._materials = tuple(
+            m if m is not None else Material("constant", color=(float(a[0]), float(a[1]), float(a[2])))
+            for m, a in zip(own, albedo, strict=True)
+        )
+    return scene, albedo
 
 
-def build_light(p: dict[str, Any], *, shading: bool) -> RectLight | DirectionalLight:
+def render_albedo(scene: Scene, albedo: list[np.ndarray]) -> dict[str, Any]:
+    """``render``'s albedo argument for a scene of :func:`build_scene`:
+    ``{"albedo": [...]}`` (one RGB per mesh), or nothing where the scene's
+    materials hold the colours (``albedo=`` would override them)."""
+    if any(m is not None for m in scene.materials):
+        return {}
+    return {"albedo": [tuple(float(c) for c in a) for a in albedo]}
+
+
+def build_light(p: dict[str, Any], *, shading: bool) -> Light:
     """The light; with ``shading`` its ``radiance`` or ``irradiance`` too."""
     extra: dict[str, Any] = {}
-    if p["kind"] == "rect":
+    kind = p["kind"]
+    if kind == "sun":
         if shading:
-            extra["radiance"] = p["radiance"]
-        return RectLight(center=p["center"], normal=p["normal"], up=p["up"], size=p["size"], **extra)
+            extra["irradiance"] = p["irradiance"]
+        return DirectionalLight(direction=p["direction"], up=p["up"], angular_size=p["angular_size"], **extra)
     if shading:
-        extra["irradiance"] = p["irradiance"]
-    return DirectionalLight(direction=p["direction"], up=p["up"], angular_size=p["angular_size"], **extra)
+        extra["radiance"] = p["radiance"]
+    if kind == "rect":
+        return RectLight(center=p["center"], normal=p["normal"], up=p["up"], size=p["size"], **extra)
+    if kind == "disk":
+        return DiskLight(center=p["center"], normal=p["normal"], radius=p["radius"], **extra)
+    if kind == "sphere":
+        return SphereLight(center=p["center"], radius=p["radius"], **extra)
+    raise ValueError(f"kind: unknown light kind {kind!r}")
+
+
+def record_lights(params: dict[str, Any]) -> list[dict[str, Any]]:
+    """An item's lights as its record holds them: ``lights`` (a spec with
+    ``lights_per_item`` above 1), else the one ``light``."""
+    return list(params["lights"]) if "lights" in params else [params["light"]]
+
+
+def build_lights(params: dict[str, Any], *, shading: bool) -> Light | list[Light]:
+    """What ``render`` takes for the item: a list of its lights where its
+    record has ``lights`` (even one), else its one light alone (as before
+    several lights per item; the channels are ``V`` then, not ``V.0``)."""
+    lights = [build_light(p, shading=shading) for p in record_lights(params)]
+    return lights if "lights" in params else lights[0]
 
 
 def build_camera(p: dict[str, Any]) -> Camera:

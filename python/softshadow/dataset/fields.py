@@ -124,7 +124,7 @@ class Table:
         return parse_range(self.name(key), v, lo, hi, open_lo=open_lo)
 
     def int_range(self, key: str, default: IntRange | int, lo: int, hi: int) -> IntRange:
-        v = self.raw(key, default)
+        v = given = self.raw(key, default)
         if isinstance(v, int) and not isinstance(v, bool):
             v = (v, v)
         ok = (
@@ -135,7 +135,7 @@ class Table:
         )
         if not ok:
             raise self.fail(
-                key, f"must be an integer or [low, high] integers with {lo} <= low <= high <= {hi}, got {_show(v)}"
+                key, f"must be an integer or [low, high] integers with {lo} <= low <= high <= {hi}, got {_show(given)}"
             )
         return int(v[0]), int(v[1])
 

@@ -5,10 +5,14 @@ Item k's files, under ``outputs.folder`` in subfolders of 1000 items
 
 * ``.exr``: the requested channels, float32, as :meth:`softshadow.Image.channels`
   names them (``V``, ``shaded.*``, ``unshadowed.*``, ``depth``, ``normal.x/y/z``,
-  ``position.x/y/z``, ``mesh_id``, ``mask``);
+  ``position.x/y/z``, ``mesh_id``, ``mask``, ``albedo.*``); with several
+  lights per item (``lights_per_item``) the visibility is ``V.0``, ``V.1``, ...
+  one per light, and the shading sums the lights;
 * ``.maps.exr`` on request: the light-view occluder layers (``layer0`` front,
   ``layer1`` back), planar depth from the light or the sun's orthographic depth;
-* ``.png`` (visibility) and ``.shaded.png`` on request: 8-bit previews;
+  with several lights ``layer0.j``, ``layer1.j`` for light j;
+* ``.png`` (visibility; with several lights their mean) and ``.shaded.png``
+  on request: 8-bit previews;
 * ``.json``: the record: every sampled parameter, the seed, k, the spec's
   hash, the resolved method and the versions. Nothing in it depends on the
   machine or the time, so the files are the same bit for bit wherever and
@@ -29,7 +33,7 @@ import numpy as np
 from .. import io as ssio
 from ..scene import Scene
 from . import limits as L
-from .build import build_camera, build_light, build_scene
+from .build import build_camera, build_light, build_lights, build_scene, record_lights, render_albedo
 from .files import write_item_files
 from .sampling import item_seed, sample_item, scene_item
 from .spec import REFERENCE, Spec, shading_available
@@ -74,8 +78,10 @@ def _versions(mitsuba: bool) -> tuple[tuple[str, str | None], ...]:
 
 
 def select_channels(all_channels: dict[str, np.ndarray], groups: tuple[str, ...]) -> dict[str, np.ndarray]:
-    """The channels of the requested groups (``visibility`` is ``V``; a group
-    ``g`` is the channel ``g`` or the channels ``g.*``), in the groups' order."""
+    """The channels of the requested groups (``visibility`` is ``V``, or
+    ``V.0``, ``V.1``, ... with several lights; a group ``g`` is the channel
+    ``g`` or the channels ``g.*``: ``albedo`` is ``albedo.R/G/B``), in the
+    groups' order."""
     out = {}
     for g in groups:
         name = "V" if g == "visibility" else g
@@ -109,37 +115,46 @@ def _scene(spec: Spec, k: int, params: dict[str, Any]) -> tuple[Scene, list[np.n
 
 def render_item(
     spec: Spec, k: int, threads: int | None
-) -> tuple[dict[str, np.ndarray], list[np.ndarray], dict[str, Any]]:
-    """Item k's channels (all of them), light-view maps and record (without file names)."""
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], dict[str, Any]]:
+    """Item k's channels (all of them), light-view maps (by channel name) and
+    record (without file names)."""
     params = sample_item(spec, k)
     scene, albedo = _scene(spec, k, params)
     camera = build_camera(params["camera"])
     m = spec.method
     record: dict[str, Any] = {"k": k, "seed": spec.seed, "spec_hash": spec.hash, "versions": versions(spec)}
     record.update(params)
-    maps: list[np.ndarray] = []
+    maps: dict[str, np.ndarray] = {}
     if m.name == REFERENCE:
         from ..reference import render_visibility
 
         if threads is not None:
             _cap_drjit_threads(threads)
         samples = int(m.options.get("samples", 256))
-        jitter_seed = item_seed(spec.seed, k)
-        light = build_light(params["light"], shading=False)
-        ref = render_visibility(scene, light, camera, samples, seed=jitter_seed)
-        channels: dict[str, np.ndarray] = {"V": ref.visibility, "depth": ref.depth}
+        lights = record_lights(params)
+        seeds = [item_seed(spec.seed, k, j) for j in range(len(lights))]
+        refs = [
+            render_visibility(scene, build_light(p, shading=False), camera, samples, seed=s)
+            for p, s in zip(lights, seeds, strict=True)
+        ]
+        ref = refs[0]  # the G-buffer: every light's run sees the same first hits
+        channels: dict[str, np.ndarray] = (
+            {f"V.{j}": r.visibility for j, r in enumerate(refs)} if spec.several_lights else {"V": ref.visibility}
+        )
+        channels["depth"] = ref.depth
         for i, axis in enumerate("xyz"):
             channels[f"position.{axis}"] = ref.position[..., i]
             channels[f"normal.{axis}"] = ref.normal[..., i]
         channels["mesh_id"] = ref.mesh_id.astype(np.float32)
         channels["mask"] = ref.mask.astype(np.float32)
-        record["method"] = {"name": REFERENCE, "samples": ref.samples, "jitter_seed": jitter_seed}
+        jitter: int | list[int] = seeds if spec.several_lights else seeds[0]
+        record["method"] = {"name": REFERENCE, "samples": ref.samples, "jitter_seed": jitter}
     else:
         from ..api import render
 
         shading = shading_available()
-        light = build_light(params["light"], shading=shading)
-        extra: dict[str, Any] = {"albedo": [tuple(float(c) for c in a) for a in albedo]} if shading else {}
+        light = build_lights(params, shading=shading)
+        extra = render_albedo(scene, albedo) if shading else {}
         config, loose = method_call(spec)
         img = render(
             scene, light, camera, config,
@@ -147,17 +162,47 @@ def render_item(
             backend=m.backend, threads=threads, **extra, **loose,
         )  # fmt: skip
         channels = img.channels()
-        maps = list(img.shadow_maps)
-        record["method"] = {"name": m.name, "config": repr(img.method), "backend": img.backend}
+        parts = img.parts if spec.several_lights else (img,)
+        if spec.several_lights:
+            record["method"] = {"name": m.name, "config": [repr(p.method) for p in parts], "backend": img.backend}
+        else:
+            record["method"] = {"name": m.name, "config": repr(img.method), "backend": img.backend}
         if spec.outputs.light_maps:
-            record["light_maps"] = {
-                "layers": len(maps),
-                "extent": None if img.map_extent is None else list(img.map_extent),
-                "depth_origin": None if img.depth_origin is None else list(img.depth_origin),
-                "depth_range": img.depth_range,
-            }
-    record["shading"] = {"albedo": "per mesh, scene order", "applied": m.name != REFERENCE and shading_available()}
+            maps = _light_maps(parts, several=spec.several_lights)
+            about = [
+                {
+                    "layers": len(p.shadow_maps),
+                    "extent": None if p.map_extent is None else list(p.map_extent),
+                    "depth_origin": None if p.depth_origin is None else list(p.depth_origin),
+                    "depth_range": p.depth_range,
+                }
+                for p in parts
+            ]
+            record["light_maps"] = about if spec.several_lights else about[0]
+    record["shading"] = {"albedo": _albedo_note(scene), "applied": m.name != REFERENCE and shading_available()}
     return channels, maps, record
+
+
+def _albedo_note(scene: Scene) -> str:
+    """The record's word on where the albedo came from (build.py)."""
+    if any(mat is not None for mat in scene.materials):
+        return 'per mesh, scene order; the file\'s own colours for the objects with "colors": "file"'
+    return "per mesh, scene order"
+
+
+def _light_maps(parts: tuple[Any, ...], *, several: bool) -> dict[str, np.ndarray]:
+    """The light-view layers by channel name: ``layer0``, ``layer1`` (one
+    light), or ``layer0.j``, ``layer1.j`` for light j (several; one EXR, so
+    one size: the spec fixes the maps' resolution). Empty when the method
+    made none."""
+    out: dict[str, np.ndarray] = {}
+    for j, p in enumerate(parts):
+        for i, a in enumerate(p.shadow_maps):
+            out[f"layer{i}.{j}" if several else f"layer{i}"] = a
+    shapes = {a.shape for a in out.values()}
+    if len(shapes) > 1:
+        raise RuntimeError(f"outputs.light_maps: the lights' maps have different sizes {sorted(shapes)}")
+    return out
 
 
 def method_call(spec: Spec) -> tuple[Any, dict[str, Any]]:
@@ -191,10 +236,9 @@ def make_item(spec: Spec, out: str, k: int, threads: int | None = None) -> dict[
     if "maps" in files:
         if not maps:
             raise RuntimeError(f"outputs.light_maps: method {spec.method.name!r} gave no light-view maps")
-        layers = {f"layer{i}": a for i, a in enumerate(maps)}
-        writers[files["maps"]] = lambda p: ssio.write_exr(p, layers, compression=mode)
+        writers[files["maps"]] = lambda p: ssio.write_exr(p, maps, compression=mode)
     if "preview" in files:
-        writers[files["preview"]] = lambda p: ssio.write_png(p, ssio.to_uint8(all_channels["V"]))
+        writers[files["preview"]] = lambda p: ssio.write_png(p, ssio.to_uint8(_preview_visibility(all_channels)))
     if "shaded_preview" in files:
         shaded = np.stack([channels[n] for n in channels if n.startswith("shaded.")], axis=-1)
         writers[files["shaded_preview"]] = lambda p: ssio.write_png(p, _tone_map(shaded))
@@ -216,6 +260,14 @@ def _cap_drjit_threads(threads: int) -> None:
         _, dr = _mitsuba()
         dr.set_thread_count(threads)
         _drjit_threads = threads
+
+
+def _preview_visibility(channels: dict[str, np.ndarray]) -> np.ndarray:
+    """The visibility preview: ``V``, or the mean of ``V.0``, ``V.1``, ... (several lights)."""
+    if "V" in channels:
+        return channels["V"]
+    several = [v for name, v in channels.items() if name.startswith("V.")]
+    return np.asarray(np.mean(np.stack(several), axis=0, dtype=np.float64))
 
 
 def _tone_map(rgb: np.ndarray) -> np.ndarray:

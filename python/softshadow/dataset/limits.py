@@ -24,6 +24,9 @@ MAX_INSTANCES = 1000
 """Instances one ``[[objects]]`` table may place per item (``count``, ``grid``)."""
 MAX_LIGHT_ENTRIES = 16
 """``[[lights]]`` tables per spec."""
+MAX_LIGHTS_PER_ITEM = 32
+"""Lights one item draws (``lights_per_item``); the core's own bound on one
+call's lights (``softshadow.limits()["lights"]``) applies too."""
 MAX_MESH_FILES = 100_000
 """Mesh files one folder may hold."""
 MAX_COORDINATE = 1.0e6

@@ -10,6 +10,13 @@ were. The result is plain JSON values (the item's record) from which
 (k // n alike) draw their objects and ground from the first one's objects
 stream and their light and camera from their own.
 
+Several lights (``lights_per_item``): their number comes from a stream of
+its own (child 4 of item k's seed sequence; child 3 is the reference's
+jitter, :func:`item_seed`), drawn only when the range is not one number;
+the lights are then drawn one after the other from the light stream, each
+table picked by weight then sampled as one light is. So the first light of
+every item is the one a spec with one light per item draws.
+
 Placement (per instance): the base mesh is scaled so that the largest side
 of its bounding box is 1, stretched per axis, scaled by ``scale``, tilted by
 ``tilt`` degrees about a horizontal axis at a random angle, turned by
@@ -66,10 +73,27 @@ def sample_item(spec: Spec, k: int) -> dict[str, Any]:
     ground = None
     if spec.ground.enabled:
         ground = {"size": spec.ground.size, "albedo": _color(r_obj, spec.ground.albedo)}
+    camera = _camera(r_cam, spec)
+    if not spec.several_lights:
+        return {"objects": objects, "ground": ground, "light": _pick_light(r_light, spec), "camera": camera}
+    lights = [_pick_light(r_light, spec) for _ in range(light_count(spec, k))]
+    return {"objects": objects, "ground": ground, "lights": lights, "camera": camera}
+
+
+def light_count(spec: Spec, k: int) -> int:
+    """How many lights item k draws (``lights_per_item``), from its own stream."""
+    lo, hi = spec.lights_per_item
+    if lo == hi:
+        return lo
+    rng = np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(k, 4)))
+    return int(rng.integers(lo, hi + 1))
+
+
+def _pick_light(rng: np.random.Generator, spec: Spec) -> dict[str, Any]:
+    """One light: a ``[[lights]]`` table by weight (no draw when there is one), then its values."""
     weights = np.array([light.weight for light in spec.lights])
-    which = int(r_light.choice(len(spec.lights), p=weights / weights.sum())) if len(spec.lights) > 1 else 0
-    light = _light(r_light, which, spec.lights[which])
-    return {"objects": objects, "ground": ground, "light": light, "camera": _camera(r_cam, spec)}
+    which = int(rng.choice(len(spec.lights), p=weights / weights.sum())) if len(spec.lights) > 1 else 0
+    return _light(rng, which, spec.lights[which])
 
 
 def _instances(rng: np.random.Generator, index: int, o: ObjectSpec, spec: Spec) -> list[dict[str, Any]]:
@@ -92,6 +116,8 @@ def _instances(rng: np.random.Generator, index: int, o: ObjectSpec, spec: Spec) 
         if o.kind == "mesh":
             f = o.files[int(rng.integers(len(o.files)))] if len(o.files) > 1 else o.files[0]
             inst["file"] = spec.relative(f)
+            if spec.file_colors(o, f):
+                inst["colors"] = "file"  # the file's own colours, not the albedo (build.py)
         inst.update(
             scale=uniform(rng, o.scale),
             stretch=[uniform(rng, r) for r in o.stretch],
@@ -122,6 +148,18 @@ def tangent_up(azimuth: float, elevation: float) -> np.ndarray:
 def _light(rng: np.random.Generator, which: int, s: LightSpec) -> dict[str, Any]:
     az, el = uniform(rng, s.azimuth), uniform(rng, s.elevation)
     d, up = direction(az, el), tangent_up(az, el)
+    if s.kind in ("disk", "sphere"):
+        radius = uniform(rng, s.radius)
+        dist = uniform(rng, s.distance)
+        center = np.asarray(s.target) + dist * d
+        out: dict[str, Any] = {
+            "entry": which, "kind": s.kind, "azimuth": az, "elevation": el, "distance": dist,
+            "center": center.tolist(),
+        }  # fmt: skip
+        if s.kind == "disk":
+            out["normal"] = (-d).tolist()  # facing the target
+        out.update(radius=radius, radiance=uniform(rng, s.power))
+        return out
     if s.kind == "rect":
         width = uniform(rng, s.size)
         height = width * uniform(rng, s.aspect)
@@ -151,6 +189,10 @@ def _camera(rng: np.random.Generator, spec: Spec) -> dict[str, Any]:
     }  # fmt: skip
 
 
-def item_seed(seed: int, k: int) -> int:
-    """A 32-bit seed of item k for what draws its own numbers (the Mitsuba reference's jitter)."""
-    return int(np.random.SeedSequence(seed, spawn_key=(k,)).spawn(4)[3].generate_state(1)[0])
+def item_seed(seed: int, k: int, light: int = 0) -> int:
+    """A 32-bit seed of item k for what draws its own numbers (the Mitsuba
+    reference's jitter), for its light ``light``: child 3 of its seed
+    sequence for the first, 4 + light for the others (4 draws the number of
+    lights, :func:`light_count`)."""
+    child = 3 if light == 0 else 4 + light
+    return int(np.random.SeedSequence(seed, spawn_key=(k, child)).generate_state(1)[0])

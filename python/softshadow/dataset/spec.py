@@ -37,10 +37,29 @@ Color = tuple[Range, Range, Range]
 
 PRIMITIVES = ["bunny", "box", "sphere", "torus"]
 OBJECT_KINDS = [*PRIMITIVES, "mesh"]
-CHANNELS = ["visibility", "shaded", "unshadowed", "depth", "normal", "position", "mesh_id", "mask"]
-"""Channel groups an item's EXR may hold (``position`` only on request)."""
+CHANNELS = ["visibility", "shaded", "unshadowed", "depth", "normal", "position", "mesh_id", "mask", "albedo"]
+"""Channel groups an item's EXR may hold (``position`` and ``albedo`` only on request)."""
 DEFAULT_CHANNELS = ["visibility", "shaded", "unshadowed", "depth", "normal", "mesh_id", "mask"]
-SHADING_CHANNELS = {"shaded", "unshadowed"}
+SHADING_CHANNELS = {"shaded", "unshadowed", "albedo"}
+"""The channels of ``ss.render``'s shading (not the Mitsuba reference's)."""
+LIGHT_KINDS = ["rect", "disk", "sphere", "sun"]
+PLACED_KINDS = ("rect", "disk", "sphere")
+"""The area lights, placed at ``distance`` from ``target`` (the sun has a direction only)."""
+LIGHT_KEYS: dict[str, tuple[str, ...]] = {
+    "size": ("rect",),
+    "aspect": ("rect",),
+    "radius": ("disk", "sphere"),
+    "distance": PLACED_KINDS,
+    "target": PLACED_KINDS,
+    "radiance": PLACED_KINDS,
+    "angular_size": ("sun",),
+    "irradiance": ("sun",),
+}
+"""The ``[[lights]]`` keys that only some kinds take (the others take
+``kind``, ``weight``, ``azimuth`` and ``elevation``)."""
+COLORS = ["file", "albedo"]
+"""``colors`` of a ``kind = "mesh"`` object: the file's own colours where it
+has them, or the sampled ``albedo`` everywhere."""
 MESH_EXTENSIONS = {".obj", ".ply", ".stl", ".off", ".glb", ".gltf", ".dae", ".3mf"}
 """The mesh files a folder contributes (formats trimesh reads)."""
 REFERENCE = "reference"
@@ -79,6 +98,9 @@ class ObjectSpec:
     yaw: Range
     tilt: Range
     albedo: Color
+    colors: str = "albedo"
+    """``"file"``: a mesh file's own colours and texture where it has them
+    (``kind = "mesh"`` only); ``"albedo"``: the sampled ``albedo``."""
 
 
 @dataclass(frozen=True)
@@ -93,7 +115,9 @@ class LightSpec:
     target: tuple[float, float, float]
     angular_size: Range
     power: Range
-    """``radiance`` of a rectangle, ``irradiance`` of the sun."""
+    """``radiance`` of a rectangle, disk or sphere, ``irradiance`` of the sun."""
+    radius: Range = (0.0, 0.0)
+    """A disk's or a sphere's radius."""
 
 
 @dataclass(frozen=True)
@@ -147,22 +171,52 @@ class Spec:
     """Consecutive items that share one scene (objects and ground), each with
     its own light and camera: items k and j share it when k // views ==
     j // views (:func:`.sampling.scene_item`)."""
+    lights_per_item: IntRange = (1, 1)
+    """How many lights an item draws (each from the ``[[lights]]`` tables by
+    weight); more than 1 possible makes every item of the spec a several-light
+    item (:attr:`several_lights`)."""
+    mesh_colors: dict[str, bool] = field(repr=False, compare=False, default_factory=dict)
+    """Whether each mesh file carries colours (a material, vertex or face
+    colours, a texture), by absolute path."""
+
+    @property
+    def several_lights(self) -> bool:
+        """Whether items may have more than one light: then every item is
+        rendered with a list of lights (channels ``V.0``, ``V.1``, ...; the
+        record's ``lights``), even one that drew a single light."""
+        return self.lights_per_item[1] > 1
+
+    def file_colors(self, o: ObjectSpec, path: str) -> bool:
+        """Whether instances of ``o`` drawing the file ``path`` keep its own colours."""
+        return o.kind == "mesh" and o.colors == "file" and self.mesh_colors.get(path, False)
 
     def canonical(self) -> dict[str, Any]:
         """What defines the items (everything but ``count``), as JSON values:
         mesh files appear by their path relative to the spec's folder and
-        their sha256, so moving the spec with its meshes keeps its hash."""
+        their sha256, so moving the spec with its meshes keeps its hash.
+        Fields added since the first format are left out where they change
+        nothing (``views = 1``, one light, ``compression = "zip"``, a light's
+        ``radius`` for a rectangle or the sun, an object's ``colors`` unless
+        its files' own colours are used), so that specs from before them
+        keep their hash (and their output folders resume)."""
         d = asdict(self)
-        for name in ("text", "folder", "mesh_hashes", "count"):
+        for name in ("text", "folder", "mesh_hashes", "mesh_colors", "count"):
             d.pop(name)
-        for obj in d["objects"]:
+        for o, obj in zip(self.objects, d["objects"], strict=True):
+            if not any(self.file_colors(o, f) for f in o.files):
+                del obj["colors"]  # as before the field: the sampled albedo
             obj["files"] = [[self.relative(f), self.mesh_hashes[f]] for f in obj["files"]]
+        for light in d["lights"]:
+            if light["kind"] not in ("disk", "sphere"):
+                del light["radius"]
         if d["outputs"]["compression"] == "zip":
             # The default, left out so that specs from before the field
             # keep their hash (and their output folders resume).
             del d["outputs"]["compression"]
         if d["views"] == 1:
             del d["views"]  # likewise
+        if tuple(d["lights_per_item"]) == (1, 1):
+            del d["lights_per_item"]  # likewise
         return json.loads(json.dumps(d))
 
     @functools.cached_property
@@ -220,19 +274,32 @@ def parse_spec(data: dict[str, Any], *, text: str = "", folder: str = ".") -> Sp
     count = top.integer("count", 1, 1, L.MAX_COUNT)
     views = top.integer("views", 1, 1, L.MAX_VIEWS)
     ground = _ground(top.table("ground"))
-    objects = tuple(_object(t, folder) for t in top.tables("objects", most=L.MAX_OBJECT_ENTRIES))
+    colored: dict[str, bool] = {}
+    objects = tuple(_object(t, folder, colored) for t in top.tables("objects", most=L.MAX_OBJECT_ENTRIES))
     instances = sum(_most_instances(o) for o in objects)
     if instances > L.MAX_INSTANCES:
         raise SpecError(f"objects: up to {instances} instances per item; at most {L.MAX_INSTANCES}")
     if not ground.enabled and all(_most_instances(o) == 0 for o in objects):
         raise SpecError("objects: no objects and no ground: an item would have no surface")
     lights = tuple(_light(t) for t in top.tables("lights", most=L.MAX_LIGHT_ENTRIES, least=1))
+    lights_per_item = top.int_range("lights_per_item", 1, 1, _most_lights())
     camera = _camera(top.table("camera", required=True))
     method = _method(top.table("method"))
-    outputs = _outputs(top.table("outputs"), method)
+    outputs = _outputs(top.table("outputs"), method, lights, lights_per_item)
     top.done()
+    _check_light_kinds(lights, method, outputs.light_maps)
     hashes = {f: sha256_file(f) for o in objects for f in o.files}
-    return Spec(seed, count, ground, objects, lights, camera, method, outputs, text, folder, hashes, views)
+    return Spec(
+        seed, count, ground, objects, lights, camera, method, outputs, text, folder, hashes, views,
+        lights_per_item=lights_per_item, mesh_colors=colored,
+    )  # fmt: skip
+
+
+def _most_lights() -> int:
+    """``lights_per_item``'s bound: this module's and the core's (one call's lights)."""
+    import softshadow as ss
+
+    return min(L.MAX_LIGHTS_PER_ITEM, int(ss.limits().get("lights", 1)))
 
 
 def _ground(t: Table) -> GroundSpec:
@@ -245,13 +312,19 @@ def _ground(t: Table) -> GroundSpec:
     return g
 
 
-def _object(t: Table, folder: str) -> ObjectSpec:
+def _object(t: Table, folder: str, colored: dict[str, bool]) -> ObjectSpec:
+    """One ``[[objects]]`` table; ``colored`` gets whether each of its mesh
+    files carries colours."""
     kind = t.choice("kind", OBJECT_KINDS)
     path: str | None = None
     files: tuple[str, ...] = ()
+    colors = "albedo"
     if kind == "mesh":
         path = t.string("path")
-        files = _mesh_files(t.name("path"), path, folder)
+        colors = t.choice("colors", COLORS, "file")
+        files = _mesh_files(t.name("path"), path, folder, colored, colors=colors == "file")
+    elif t.has("colors"):
+        raise t.fail("colors", 'only for kind = "mesh" (a mesh file\'s own colours)')
     placement = t.choice("placement", ["ground", "floating"], "ground")
     layout = t.choice("layout", ["random", "grid"], "random")
     M = L.MAX_COORDINATE
@@ -274,6 +347,7 @@ def _object(t: Table, folder: str) -> ObjectSpec:
         yaw=t.range("yaw", (0.0, 360.0), -3600.0, 3600.0),
         tilt=t.range("tilt", 0.0, -180.0, 180.0),
         albedo=t.color("albedo", 0.7),
+        colors=colors,
     )
     if placement == "ground" and t.has("height"):
         raise t.fail("height", 'only for placement = "floating" (a grounded object rests at height 0)')
@@ -332,11 +406,13 @@ def _file_kind(mode: int) -> str:
     return "special file"
 
 
-def _mesh_files(name: str, path: str, folder: str) -> tuple[str, ...]:
+def _mesh_files(name: str, path: str, folder: str, colored: dict[str, bool], *, colors: bool) -> tuple[str, ...]:
     """The mesh files of ``path`` (a file or a folder of them), each read once
     (:func:`.build.check_mesh_file`): a file that cannot be used is refused
-    now, naming it, rather than failing every item that draws it. Only
-    regular files: reading a device (``/dev/zero``) or a FIFO would never end."""
+    now, naming it, rather than failing every item that draws it (with
+    ``colors``, one whose colours cannot be used too). Only regular files:
+    reading a device (``/dev/zero``) or a FIFO would never end. ``colored``
+    gets whether each file carries colours."""
     if not path or "\x00" in path:
         raise SpecError(f"{name}: must be a mesh file or a folder of them, got {path!r}")
     full = os.path.normpath(os.path.join(folder, os.path.expanduser(path)))
@@ -373,45 +449,56 @@ def _mesh_files(name: str, path: str, folder: str) -> tuple[str, ...]:
         raise SpecError(f"{name}: {path!r} is a {_file_kind(mode)}, not a regular file or a folder of mesh files")
     for f in found:
         try:
-            check_mesh_file(f)
+            colored[f] = check_mesh_file(f, colors=colors)
         except MeshError as e:
             raise SpecError(f"{name}: {e}") from None
     return tuple(found)
 
 
 def _light(t: Table) -> LightSpec:
-    kind = t.choice("kind", ["rect", "sun"])
+    kind = t.choice("kind", LIGHT_KINDS)
     M = L.MAX_COORDINATE
-    rect = kind == "rect"
-    target = t.raw("target", [0.0, 0.0, 0.0]) if rect else [0.0, 0.0, 0.0]
+    placed = kind in PLACED_KINDS
+    for key, kinds in LIGHT_KEYS.items():
+        if kind not in kinds and t.has(key):
+            raise t.fail(key, f"only for kind = {_or(kinds)}")
+    target = t.raw("target", [0.0, 0.0, 0.0]) if placed else [0.0, 0.0, 0.0]
     if not (
         isinstance(target, list)
         and len(target) == 3
         and all(isinstance(x, (int, float)) and not isinstance(x, bool) and abs(x) <= M for x in target)
     ):
         raise t.fail("target", f"must be [x, y, z] finite numbers within [-{M:g}, {M:g}], got {target!r}")
+    rect, round_ = kind == "rect", kind in ("disk", "sphere")
     light = LightSpec(
         kind=kind,
         weight=t.number("weight", 1.0, 0.0, M, open_lo=True),
         azimuth=t.range("azimuth", (0.0, 360.0), -3600.0, 3600.0),
         elevation=t.range("elevation", (30.0, 80.0), 1.0, 89.0)
-        if rect
+        if placed
         else t.range("elevation", (20.0, 70.0), 1.0, 90.0),
         size=t.range("size", 1.0, 0.0, M, open_lo=True) if rect else (0.0, 0.0),
         aspect=t.range("aspect", 1.0, 1e-3, 1e3) if rect else (0.0, 0.0),
-        distance=t.range("distance", (3.0, 5.0), 0.0, M, open_lo=True) if rect else (0.0, 0.0),
+        distance=t.range("distance", (3.0, 5.0), 0.0, M, open_lo=True) if placed else (0.0, 0.0),
         target=(float(target[0]), float(target[1]), float(target[2])),
-        angular_size=t.range("angular_size", 0.53, 0.0, 90.0) if not rect else (0.0, 0.0),
-        power=t.range("radiance" if rect else "irradiance", 1.0, 0.0, M),
+        angular_size=t.range("angular_size", 0.53, 0.0, 90.0) if not placed else (0.0, 0.0),
+        power=t.range("radiance" if placed else "irradiance", 1.0, 0.0, M),
+        radius=t.range("radius", 0.5, 0.0, M, open_lo=True) if round_ else (0.0, 0.0),
     )
-    if not rect:
-        for key in ("size", "aspect", "distance", "target", "radiance"):
-            if t.has(key):
-                raise t.fail(key, 'only for kind = "rect"')
-    elif t.has("angular_size") or t.has("irradiance"):
-        raise t.fail("angular_size" if t.has("angular_size") else "irradiance", 'only for kind = "sun"')
+    if kind == "sphere" and light.radius[1] >= light.distance[0]:
+        raise t.fail(
+            "radius",
+            f"a sphere's radius must stay below its distance from the target (or the target is inside it): "
+            f"radius up to {light.radius[1]:g}, distance from {light.distance[0]:g}",
+        )
     t.done()
     return light
+
+
+def _or(kinds: tuple[str, ...]) -> str:
+    """``"rect"``, ``"disk" or "sphere"``, ``"rect", "disk" or "sphere"``."""
+    quoted = [f'"{k}"' for k in kinds]
+    return quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
 
 
 def _camera(t: Table) -> CameraSpec:
@@ -481,6 +568,73 @@ def _method(t: Table) -> MethodSpec:
     return m
 
 
+#: The lights a method's refusal is probed with (:func:`_check_light_kinds`):
+#: one of each kind a map method may refuse, and a rectangle that every
+#: method shades, over a box on a ground square.
+_PROBE_LIGHTS = {
+    "rect": ("RectLight", ((0.0, 3.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0))),
+    "disk": ("DiskLight", ((0.0, 3.0, 0.0), (0.0, -1.0, 0.0), 0.5)),
+    "sphere": ("SphereLight", ((0.0, 3.0, 0.0), 0.5)),
+}
+
+
+def _check_light_kinds(lights: tuple[LightSpec, ...], method: MethodSpec, light_maps: bool) -> None:
+    """SpecError when the method cannot do with a kind of the spec's lights
+    what every item drawing it would ask: shade it (naming ``method.name``:
+    the map methods refuse spheres, most of them disks too; an ``Auto`` with a
+    target refuses spheres), or, with ``light_maps``, make its light-view
+    maps (naming ``outputs.light_maps``: ``auto`` traces disks and spheres).
+    The core is asked, with a 4x4 render of a box under one light of that
+    kind, as the items call it. Only disks and spheres are asked about
+    (every method shades rectangles and the sun); a render the core refuses
+    for a rectangle too is left to the items."""
+    kinds = [k for k in ("disk", "sphere") if any(light.kind == k for light in lights)]
+    if method.name == REFERENCE or not kinds:
+        return
+    import softshadow as ss
+
+    from .._core import Auto
+    from ..scenes.primitives import box, quad
+
+    config: Any = make_config(method)
+    loose: dict[str, Any] = {}
+    if light_maps and config == Auto():
+        config, loose = "auto", {"passes": 2}  # auto's map rule, as item.method_call runs it
+    scene = ss.Scene(meshes=[box((0.0, 0.5, 0.0), (1.0, 1.0, 1.0)), quad((0.0, 0.0, 0.0), 2.0)])
+    camera = ss.Camera.look_at(
+        eye=(3.0, 3.0, 3.0), target=(0.0, 0.3, 0.0), up=(0.0, 1.0, 0.0), fov_y=40.0, resolution=(4, 4)
+    )
+
+    def probe(kind: str) -> tuple[str | None, bool]:
+        """(the core's refusal or None, whether it made light-view maps)."""
+        cls, args = _PROBE_LIGHTS[kind]
+        try:
+            img = ss.render(
+                scene, getattr(ss, cls)(*args), camera, config, map_resolution=(8, 8),
+                normal_offset=method.normal_offset, depth_bias=method.depth_bias, threads=1, **loose,
+            )  # fmt: skip
+        except ValueError as e:
+            return str(e), False
+        return None, bool(img.shadow_maps)
+
+    rect = probe("rect")
+    if rect[0] is not None:
+        return  # not about the kind: the items will say what it is
+    for kind in kinds:
+        i = next(i for i, light in enumerate(lights) if light.kind == kind)
+        why, maps = probe(kind)
+        if why is not None:
+            raise SpecError(
+                f"method.name: {method.name!r} cannot shade lights[{i}], of kind = {kind!r} ({why}); "
+                '"exact" and "auto" (without a target for a sphere) shade every kind'
+            )
+        if light_maps and rect[1] and not maps:
+            raise SpecError(
+                f"outputs.light_maps: method {method.name!r} makes no light-view maps for lights[{i}], "
+                f"of kind = {kind!r} (its shadows are traced)"
+            )
+
+
 def make_config(m: MethodSpec, *, path: str = "method.options") -> Any:
     """The method's typed config from its name and options. An option whose
     value is a table ``{ type = "SlopeScaleBias", ... }`` becomes that config
@@ -517,7 +671,7 @@ def _option_value(name: str, value: Any, option: Any) -> Any:
     return value
 
 
-def _outputs(t: Table, method: MethodSpec) -> OutputSpec:
+def _outputs(t: Table, method: MethodSpec, lights: tuple[LightSpec, ...], lights_per_item: IntRange) -> OutputSpec:
     shading = shading_available() and method.name != REFERENCE
     available = [c for c in CHANNELS if shading or c not in SHADING_CHANNELS]
     default = [c for c in DEFAULT_CHANNELS if c in available]
@@ -539,6 +693,14 @@ def _outputs(t: Table, method: MethodSpec) -> OutputSpec:
     light_maps = t.boolean("light_maps", False)
     if light_maps and (method.name in ("exact", REFERENCE)):
         raise t.fail("light_maps", f"method {method.name!r} makes no light-view maps")
+    if light_maps:
+        fixed = method.map_resolution is not None or "occluder_resolution" in method.options
+        if lights_per_item[1] > 1 and not fixed:
+            raise t.fail(
+                "light_maps",
+                "with several lights per item every light's maps go to one EXR file, so they need one size: "
+                "set method.map_resolution",
+            )
     folder = t.string("folder", "items")
     if len(folder) > L.MAX_NAME or not FOLDER_NAME.match(folder) or folder in RESERVED_NAMES:
         raise t.fail(
