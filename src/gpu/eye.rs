@@ -204,10 +204,9 @@ impl EyeStages for GpuEye {
             .iter()
             .map(GpuRayStart::new)
             .collect();
-        let (v, t) = exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
+        let ((v, weighted), t) = exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
-        // The device counts clear rays only: its shading multiplies by V.
-        Ok((v, None))
+        Ok((v, Some(weighted)))
     }
 
     fn shade_maps(
@@ -379,8 +378,9 @@ impl GpuRayStart {
     }
 }
 
-/// `exact`'s visibility per ray start, through a BVH of `tris` (kernel
-/// light space) on the device; and the device's stage times.
+/// `exact`'s visibility per ray start and its weighted visibility
+/// (eye_rays.wgsl), through a BVH of `tris` (kernel light space) on the
+/// device; and the device's stage times.
 fn exact_visibility(
     g: &Gpu,
     bvh: &Bvh,
@@ -388,10 +388,10 @@ fn exact_visibility(
     samples: u32,
     light_shape: LightShape,
     sw: &mut Stopwatch,
-) -> Result<(Vec<f32>, Timings)> {
+) -> Result<((Vec<f32>, Vec<f32>), Timings)> {
     let n = starts.len();
     if n == 0 {
-        return Ok((vec![], vec![]));
+        return Ok(((vec![], vec![]), vec![]));
     }
     fits(g, "resolution", n as u64 * size_of::<GpuRayStart>() as u64)?;
     let has_tris = !bvh.is_empty();
@@ -421,13 +421,20 @@ fn exact_visibility(
             4,
             wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         );
-        let vis = storage(device, "visibility", bytes, wgpu::BufferUsages::COPY_SRC);
+        let vis = storage(device, "visibility", 2 * bytes, wgpu::BufferUsages::COPY_SRC);
+        let weights = storage(
+            device,
+            "sample weights",
+            2 * bytes,
+            wgpu::BufferUsages::COPY_DST,
+        );
         sw.lap("upload");
         let timer = StageTimer::new(g, 1);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("softshadow eye exact"),
         });
         enc.clear_buffer(&seen, 0, None);
+        enc.clear_buffer(&weights, 0, None);
         enc.clear_buffer(&status, 0, None);
         {
             let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
@@ -456,6 +463,7 @@ fn exact_visibility(
                         Some(&seen),
                         Some(&status),
                         Some(&start_buf),
+                        Some(&weights),
                     ],
                 );
                 pass.set_bind_group(0, &bg, &[]);
@@ -475,16 +483,19 @@ fn exact_visibility(
                     Some(&seen),
                     None,
                     Some(&start_buf),
+                    Some(&weights),
                 ],
             );
             pass.set_pipeline(&p.rays_resolve);
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, 1);
         }
-        submit_and_read(g, enc, &timer, &[(&vis, bytes), (&status, 4)], sw)
+        submit_and_read(g, enc, &timer, &[(&vis, 2 * bytes), (&status, 4)], sw)
     })?;
     if words(&out.buffers[1])[0] != 0 {
         return Err(budget_error());
     }
-    Ok((visibility(&out.buffers[0])?, out.device_timings))
+    let mut v = visibility(&out.buffers[0])?;
+    let weighted = v.split_off(n);
+    Ok(((v, weighted), out.device_timings))
 }

@@ -9,9 +9,13 @@
 // (the point moved off its surface along the normal by Mitsuba's
 // spawn_ray_to offset, computed in f64 on the CPU: rays::ray_starts),
 // and runs o + t (light point - o), t in (0, 1 - RAY_EPS) (ExactParams t0 = 0,
-// t1). A chunk of samples per dispatch counts the clear ones into `seen`;
-// the resolve divides by the sample count, 0 for a start that is not valid
-// (a point at or behind a rectangle's plane).
+// t1). A chunk of samples per dispatch counts the clear ones into `seen`,
+// and sums their weights and every sample's into `weights` (the light
+// point's share of the irradiance, cos θ cos θ' / r² up to a factor:
+// rays.rs's `RayStart::weight`); the resolve divides the count by the
+// sample count into vis[k] and the weights into vis[n + k] (the weighted
+// visibility; V where no sample weighs anything), 0 for a start that is
+// not valid (a point at or behind a rectangle's plane).
 //
 // Appended to u64.wgsl + exact.wgsl (hash, unit, occluded and its bindings;
 // ExactParams' rec_w is the number of ray starts here).
@@ -39,6 +43,8 @@ struct RayStart {
 const RAYS_GROUP: u32 = 64u;
 
 @group(0) @binding(8) var<storage, read> starts: array<RayStart>;
+// Per start: the clear samples' summed weight, then every sample's.
+@group(0) @binding(9) var<storage, read_write> weights: array<f32>;
 
 // Adds this dispatch's chunk of samples to each point's count.
 @compute @workgroup_size(64)
@@ -54,7 +60,10 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
     }
     let above = vec3<f32>(s.ax, s.ay, s.az);
     let below = vec3<f32>(s.bx, s.by, s.bz);
+    let p = 0.5 * (above + below);
     var count = 0u;
+    var w_seen = 0.0;
+    var w_all = 0.0;
     for (var k = ep.chunk_start; k < ep.chunk_start + ep.chunk_len; k++) {
         let sa = k % ep.light.na;
         let sb = k / ep.light.na;
@@ -63,16 +72,24 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
         let l = light_sample(sa, sb, j.x, j.y, ep.light);
         let x = l.x;
         let y = l.y;
+        let side = s.a0 + x * s.au + y * s.av;
         var o = below;
-        if s.a0 + x * s.au + y * s.av >= 0.0 {
+        if side >= 0.0 {
             o = above;
         }
+        let q = vec3<f32>(x, y, 0.0) - p;
+        let r2 = dot(q, q);
+        let w = max(side, 0.0) * p.z / (r2 * r2);
+        w_all += w;
         let d = vec3<f32>(x, y, 0.0) - o;
         if !occluded(o, d) {
             count += 1u;
+            w_seen += w;
         }
     }
     seen[idx] += count;
+    weights[2u * idx] += w_seen;
+    weights[2u * idx + 1u] += w_all;
 }
 
 @compute @workgroup_size(64)
@@ -82,13 +99,19 @@ fn eye_exact_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
     if idx >= ep.rec_w {
         return;
     }
+    let n = ep.rec_w;
     if starts[idx].valid == 0u {
         vis[idx] = 0.0;
+        vis[n + idx] = 0.0;
         return;
     }
     if ep.has_tris == 0u {
         vis[idx] = 1.0;
+        vis[n + idx] = 1.0;
         return;
     }
-    vis[idx] = f32(seen[idx]) / f32(ep.light.na * ep.light.nb);
+    let v = f32(seen[idx]) / f32(ep.light.na * ep.light.nb);
+    vis[idx] = v;
+    let w_all = weights[2u * idx + 1u];
+    vis[n + idx] = select(v, weights[2u * idx] / w_all, w_all > 0.0);
 }

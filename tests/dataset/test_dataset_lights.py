@@ -188,7 +188,7 @@ def test_mixed_lights_and_a_textured_asset_end_to_end(tmp_path):
     np.testing.assert_array_equal(img.shaded, channels["shaded"])
 
 
-def test_an_interrupted_several_light_run_resumes_to_the_same_files(tmp_path, monkeypatch):
+def test_an_interrupted_several_light_run_resumes_to_the_same_files_on_any_workers(tmp_path, monkeypatch):
     spec = load_spec(write(tmp_path))
     whole = tmp_path / "whole"
     run(spec, whole, progress=False)
@@ -212,7 +212,10 @@ def test_an_interrupted_several_light_run_resumes_to_the_same_files(tmp_path, mo
     resumed = run(spec, out, progress=False)
     assert (resumed.skipped, resumed.done) == (3, 5)
     assert item_hashes(out) == item_hashes(whole)
-    # Any item alone is the same too (its lights and their number are item k's own).
+    # Two worker processes (the spec pickled to them, mesh colours and all) and
+    # any item alone give the same files (its lights and their number are item k's own).
+    run(spec, tmp_path / "two", workers=2, progress=False)
+    assert item_hashes(tmp_path / "two") == item_hashes(whole)
     alone = tmp_path / "alone"
     run(spec, alone, items=[5], progress=False)
     assert item_hashes(alone) == {n: h for n, h in item_hashes(whole).items() if "/00000005." in n}
@@ -350,8 +353,8 @@ REFUSED = [
         r"method.name: 'auto' cannot shade lights\[0\], of kind = 'sphere'",
     ),
     (
-        {"outputs": {"light_maps": True}},
-        r"outputs.light_maps: method 'auto' makes no light-view maps for lights\[1\], of kind = 'disk' \(its",
+        {"lights": [{"kind": "rect"}, {"kind": "sphere"}], "outputs": {"light_maps": True}},
+        r"outputs.light_maps: method 'auto' makes no light-view maps for lights\[1\], of kind = 'sphere' \(its",
     ),
     (
         {"lights": [{"kind": "rect"}, {"kind": "sun"}], "lights_per_item": [1, 2], "outputs": {"light_maps": True}},

@@ -583,7 +583,7 @@ def _check_light_kinds(lights: tuple[LightSpec, ...], method: MethodSpec, light_
     what every item drawing it would ask: shade it (naming ``method.name``:
     the map methods refuse spheres, most of them disks too; an ``Auto`` with a
     target refuses spheres), or, with ``light_maps``, make its light-view
-    maps (naming ``outputs.light_maps``: ``auto`` traces disks and spheres).
+    maps (naming ``outputs.light_maps``: a sphere's shadows are traced).
     The core is asked, with a 4x4 render of a box under one light of that
     kind, as the items call it. Only disks and spheres are asked about
     (every method shades rectangles and the sun); a render the core refuses
