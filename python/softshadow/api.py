@@ -63,7 +63,9 @@ def soft_shadow_map(
     Parameters
     ----------
     scene, light
-        The geometry and the light: a rectangle, or a
+        The geometry and the light: a rectangle, a disk (``bitmask`` keeps
+        its samples on the disk, ``exact`` samples it; ``"auto"`` takes
+        ``bitmask``, the default ``"ssm"`` refuses it), or a
         :class:`DirectionalLight`, whose maps are orthographic (world
         half-extents; depth from the plane across the light touching the
         scene, ``sm.depth_origin``). With the split scene
@@ -349,17 +351,24 @@ def render(
     lights, and ``img.parts`` holds each light's own image.
 
     Every mesh casts and receives shadows, its own included (the far side of
-    a closed mesh is in its own umbra). A :class:`RectLight` lights its
-    ``n`` side only: points at or behind its plane get 0.
+    a closed mesh is in its own umbra). A :class:`RectLight` or
+    :class:`DiskLight` lights its ``n`` side only: points at or behind its
+    plane get 0. A :class:`DiskLight` takes ``exact``, ``bitmask`` and
+    ``shadow_mapping``, a :class:`SphereLight` ``exact`` on the CPU only;
+    the other methods refuse them with the reason (docs/lights.md).
 
     The image also holds the direct lighting of Lambertian surfaces
     (docs/shading.md): ``unshadowed = albedo / pi * E``, E the irradiance
     from the light's ``radiance`` (or the sun's ``irradiance``) in closed
     form at the pixel's point and geometric normal (facing the camera), and
-    ``shaded = unshadowed * visibility``. That product is an approximation:
-    the exact shadowed irradiance weights each visible part of the light by
-    its cosine (and 1/r^2), the visibility counts them alike; the two agree
-    where a pixel is fully lit or in umbra. The shading runs on the CPU
+    ``shaded`` the shadowed direct light: ``exact`` weighs each of its
+    samples by what it adds to the irradiance (cos θ cos θ' / r^2), so
+    ``shaded = unshadowed * V_w`` with V_w the share of the irradiance the
+    clear samples carry; the map methods shade with ``unshadowed *
+    visibility``, which weights every part of the light alike (exact where
+    a pixel is fully lit or in umbra). ``img.albedo`` is the albedo shaded
+    with: each mesh's colours, materials and textures read by
+    :meth:`Scene.from_trimesh`, or ``albedo=``. The shading runs on the CPU
     after the visibility, on every backend.
 
     method
@@ -395,7 +404,9 @@ def render(
         Keyword-only. The meshes' diffuse albedo: a number (grey) or an RGB
         triple for every mesh, or a sequence with one number or triple per
         mesh of ``scene.meshes`` (three numbers are always one RGB triple).
-        Values in [0, 1]. Default (``None``): 0.8 grey, the core's default.
+        Values in [0, 1]. It overrides the meshes' own colours
+        (``scene.materials``). Default (``None``): each mesh's colours, or
+        0.8 grey (the core's default) for a mesh without any.
     estimate_error
         Keyword-only. Also estimate the image's error (``img.error_estimate``):
         exact stratified rays (256 light samples; for ``exact``, four times
@@ -498,6 +509,11 @@ def _image(r: Any, light: Light, camera: Camera) -> Image:
     )
 
 
+def _one(value: Any) -> tuple[Any, ...]:
+    """A part's light or method (one each) as a tuple of one."""
+    return value if isinstance(value, tuple) else (value,)
+
+
 def _sum_of(parts: tuple[Image, ...], camera: Camera) -> Image:
     """Several lights' images as one: visibility (L, H, W), the shading
     summed (in float64, rounded once), the first part's G-buffer (they share
@@ -507,19 +523,26 @@ def _sum_of(parts: tuple[Image, ...], camera: Camera) -> Image:
         for stage, seconds in p.timings.items():
             timings[stage] = timings.get(stage, 0.0) + seconds
     first = parts[0]
+    shaded = np.zeros(first.shaded.shape, np.float64)
+    unshadowed = np.zeros(first.unshadowed.shape, np.float64)
+    for p in parts:
+        shaded += p.shaded
+        unshadowed += p.unshadowed
+    methods: tuple[MethodConfig, ...] = tuple(m for p in parts for m in _one(p.method))
+    lights: tuple[Light, ...] = tuple(lt for p in parts for lt in _one(p.light))
     return Image(
         visibility=np.stack([p.visibility for p in parts]),
-        shaded=np.sum([p.shaded for p in parts], axis=0, dtype=np.float64).astype(np.float32),
-        unshadowed=np.sum([p.unshadowed for p in parts], axis=0, dtype=np.float64).astype(np.float32),
+        shaded=shaded.astype(np.float32),
+        unshadowed=unshadowed.astype(np.float32),
         depth=first.depth,
         position=first.position,
         normal=first.normal,
         mesh_id=first.mesh_id,
         shadow_maps=(),
         map_extent=None,
-        method=tuple(p.method for p in parts),  # type: ignore[arg-type]
+        method=methods,
         camera=camera,
-        light=tuple(p.light for p in parts),  # type: ignore[arg-type]
+        light=lights,
         timings=timings,
         backend=first.backend,
         threads=first.threads,

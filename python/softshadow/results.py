@@ -25,7 +25,7 @@ import numpy as np
 
 from . import _core
 from ._core import ErrorEstimate
-from .lights import DirectionalLight, Light, RectLight
+from .lights import DirectionalLight, Light
 from .methods import MethodConfig
 from .scene import Camera
 
@@ -88,7 +88,7 @@ class ShadowMap:
     occluder layers (``Exact`` traces the occluder triangles)."""
     occluder_depth_back: np.ndarray | None
     """Back (farthest) occluder depth; None with one pass or no layers."""
-    light: RectLight | DirectionalLight
+    light: Light
     extent: tuple[float, float]
     """Tangent half-extents (tx, ty); for a DirectionalLight, world
     half-extents of the orthographic maps."""

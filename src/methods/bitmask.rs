@@ -934,9 +934,11 @@ mod tests {
 
     #[test]
     fn a_disk_takes_the_samples_inside_it_and_matches_its_closed_form() {
-        // 201 of 256 samples on the inscribed disk (pi/4 of 256 is 201.1).
+        // 201 of 256 samples on the inscribed disk (pi/4 of 256 is 201.1),
+        // 804 of 1024 (804.2).
         assert_eq!(Bitmask::for_shape(256, Gaps::Open, None, true).counted(), 201);
         assert_eq!(Bitmask::for_shape(1024, Gaps::Open, None, false).counted(), 1024);
+        assert_eq!(Bitmask::for_shape(1024, Gaps::Open, None, true).counted(), 804);
         // The plate under a disk of radius 1/2: the rim is placed to within
         // a sample's cell, so the error is larger than the square's but
         // small on average.

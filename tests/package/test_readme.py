@@ -48,6 +48,10 @@ def test_eye_view_example_runs():
     env: dict = {}
     exec(compile(block.group(1), "README.md", "exec"), env)
     img = env["img"]
-    assert img.visibility.shape == (240, 320) and img.mask.mean() > 0.3
-    # The bunny shadows the floor and itself: some pixels it sees are dark.
-    assert (img.visibility[img.mask] < 0.05).mean() > 0.02
+    # The last image is the three lights' (a disk, a sphere and the sun).
+    assert img.visibility.shape == (3, 240, 320) and img.mask.mean() > 0.3
+    assert img.albedo.shape == (240, 320, 3) and len(img.parts) == 3
+    # The bunny shadows the floor and itself: some pixels it sees are dark
+    # under each light.
+    for v in img.visibility:
+        assert (v[img.mask] < 0.05).mean() > 0.02
