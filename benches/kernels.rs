@@ -29,7 +29,7 @@ use softshadow::methods::bitmask::Gaps;
 use softshadow::methods::ssm::Precision;
 use softshadow::methods::{Method, ShadowInputs};
 use softshadow::raster::rasterize;
-use softshadow::{BackendChoice, BitmaskConfig, ExactConfig, MethodConfig, RectLight, SsmConfig};
+use softshadow::{AreaLight, BackendChoice, BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 
 const RESOLUTION: usize = 256;
 const LIGHT_HEIGHT: f64 = 4.0;
@@ -101,8 +101,8 @@ fn sphere(center: [f64; 3], radius: f64, n: u32) -> Mesh {
 }
 
 /// The 1x1 light at height 4 looking down (scenes.py's `default_light`).
-fn default_light() -> RectLight {
-    RectLight::new(
+fn default_light() -> AreaLight {
+    AreaLight::rect(
         [0.0, LIGHT_HEIGHT, 0.0],
         [0.0, -1.0, 0.0],
         [0.0, 0.0, 1.0],
@@ -115,14 +115,14 @@ struct Scene {
     occluders: Mesh,
     receivers: Mesh,
     light: softshadow::Light,
-    rect: RectLight,
+    rect: AreaLight,
 }
 
 fn scene() -> Scene {
     Scene {
         occluders: sphere([0.0, 1.0, 0.0], 0.3, 48),
         receivers: floor(),
-        light: softshadow::Light::Rect(default_light()),
+        light: softshadow::Light::Area(default_light()),
         rect: default_light(),
     }
 }

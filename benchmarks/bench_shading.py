@@ -125,7 +125,7 @@ def main() -> None:
         "warm-up; Mitsuba's is one render, scene loading and JIT included. The lights emit 1 and every "
         "mesh's albedo is 0.8; `city`'s sun is made hard (Mitsuba's directional emitter is a delta), so "
         "`exact` casts one ray a pixel there. `V × unshadowed` is exact's visibility with every part of the "
-        "light weighted alike (the shading of the map methods, and of the GPU). The disk has the rectangle's "
+        "light weighted alike (what the map methods shade with). The disk has the rectangle's "
         "area, the sphere the disk's radius, both at its centre. The shading stage is "
         "`img.timings['shading']` of the `auto` renders (the albedo image, the closed form at every pixel that "
         "sees a surface)."

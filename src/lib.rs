@@ -70,5 +70,6 @@ pub use backend::{Backend, BackendChoice};
 pub use error::{Error, Result};
 pub use geom::light::{AreaLight, MapGrid};
 pub use geom::light_space::{Light, LightSpace};
+pub use geom::sphere_light::SphereLight;
 pub use geom::sun::DirectionalLight;
 pub use methods::{BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};

@@ -106,7 +106,7 @@ impl Material<'_> {
                         format!("UVs must be finite, got {:?} at row {k}", uv[k]),
                     ));
                 }
-                let n = width.checked_mul(height).unwrap_or(usize::MAX);
+                let n = width.saturating_mul(height);
                 if n == 0 || n > MAX_TEXTURE_TEXELS || n != texels.len() {
                     return Err(Error::invalid(
                         arg,

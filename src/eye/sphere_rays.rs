@@ -4,10 +4,11 @@
 //!
 //! From a point x outside the sphere (centre c, radius R, d = |c − x|) the
 //! light is the cap of directions within α of c − x, sin α = R/d. Its
-//! a x b strata are equal in solid angle: the sample (u1, u2) in [0, 1)²
-//! of stratum (sa, sb) is the direction at cos θ = 1 − u1 (1 − cos α),
-//! φ = 2π u2 about c − x (`light_shape::sphere::cap_direction`), and its
-//! ray stops at the sphere's near surface (`cap_hit`), a hair short. The
+//! a x b strata are equal in solid angle: the sample in [0, 1)² of stratum
+//! (sa, sb) goes onto the unit disk by the concentric map (disk.rs), and
+//! the disk's point (ρ, φ) onto the cap at cos θ = 1 − ρ² (1 − cos α),
+//! azimuth φ about c − x (`light_shape::sphere::cap_direction`); its ray
+//! stops at the sphere's near surface (`cap_hit`), a hair short. The
 //! fraction of clear rays is the visibility: the fraction of the cap's
 //! solid angle seen, as a planar light's is the fraction of its area.
 //!
@@ -26,7 +27,7 @@
 
 use super::gbuffer::GBuffer;
 use super::rays::RAY_EPSILON;
-use crate::geom::light_shape::{sphere, LightShape};
+use crate::geom::light_shape::{disk, sphere, LightShape};
 use crate::geom::sphere_light::SphereLight;
 use crate::methods::bvh::Bvh;
 use crate::methods::probe::certain_by_pixel;
@@ -70,10 +71,19 @@ fn trace(bvh: &Bvh, light: &SphereLight, p: DVec3, n: DVec3, key: u64, s: &Sampl
     let (mut w_clear, mut w_all) = (0f64, 0f64);
     for sb in 0..nb {
         for sa in 0..na {
-            // The unit square's point, shifted from [-1/2, 1/2) to [0, 1).
+            // The unit square's point (shifted from [-1/2, 1/2) to
+            // [0, 1)) onto the unit disk by the concentric map, then the
+            // disk onto the cap: 1 - cos θ = ρ² (1 - cos α), the azimuth
+            // the disk's angle. Both maps keep areas, so equal strata keep
+            // equal solid angles, and the strata stay compact (polar
+            // strata in (1 - cos θ, φ) erred 0.0050 against Mitsuba on
+            // contact_boxes' sphere at 256 samples).
             let (x, y) = s.sample(key, sa, sb);
-            let u = |t: f32| (f64::from(t) + 0.5).clamp(0.0, 1.0);
-            let Some(d) = sphere::cap_direction(c, r, p, u(x), u(y)) else {
+            let (dx, dy) = disk::sample_point(1.0, (1, 1), 0, 0, x + 0.5, y + 0.5);
+            let (dx, dy) = (f64::from(dx), f64::from(dy));
+            let rho2 = (dx * dx + dy * dy).min(1.0);
+            let turn = dy.atan2(dx) / std::f64::consts::TAU;
+            let Some(d) = sphere::cap_direction(c, r, p, rho2, turn.rem_euclid(1.0)) else {
                 continue;
             };
             let w = n.dot(d).max(0.0);

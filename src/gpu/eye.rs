@@ -204,7 +204,8 @@ impl EyeStages for GpuEye {
             .iter()
             .map(GpuRayStart::new)
             .collect();
-        let ((v, weighted), t) = exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
+        let ((v, weighted), t) =
+            exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
         Ok((v, Some(weighted)))
     }
@@ -378,6 +379,9 @@ impl GpuRayStart {
     }
 }
 
+/// Per ray start: the visibility, and the weighted visibility.
+type Visibilities = (Vec<f32>, Vec<f32>);
+
 /// `exact`'s visibility per ray start and its weighted visibility
 /// (eye_rays.wgsl), through a BVH of `tris` (kernel light space) on the
 /// device; and the device's stage times.
@@ -388,7 +392,7 @@ fn exact_visibility(
     samples: u32,
     light_shape: LightShape,
     sw: &mut Stopwatch,
-) -> Result<((Vec<f32>, Vec<f32>), Timings)> {
+) -> Result<(Visibilities, Timings)> {
     let n = starts.len();
     if n == 0 {
         return Ok(((vec![], vec![]), vec![]));
@@ -421,7 +425,12 @@ fn exact_visibility(
             4,
             wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         );
-        let vis = storage(device, "visibility", 2 * bytes, wgpu::BufferUsages::COPY_SRC);
+        let vis = storage(
+            device,
+            "visibility",
+            2 * bytes,
+            wgpu::BufferUsages::COPY_SRC,
+        );
         let weights = storage(
             device,
             "sample weights",

@@ -246,8 +246,8 @@ fn shade_points(
             wgpu::BufferUsages::COPY_DST,
         );
         let axes_buf = upload(device, "axes", &axes);
-        let tables =
-            gather::method_tables(method, f.light_shape).map(|t| upload(device, "method tables", &t));
+        let tables = gather::method_tables(method, f.light_shape)
+            .map(|t| upload(device, "method tables", &t));
         let vis = storage(
             device,
             "visibility",

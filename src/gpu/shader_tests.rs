@@ -145,7 +145,8 @@ fn mask_words_are_the_rank_tables_entries_and_cost_their_loop() {
                 gaps,
             };
             // method_tables asserts the length; the words hold every sample.
-            let t = method_tables(m, crate::geom::light_shape::LightShape::rect([1.0, 1.0])).unwrap();
+            let t =
+                method_tables(m, crate::geom::light_shape::LightShape::rect([1.0, 1.0])).unwrap();
             let words = mask_words(samples) as usize;
             assert_eq!(t.len(), 2 * (samples as usize + 1) * words);
             assert!(32 * words >= samples as usize);

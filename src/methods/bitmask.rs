@@ -632,7 +632,12 @@ impl Bitmask {
     }
 
     /// `new`, for a disk light where `disk` (`Pattern::new`).
-    pub fn for_shape(samples: u32, gaps: Gaps, hierarchy: Option<Hierarchy>, disk: bool) -> Bitmask {
+    pub fn for_shape(
+        samples: u32,
+        gaps: Gaps,
+        hierarchy: Option<Hierarchy>,
+        disk: bool,
+    ) -> Bitmask {
         let n = (samples as f64).sqrt().round() as usize;
         let pattern = if n * n <= 256 {
             Patterns::Small(Pattern::new(n, disk))
@@ -936,9 +941,18 @@ mod tests {
     fn a_disk_takes_the_samples_inside_it_and_matches_its_closed_form() {
         // 201 of 256 samples on the inscribed disk (pi/4 of 256 is 201.1),
         // 804 of 1024 (804.2).
-        assert_eq!(Bitmask::for_shape(256, Gaps::Open, None, true).counted(), 201);
-        assert_eq!(Bitmask::for_shape(1024, Gaps::Open, None, false).counted(), 1024);
-        assert_eq!(Bitmask::for_shape(1024, Gaps::Open, None, true).counted(), 804);
+        assert_eq!(
+            Bitmask::for_shape(256, Gaps::Open, None, true).counted(),
+            201
+        );
+        assert_eq!(
+            Bitmask::for_shape(1024, Gaps::Open, None, false).counted(),
+            1024
+        );
+        assert_eq!(
+            Bitmask::for_shape(1024, Gaps::Open, None, true).counted(),
+            804
+        );
         // The plate under a disk of radius 1/2: the rim is placed to within
         // a sample's cell, so the error is larger than the square's but
         // small on average.
@@ -949,10 +963,14 @@ mod tests {
                 48,
                 disk,
             );
-            assert!(mean < 0.01 && max < 0.08, "{samples}: mean {mean} max {max}");
+            assert!(
+                mean < 0.01 && max < 0.08,
+                "{samples}: mean {mean} max {max}"
+            );
         }
         // The same maps under the square light are shaded as before.
-        let square = crate::methods::plate_case::max_error(&Bitmask::new(256, Gaps::Open, None), 48);
+        let square =
+            crate::methods::plate_case::max_error(&Bitmask::new(256, Gaps::Open, None), 48);
         assert!(square <= 4.0 * 16.0 / 256.0 + 1e-6);
     }
 

@@ -340,7 +340,11 @@ pub(crate) mod plate_case {
     /// `max_error` under a light of `shape`: the unit square, or the disk
     /// of radius 1/2 (whose occluded part is a rectangle's overlap with
     /// it, `light_shape::disk::rect_overlap`).
-    pub fn mean_and_max_error(method: &dyn ShadowMethod, n: usize, shape: LightShape) -> (f64, f64) {
+    pub fn mean_and_max_error(
+        method: &dyn ShadowMethod,
+        n: usize,
+        shape: LightShape,
+    ) -> (f64, f64) {
         let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
         let (zo, zr, a) = (2.0f64, 4.0f64, 0.25f64);
         let front: Vec<f32> = (0..n * n)
@@ -377,11 +381,8 @@ pub(crate) mod plate_case {
                 let (x, y) = (grid.x_of(i), grid.y_of(j));
                 let exact = match shape {
                     LightShape::Disk { radius } => {
-                        let hidden = crate::geom::light_shape::disk::rect_overlap(
-                            radius,
-                            span(x),
-                            span(y),
-                        );
+                        let hidden =
+                            crate::geom::light_shape::disk::rect_overlap(radius, span(x), span(y));
                         1.0 - hidden / shape.area()
                     }
                     LightShape::Rect { .. } => 1.0 - ov(x) * ov(y),

@@ -184,6 +184,7 @@ def _image(img: ss.Image) -> dict[str, np.ndarray | None]:
         "visibility": img.visibility,
         "shaded": img.shaded,
         "unshadowed": img.unshadowed,
+        "albedo": img.albedo,
         "depth": img.depth,
         "position": img.position,
         "normal": img.normal,
@@ -242,6 +243,24 @@ def _eye_view_cases(backends: list[str]) -> Iterator[tuple[str, Callable[[], dic
                 yield (
                     f"eye-point/bunny_on_floor/{label}/{b}",
                     lambda method=method, b=b: _image(ss.render(scene, point, cam, method, backend=b)),
+                )
+    # Disks and spheres (issue 31): a disk traced and on the bitmask's
+    # samples on it, a sphere traced (CPU), and three lights in one call.
+    disk = ss.DiskLight(light.center, light.normal, 0.5, radiance=(1.0, 0.8, 0.6))
+    sphere = ss.SphereLight(light.center, 0.4, radiance=2.0)
+    shaped = (
+        ("disk-exact16", disk, ss.Exact(samples=16), ALL),
+        ("disk-bitmask64", disk, ss.Bitmask(samples=64), ALL),
+        ("sphere-exact16", sphere, ss.Exact(samples=16), ("cpu",)),
+        ("sphere-default", sphere, "auto", ("cpu",)),
+        ("three-lights", [light, disk, sphere], "auto", ("cpu",)),
+    )
+    for label, lt, method, where in shaped:
+        for b in backends:
+            if b in where:
+                yield (
+                    f"eye-lights/bunny_on_floor/{label}/{b}",
+                    lambda lt=lt, method=method, b=b: _image(ss.render(scene, lt, cam, method, backend=b)),
                 )
 
 
