@@ -384,27 +384,7 @@ mod tests {
     use super::*;
     use crate::geom::light::light_frame;
 
-    /// A deterministic uniform generator in [0, 1) (splitmix64).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next()
-        }
-        fn unit(&mut self) -> DVec3 {
-            let z = self.range(-1.0, 1.0);
-            let phi = self.range(0.0, 2.0 * PI);
-            let s = (1.0 - z * z).sqrt();
-            DVec3::new(s * phi.cos(), s * phi.sin(), z)
-        }
-    }
+    use super::super::test_rng::Rng;
 
     fn placement(center: [f64; 3], normal: [f64; 3], up: [f64; 3]) -> Placement {
         let (u, v, n) = light_frame("normal", normal, up).unwrap();

@@ -60,6 +60,8 @@ pub(crate) mod disk;
 mod placement;
 mod rect;
 pub(crate) mod sphere;
+#[cfg(test)]
+mod test_rng;
 
 use crate::error::{Error, Result};
 use crate::geom::units::{MAX_RELATIVE_SIZE, MIN_RELATIVE_SIZE};
