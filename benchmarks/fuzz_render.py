@@ -590,9 +590,9 @@ def draw_light(d: Draw, s: float, t: tuple, meshes: list[Mesh], room: dict) -> t
             radius = Code(d.choice(["0.0", "-1.0", "float('nan')", "float('inf')", "'1'", "(1.0, 2.0)"]))
         if shape < 0.15:
             light = call("ss.DiskLight", center, normal, radius, **emission(d, "radiance"))
-            return light, {"rect": False, "big": False}
+            return light, {"rect": False, "big": False, "kind": "disk"}
         light = call("ss.SphereLight", center, radius, **emission(d, "radiance"))
-        return light, {"rect": False, "big": False}
+        return light, {"rect": False, "big": False, "kind": "sphere"}
     light = call("ss.RectLight", center, normal, up, size, **emission(d, "radiance"))
     big = isinstance(size, (float, tuple)) and max(np.atleast_1d(np.asarray(size, float))) > 5 * s
     return light, {"rect": True, "big": big}
@@ -911,7 +911,7 @@ def draw_case(seed: int, index: int) -> Case:
         steps.append(("map", f"sm = {call('ss.soft_shadow_map', Code(which), Code('light'), **map_kw)}"))
     label = (
         f"{layout} x{len(meshes)} s={s:g} |t|={max(map(abs, t)):g} "
-        f"{'rect' if light_info['rect'] else 'sun'} {method}{loose_src}{kw_src}"
+        f"{light_info.get('kind', 'rect' if light_info['rect'] else 'sun')} {method}{loose_src}{kw_src}"
     )
     return Case(seed, index, setup, steps, label[:200], gpu, repeat, d.hostile_args)
 

@@ -75,11 +75,15 @@ class Scene:
     Each argument is one mesh or an iterable of meshes; a mesh is a
     ``trimesh.Trimesh`` (or anything with ``vertices`` and ``faces``) or a
     ``(vertices (n, 3), faces (m, 3))`` pair. The constructor keeps the
-    geometry only (``materials`` is all None); :meth:`from_trimesh` also
-    keeps the colours.
+    geometry, and ``materials=`` (keyword-only) the colours: one
+    :class:`~softshadow.materials.Material` or None per mesh of ``meshes``,
+    each checked against its mesh (default: all None);
+    :meth:`from_trimesh` reads them from the file.
     """
 
-    def __init__(self, occluders: Any = None, receivers: Any = None, *, meshes: Any = None) -> None:
+    def __init__(
+        self, occluders: Any = None, receivers: Any = None, *, meshes: Any = None, materials: Any = None
+    ) -> None:
         if meshes is not None and (occluders is not None or receivers is not None):
             raise TypeError("meshes: pass either meshes or occluders and receivers, not both")
         if meshes is None and (occluders is None or receivers is None):
@@ -104,8 +108,26 @@ class Scene:
         self._occ = _concat(self.occluders)
         # Every mesh casts and receives: one mesh serves as both.
         self._rec = _concat(self.receivers) if self.split else self._occ
-        self._materials: tuple[Material | None, ...] = (None,) * len(self.meshes)
+        self._materials = self._checked_materials(materials)
         self._prepared = _core.Prepared()
+
+    def _checked_materials(self, materials: Any) -> tuple[Material | None, ...]:
+        """``materials=``: None (no colours), or one Material or None per
+        mesh of ``meshes``, each fitting its mesh; TypeError or ValueError
+        naming ``materials`` (``materials[k]``) otherwise."""
+        if materials is None:
+            return (None,) * len(self.meshes)
+        if not isinstance(materials, (list, tuple)):
+            raise TypeError(f"materials: must be a list of softshadow.Material or None, got {type(materials).__name__}")
+        if len(materials) != len(self.meshes):
+            raise ValueError(f"materials: {len(materials)} materials for {len(self.meshes)} meshes")
+        for k, (m, (v, f)) in enumerate(zip(materials, self.meshes, strict=True)):
+            if m is None:
+                continue
+            if not isinstance(m, Material):
+                raise TypeError(f"materials[{k}]: must be a softshadow.Material or None, got {type(m).__name__}")
+            m.check(f"materials[{k}]", len(v), len(f))
+        return tuple(materials)
 
     @property
     def materials(self) -> tuple[Material | None, ...]:
@@ -160,9 +182,7 @@ class Scene:
         if isinstance(obj, (str, os.PathLike)):
             obj = trimesh.load(os.fspath(obj))
         if isinstance(obj, trimesh.Trimesh):
-            scene = cls(meshes=[obj])
-            scene._materials = (Material.from_trimesh(obj, "meshes[0]"),)
-            return scene
+            return cls(meshes=[obj], materials=[Material.from_trimesh(obj, "meshes[0]")])
         if not isinstance(obj, trimesh.Scene):
             raise TypeError(f"obj: must be a trimesh.Scene, a trimesh.Trimesh or a path, got {type(obj).__name__}")
         meshes: list[Mesh] = []
@@ -181,9 +201,7 @@ class Scene:
             materials.append(read[name])
         if not meshes:
             raise ValueError("obj: the trimesh scene has no triangle meshes")
-        scene = cls(meshes=meshes)
-        scene._materials = tuple(materials)
-        return scene
+        return cls(meshes=meshes, materials=materials)
 
     @staticmethod
     def _meshes(value: Any, name: str) -> list[Mesh]:

@@ -418,3 +418,18 @@ def test_shapes_that_do_not_match_the_mesh_name_it():
         m.check("meshes[4]", 8, 12)
     m.check("meshes[4]", 8, 11)
     assert ss.Material is Material
+
+
+def test_a_scene_takes_its_materials_by_keyword_checked_against_its_meshes():
+    tri = (np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    red = Material("constant", color=(1.0, 0.0, 0.0))
+    scene = ss.Scene(meshes=[tri, tri], materials=[red, None])
+    assert scene.materials == (red, None)
+    assert ss.Scene(meshes=[tri]).materials == (None,)
+    with pytest.raises(ValueError, match="materials: 1 materials for 2 meshes"):
+        ss.Scene(meshes=[tri, tri], materials=[red])
+    with pytest.raises(TypeError, match=r"materials\[0\]"):
+        ss.Scene(meshes=[tri], materials=["red"])
+    faces = Material("face", face_colors=np.zeros((2, 3), np.float32))
+    with pytest.raises(ValueError, match=r"materials\[0\]"):
+        ss.Scene(meshes=[tri], materials=[faces])

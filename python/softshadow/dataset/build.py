@@ -166,14 +166,13 @@ def build_scene(params: dict[str, Any], folder: str) -> tuple[Scene, list[np.nda
         meshes.append(quad((0.0, 0.0, 0.0), 0.5 * params["ground"]["size"]))
         albedo.append(np.asarray(params["ground"]["albedo"]))
         own.append(None)
-    scene = Scene(meshes=meshes)
+    materials = None
     if any(m is not None for m in own):
-        # Scene(meshes=...) keeps no colours; from_trimesh sets them so too.
-        scene._materials = tuple(
+        materials = [
             m if m is not None else Material("constant", color=(float(a[0]), float(a[1]), float(a[2])))
             for m, a in zip(own, albedo, strict=True)
-        )
-    return scene, albedo
+        ]
+    return Scene(meshes=meshes, materials=materials), albedo
 
 
 def render_albedo(scene: Scene, albedo: list[np.ndarray]) -> dict[str, Any]:
