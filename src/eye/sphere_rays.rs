@@ -21,15 +21,19 @@
 //! neighbours' probes saw all of the cap or none of it keeps that answer
 //! (`methods/probe.rs`), the others trace every sample.
 //!
-//! The rays are traced one at a time through the BVH of every triangle,
-//! relative to the sphere's centre in f32 (no packets or shafts: each
-//! pixel's rays go to its own cap).
+//! The rays go through the BVH of every triangle, relative to the sphere's
+//! centre in f32, eight neighbouring pixels' rays of one stratum together
+//! (`methods/packet.rs`, with its shadow cache; no shafts: each pixel's rays
+//! go to its own cap). Each ray is the segment from its origin to its point
+//! on the sphere, t in (0, 1 − RAY_EPS).
 
 use super::gbuffer::GBuffer;
-use super::rays::RAY_EPSILON;
+use super::rays::{tiled, RAY_EPSILON};
+use crate::geom::light_shape::sphere::CapFrame;
 use crate::geom::light_shape::{disk, sphere, LightShape};
 use crate::geom::sphere_light::SphereLight;
 use crate::methods::bvh::Bvh;
+use crate::methods::packet::{Mask, Rays, LANES};
 use crate::methods::probe::certain_by_pixel;
 use crate::methods::shadow_rays::{Jitter, Sampling, RAY_EPS};
 use glam::{DVec3, Vec3};
@@ -55,64 +59,134 @@ fn pattern(samples: u32, jitter: Jitter) -> Sampling {
     }
 }
 
-/// The fraction of `sampling`'s rays from surface point `p` (normal `n`,
-/// facing the camera) that reach the sphere, and the weighted fraction
-/// (each ray by the cosine n · d: the cap is sampled uniformly in solid
-/// angle, so that is its share of the irradiance; V where every ray lies
-/// below the horizon); 0 inside it.
-fn trace(bvh: &Bvh, light: &SphereLight, p: DVec3, n: DVec3, key: u64, s: &Sampling) -> [f32; 2] {
-    if !light.is_outside(p) {
-        return [0.0; 2];
+/// The cap sample of stratum (sa, sb) of `s` for the jitter key `key`:
+/// [u1, cos φ, sin φ]. The unit square's point (shifted from [-1/2, 1/2)
+/// to [0, 1)) goes onto the unit disk by the concentric map, then the disk
+/// onto the cap: u1 = ρ² (so 1 − cos θ = ρ² (1 − cos α)), the azimuth the
+/// disk's angle. Both maps keep areas, so equal strata keep equal solid
+/// angles, and the strata stay compact (polar strata in (1 − cos θ, φ)
+/// erred 0.0050 against Mitsuba on contact_boxes' sphere at 256 samples,
+/// these 0.0048).
+fn cap_sample(s: &Sampling, key: u64, sa: u32, sb: u32) -> [f64; 3] {
+    let (x, y) = s.sample(key, sa, sb);
+    let (dx, dy) = disk::sample_point(1.0, (1, 1), 0, 0, x + 0.5, y + 0.5);
+    let (dx, dy) = (f64::from(dx), f64::from(dy));
+    let rho = (dx * dx + dy * dy).sqrt();
+    if rho > 0.0 {
+        [(rho * rho).min(1.0), dx / rho, dy / rho]
+    } else {
+        [0.0, 1.0, 0.0]
     }
+}
+
+/// A pixel's surface point `p` and normal `n` (facing the camera), and its
+/// jitter key.
+#[derive(Clone, Copy)]
+struct Pixel {
+    p: DVec3,
+    n: DVec3,
+    key: u64,
+}
+
+/// Wide levels above the leaf that blocked a packet's last blocked ray
+/// whose subtree is searched first (`shadow_rays.rs`'s shadow cache).
+const CACHE_LEVELS: u32 = 1;
+
+/// The fraction of `s`'s rays from each of up to `LANES` pixels that reach
+/// the sphere, and the weighted fraction (each ray by the cosine n · d: the
+/// cap is sampled uniformly in solid angle, so that is its share of the
+/// irradiance; V where every ray lies below the horizon); 0 for a pixel
+/// inside the sphere. The pixels' rays of one stratum are traced together
+/// (`packet.rs`), each the segment from its origin to its point on the
+/// sphere, t in (0, 1 - RAY_EPS).
+fn trace_packet(
+    bvh: &Bvh,
+    light: &SphereLight,
+    pixels: &[Pixel],
+    s: &Sampling,
+    table: Option<&[[f64; 3]]>,
+) -> [[f32; 2]; LANES] {
+    let m = pixels.len();
+    debug_assert!((1..=LANES).contains(&m));
     let (c, r) = (light.center, light.radius);
-    let mag = (1.0 + p.abs().max_element()) * RAY_EPSILON;
+    let lane = |i: usize| pixels[i.min(m - 1)];
+    let mut live: Mask = 0;
+    for (i, px) in pixels.iter().enumerate() {
+        if light.is_outside(px.p) {
+            live |= 1 << i;
+        }
+    }
+    let mag: [f64; LANES] =
+        std::array::from_fn(|i| (1.0 + lane(i).p.abs().max_element()) * RAY_EPSILON);
+    let frames: [Option<CapFrame>; LANES] = std::array::from_fn(|i| CapFrame::new(c, r, lane(i).p));
     let (na, nb) = s.light.grid;
-    let mut clear = 0u32;
-    let (mut w_clear, mut w_all) = (0f64, 0f64);
+    let mut clear = [0u32; LANES];
+    let (mut w_clear, mut w_all) = ([0f64; LANES], [0f64; LANES]);
+    let mut cache: Option<u32> = None;
     for sb in 0..nb {
         for sa in 0..na {
-            // The unit square's point (shifted from [-1/2, 1/2) to
-            // [0, 1)) onto the unit disk by the concentric map, then the
-            // disk onto the cap: 1 - cos θ = ρ² (1 - cos α), the azimuth
-            // the disk's angle. Both maps keep areas, so equal strata keep
-            // equal solid angles, and the strata stay compact (polar
-            // strata in (1 - cos θ, φ) erred 0.0050 against Mitsuba on
-            // contact_boxes' sphere at 256 samples).
-            let (x, y) = s.sample(key, sa, sb);
-            let (dx, dy) = disk::sample_point(1.0, (1, 1), 0, 0, x + 0.5, y + 0.5);
-            let (dx, dy) = (f64::from(dx), f64::from(dy));
-            let rho2 = (dx * dx + dy * dy).min(1.0);
-            let turn = dy.atan2(dx) / std::f64::consts::TAU;
-            let Some(d) = sphere::cap_direction(c, r, p, rho2, turn.rem_euclid(1.0)) else {
-                continue;
-            };
-            let w = n.dot(d).max(0.0);
-            w_all += w;
-            let o = if n.dot(d) >= 0.0 {
-                p + mag * n
-            } else {
-                p - mag * n
-            };
-            let t = sphere::cap_hit(c, r, o, d);
-            if !(t.is_finite() && t > 0.0) {
-                continue;
+            let mut open = live;
+            // Lanes without a ray keep a harmless segment (masked off).
+            let mut o = [Vec3::ZERO; LANES];
+            let mut d = [Vec3::ONE; LANES];
+            let mut w = [0f64; LANES];
+            let shared = table.map(|t| t[(sb * na + sa) as usize]);
+            for i in 0..LANES {
+                let (Some(frame), true) = (frames[i], open & (1 << i) != 0) else {
+                    open &= !(1 << i);
+                    continue;
+                };
+                let px = lane(i);
+                let [u1, cos_phi, sin_phi] =
+                    shared.unwrap_or_else(|| cap_sample(s, px.key, sa, sb));
+                let dir = frame.direction(u1, cos_phi, sin_phi);
+                w[i] = px.n.dot(dir).max(0.0);
+                w_all[i] += w[i];
+                let origin = if px.n.dot(dir) >= 0.0 {
+                    px.p + mag[i] * px.n
+                } else {
+                    px.p - mag[i] * px.n
+                };
+                let t = sphere::cap_hit(c, r, origin, dir);
+                if !(t.is_finite() && t > 0.0) {
+                    open &= !(1 << i);
+                    continue;
+                }
+                o[i] = (origin - c).as_vec3();
+                d[i] = (t * dir).as_vec3();
             }
-            let t1 = (t * (1.0 - f64::from(RAY_EPS))) as f32;
-            if !bvh.occluded((o - c).as_vec3(), d.as_vec3(), 0.0, t1) {
-                clear += 1;
-                w_clear += w;
+            let hit_open = open;
+            let rays = Rays::new(o, d);
+            for from in [cache, Some(0)].into_iter().flatten() {
+                if open == 0 {
+                    break;
+                }
+                let (blocked, node) = bvh.occluded_lanes(from, &rays, open, 0.0, 1.0 - RAY_EPS);
+                open &= !blocked;
+                if let Some(k) = node {
+                    cache = Some(bvh.wide_ancestor(k, CACHE_LEVELS));
+                }
+            }
+            for i in 0..LANES {
+                if hit_open & open & (1 << i) != 0 {
+                    clear[i] += 1;
+                    w_clear[i] += w[i];
+                }
             }
         }
     }
-    let v = clear as f32 / (na * nb) as f32;
-    [
-        v,
-        if w_all > 0.0 {
-            (w_clear / w_all) as f32
+    std::array::from_fn(|i| {
+        if live & (1 << i) == 0 {
+            return [0.0; 2];
+        }
+        let v = clear[i] as f32 / (na * nb) as f32;
+        let vw = if w_all[i] > 0.0 {
+            (w_clear[i] / w_all[i]) as f32
         } else {
             v
-        },
-    ]
+        };
+        [v, vw]
+    })
 }
 
 /// The visibility of each pixel of `hits` (flat indices into `g`, each
@@ -128,28 +202,47 @@ pub fn sphere_visibility(
     samples: u32,
     probe: Option<u32>,
 ) -> Vec<[f32; 2]> {
-    let at = |k: usize| {
-        (
-            DVec3::from_array(g.position[k]),
-            Vec3::from_array(g.normal[k]).as_dvec3(),
-        )
+    let at = |k: usize| Pixel {
+        p: DVec3::from_array(g.position[k]),
+        n: Vec3::from_array(g.normal[k]).as_dvec3(),
+        key: k as u64,
     };
     // The call's token, read on this thread (it is thread-local): a
     // cancelled call skips its remaining pixels, and the orchestrator
     // returns the cancellation, not the image.
     let token = crate::cancel::current();
+    // Pixels in 4 x 2 tiles (`rays::tiled`), `LANES` neighbours a packet;
+    // a shared pattern's cap samples computed once.
     let run = |pixels: &[usize], s: &Sampling| -> Vec<[f32; 2]> {
-        pixels
-            .par_iter()
-            .with_min_len(16)
-            .map(|&k| {
+        let order = tiled(pixels, g.width, g.height);
+        let (na, nb) = s.light.grid;
+        let table: Option<Vec<[f64; 3]>> = (s.jitter == Jitter::Shared).then(|| {
+            (0..nb)
+                .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
+                .map(|(sa, sb)| cap_sample(s, 0, sa, sb))
+                .collect()
+        });
+        let packets: Vec<(Vec<usize>, [[f32; 2]; LANES])> = order
+            .par_chunks(LANES)
+            .with_min_len(4)
+            .map(|group| {
                 if token.is_cancelled() {
-                    return [1.0; 2];
+                    return (group.to_vec(), [[1.0; 2]; LANES]);
                 }
-                let (p, n) = at(k);
-                trace(bvh, light, p, n, k as u64, s)
+                let px: Vec<Pixel> = group.iter().map(|&j| at(pixels[j])).collect();
+                (
+                    group.to_vec(),
+                    trace_packet(bvh, light, &px, s, table.as_deref()),
+                )
             })
-            .collect()
+            .collect();
+        let mut out = vec![[1.0f32; 2]; pixels.len()];
+        for (group, v) in packets {
+            for (&j, v) in group.iter().zip(v) {
+                out[j] = v;
+            }
+        }
+        out
     };
     let fine = pattern(samples, Jitter::Shared);
     let Some(p) = probe.filter(|&p| p < samples) else {

@@ -132,6 +132,40 @@ pub fn cap_direction(center: DVec3, radius: f64, x: DVec3, u1: f64, u2: f64) -> 
 /// distance √(D² − R²) or near it, so every direction of the cap gets a
 /// finite distance. A direction pointing away from the sphere (b <= 0) gets
 /// infinity, and a point inside or on the sphere 0.
+/// The cap seen from a point, set up once for many directions
+/// (`cap_direction`'s frame and scale): the axis w toward the centre, an
+/// orthonormal pair about it, and 1 − cos α.
+#[derive(Clone, Copy, Debug)]
+pub struct CapFrame {
+    w: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    one_minus_cos_a: f64,
+}
+
+impl CapFrame {
+    /// The frame of the cap seen from `x`; None inside the sphere.
+    pub fn new(center: DVec3, radius: f64, x: DVec3) -> Option<CapFrame> {
+        let (w, _, sin2, cos_a) = cap(center, radius, x)?;
+        let (e1, e2) = w.any_orthonormal_pair();
+        Some(CapFrame {
+            w,
+            e1,
+            e2,
+            one_minus_cos_a: sin2 / (1.0 + cos_a),
+        })
+    }
+
+    /// `cap_direction` with u1 and the azimuth's cosine and sine given:
+    /// cos θ = 1 − u1 (1 − cos α).
+    #[inline]
+    pub fn direction(&self, u1: f64, cos_phi: f64, sin_phi: f64) -> DVec3 {
+        let t = u1 * self.one_minus_cos_a;
+        let sin_t = (t * (2.0 - t)).max(0.0).sqrt();
+        (1.0 - t) * self.w + sin_t * (cos_phi * self.e1 + sin_phi * self.e2)
+    }
+}
+
 pub fn cap_hit(center: DVec3, radius: f64, x: DVec3, dir: DVec3) -> f64 {
     let q = center - x;
     let d2 = q.length_squared();
