@@ -657,6 +657,14 @@ pub fn render_lights(
             format!("must hold 1 to {MAX_LIGHTS} lights, got {}", lights.len()),
         ));
     }
+    // One albedo image serves every light: their albedos must agree (the
+    // bindings build them from one `albedo=`).
+    if lights.iter().any(|(_, l)| l.albedo != lights[0].1.albedo) {
+        return Err(Error::invalid(
+            "albedo",
+            "the lights of one call must share one albedo per mesh",
+        ));
+    }
     for (_, lighting) in lights {
         if lighting.albedo.len() != call.meshes.len() {
             return Err(Error::shape(

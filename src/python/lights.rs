@@ -9,8 +9,8 @@
 //! (on a surface facing it). Only the eye view's shaded images read it;
 //! visibility never does.
 
-use super::convert::vector;
 use super::convert::Light;
+use super::convert::{opt_float, vector};
 use super::errors;
 use super::eye::{irradiance, light_emission};
 use crate::geom::light::AreaLight;
@@ -484,7 +484,7 @@ impl PyDiskLight {
     ) -> PyResult<Self> {
         let c = vector::<3>("center", center)?;
         let n = vector::<3>("normal", normal)?;
-        let r = number("radius", radius)?;
+        let r = radius_of(radius)?;
         let light = errors::guard(|| Ok(AreaLight::disk(c, n, r)?))?;
         let radiance = light_emission("radiance", color(radiance)?)?;
         Ok(PyDiskLight {
@@ -615,7 +615,7 @@ impl PySphereLight {
         radiance: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let c = vector::<3>("center", center)?;
-        let r = number("radius", radius)?;
+        let r = radius_of(radius)?;
         errors::guard(|| Ok(SphereLight::new(c, r)?))?;
         let radiance = light_emission("radiance", color(radiance)?)?;
         Ok(PySphereLight {
@@ -692,15 +692,9 @@ impl PySphereLight {
     }
 }
 
-/// A real number (not a bool), or a TypeError naming `arg`.
-fn number(arg: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
-    let py = value.py();
-    let real = py.import("numbers")?.getattr("Real")?;
-    if value.is_instance(&real)? && !value.is_instance_of::<pyo3::types::PyBool>() {
-        return value.extract();
-    }
-    Err(PyTypeError::new_err(format!(
-        "{arg}: must be a number, got {}",
-        value.get_type().name()?
-    )))
+/// A radius: a real number (not a bool, not None), or a TypeError naming
+/// `radius` (`convert::opt_float`'s check); the core checks its value.
+fn radius_of(value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    opt_float("radius", Some(value))?
+        .ok_or_else(|| PyTypeError::new_err("radius: must be a number, got NoneType"))
 }
