@@ -14,9 +14,11 @@ render with seed 1 against it. The error of an image is
 surface. ``exact`` at ``--exact-samples`` weighs each of its samples by what
 it adds to the irradiance (docs/shading.md), so its error is its sampling's
 plus the reference's noise; ``V × unshadowed`` is the same visibility with
-the light's parts weighted alike (what the map methods shade with); the
-default method (``"auto"``) adds its visibility error; ``bitmask`` (1024
-samples) is a map method's; ``unshadowed`` shows what the shadows are worth.
+the light's parts weighted alike (what the map methods other than the
+bitmask shade with); the default method (``"auto"``) adds its visibility
+error; ``bitmask`` (1024 samples) weighs its light samples as ``exact`` its
+rays, so its error is its visibility's; ``unshadowed`` shows what the
+shadows are worth.
 Besides each scene's rectangle, the disk of the same area and the sphere of
 the same radius at its centre light it too (rows "disk", "sphere"; a sphere
 takes ``exact`` only, so no bitmask). Times: medians of
@@ -125,7 +127,8 @@ def main() -> None:
         "warm-up; Mitsuba's is one render, scene loading and JIT included. The lights emit 1 and every "
         "mesh's albedo is 0.8; `city`'s sun is made hard (Mitsuba's directional emitter is a delta), so "
         "`exact` casts one ray a pixel there. `V × unshadowed` is exact's visibility with every part of the "
-        "light weighted alike (what the map methods shade with). The disk has the rectangle's "
+        "light weighted alike (what the map methods but `bitmask` shade with; `bitmask` weighs its light "
+        "samples, docs/shading.md). The disk has the rectangle's "
         "area, the sphere the disk's radius, both at its centre. The shading stage is "
         "`img.timings['shading']` of the `auto` renders (the albedo image, the closed form at every pixel that "
         "sees a surface)."

@@ -670,6 +670,9 @@ def light_emission(arg: str, value: _Color | None = None) -> list[float]:
     """A light's emission (``arg``: "radiance" or "irradiance") checked:
     finite and >= 0, a number or 3; None gives the default."""
 
+def srgb_to_linear(values: npt.NDArray[np.float64]) -> npt.NDArray[np.float32]:
+    """Linear float32 of sRGB-encoded values (any shape), clipped to [0, 1]."""
+
 def irradiance(
     light: _Light,
     points: npt.NDArray[np.float64],

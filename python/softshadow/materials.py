@@ -61,6 +61,8 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from . import _core
+
 __all__ = ["Material", "MaterialKind", "srgb_to_linear"]
 
 MaterialKind = Literal["constant", "vertex", "face", "texture"]
@@ -76,27 +78,22 @@ _NEEDS: dict[str, tuple[str, ...]] = {
 _ARRAYS = ("vertex_colors", "face_colors", "uv", "texture")
 
 
-def _srgb_decode(c: np.ndarray) -> np.ndarray:
-    """The exact sRGB decoding (IEC 61966-2-1) of values in [0, 1], float64."""
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-
-
-#: uint8 sRGB code -> linear float32.
-_SRGB_LUT = _srgb_decode(np.arange(256) / 255.0).astype(np.float32)
+#: uint8 sRGB code -> linear float32 (the core's decoding of code / 255).
+_SRGB_LUT = _core.srgb_to_linear(np.arange(256) / 255.0)
 _SRGB_LUT.flags.writeable = False
 
 
 def srgb_to_linear(values: npt.ArrayLike) -> np.ndarray:
     """Linear float32 values of sRGB-encoded ones: uint8 codes (0-255, a
-    table lookup) or floats (clipped to [0, 1]); decoded with the exact sRGB transfer
-    function (``c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4``).
-    128 decodes to 0.2158605."""
+    table lookup) or floats (clipped to [0, 1]); decoded by the core with the
+    exact sRGB transfer function (``c <= 0.04045 ? c / 12.92 : ((c + 0.055)
+    / 1.055) ** 2.4``), as it decodes textures. 128 decodes to 0.2158605."""
     a = np.asarray(values)
     if a.dtype == np.uint8:
         return _SRGB_LUT[a]
     if a.dtype.kind != "f":
         raise TypeError(f"values: must be uint8 codes or floats in [0, 1], got dtype {a.dtype}")
-    return _srgb_decode(np.clip(a.astype(np.float64), 0.0, 1.0)).astype(np.float32)
+    return _core.srgb_to_linear(np.ascontiguousarray(a, dtype=np.float64))
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:

@@ -123,14 +123,21 @@ impl Material<'_> {
     }
 }
 
-/// The sRGB code c / 255 as linear reflectance (module doc).
-fn decode(c: u8) -> f64 {
-    let x = f64::from(c) / 255.0;
+/// An sRGB-encoded value x in [0, 1] as linear reflectance, by the exact
+/// transfer function of IEC 61966-2-1 (module doc); x clipped to [0, 1]
+/// first (NaN gives 0). Python's `materials.srgb_to_linear` is this.
+pub fn srgb_to_linear(x: f64) -> f64 {
+    let x = if x > 0.0 { x.min(1.0) } else { 0.0 };
     if x <= 0.04045 {
         x / 12.92
     } else {
         ((x + 0.055) / 1.055).powf(2.4)
     }
+}
+
+/// The sRGB code c / 255 as linear reflectance.
+fn decode(c: u8) -> f64 {
+    srgb_to_linear(f64::from(c) / 255.0)
 }
 
 /// Every code decoded once.

@@ -23,6 +23,7 @@
 //! Too little leaves acne on lit surfaces; too much lets light leak where
 //! an occluder touches a receiver (`docs/benchmarks/bias.md` measures both).
 
+use super::rays::ray_starts;
 use super::tangent_plane;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
@@ -235,9 +236,31 @@ pub fn shading_points(
     out
 }
 
+/// What the map methods give for the visible points: each one's visibility,
+/// beside it its weighted visibility where the method weighs its samples
+/// (the bitmask under an area light: `methods::shade_points_weighted`),
+/// and the maps.
+pub struct MapShading {
+    pub visibility: Vec<f32>,
+    pub weighted: Option<Vec<f32>>,
+    pub maps: EyeMaps,
+}
+
+impl MapShading {
+    /// A method's that does not weigh its samples.
+    pub fn unweighted(visibility: Vec<f32>, maps: EyeMaps) -> MapShading {
+        MapShading {
+            visibility,
+            weighted: None,
+            maps,
+        }
+    }
+}
+
 /// Rasterizes the occluder layers on `grid` and shades `points` (world,
-/// with their camera-facing `normals`). Returns the visibility per point and
-/// the maps.
+/// with their camera-facing `normals`); with `weigh`, under an area light,
+/// weighs each point's samples too where the method has them
+/// (`MapShading::weighted`: what the eye view's shaded image reads).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade(
     space: &LightSpace,
@@ -252,8 +275,9 @@ pub(crate) fn shade(
     normals: &[[f32; 3]],
     bias: &Bias,
     arg: &str,
+    weigh: bool,
     sw: &mut Stopwatch,
-) -> Result<(Vec<f32>, EyeMaps)> {
+) -> Result<MapShading> {
     let mut layers = occluder_layers(&grid, tris, passes);
     sw.lap("raster_occluders");
     let sp = shading_points(
@@ -267,6 +291,10 @@ pub(crate) fn shade(
         bias,
         method.tests_planes(),
     );
+    // The weights are the unbiased surface point's, under an area light
+    // (the sun's shading has no weights: shading.rs).
+    let receivers = (weigh && matches!(space, LightSpace::Area(_)))
+        .then(|| ray_starts(space, unit, points, normals));
     sw.lap("bias");
     let inputs = ShadowInputs {
         grid,
@@ -279,23 +307,54 @@ pub(crate) fn shade(
     debug_assert!(method.reads_input(Input::OccluderLayers));
     let shade = || match method {
         // Every mesh is an occluder: its silhouette straight from the mesh.
-        Method::Smoothies { width, falloff } => crate::methods::smoothies::Smoothies {
-            width: width.0,
-            falloff,
-        }
-        .shade(&inputs, &tris.verts, tris.faces, &sp.points, &sp.planes),
-        Method::Pcss { max_taps } => crate::methods::pcss::Pcss { max_taps }
-            .visibility_on_planes(&inputs, &sp.points, &sp.planes),
-        _ => crate::methods::shade_points(method, &inputs, &sp.points),
+        Method::Smoothies { width, falloff } => (
+            crate::methods::smoothies::Smoothies {
+                width: width.0,
+                falloff,
+            }
+            .shade(&inputs, &tris.verts, tris.faces, &sp.points, &sp.planes),
+            None,
+        ),
+        Method::Pcss { max_taps } => (
+            crate::methods::pcss::Pcss { max_taps }
+                .visibility_on_planes(&inputs, &sp.points, &sp.planes),
+            None,
+        ),
+        _ => match &receivers {
+            Some(r) => crate::methods::shade_points_weighted(method, &inputs, &sp.points, r),
+            None => (
+                crate::methods::shade_points(method, &inputs, &sp.points),
+                None,
+            ),
+        },
     };
-    let mut v = crate::methods::bounded(method, &inputs, Some(&sp.points), arg, shade)?;
+    let (mut v, mut weighted) =
+        crate::methods::bounded(method, &inputs, Some(&sp.points), arg, shade)?;
     sw.lap("shadow");
     finish(&mut v, &sp.bound);
+    if let Some(w) = &mut weighted {
+        finish_weighted(w, &sp.bound);
+    }
     for l in layers.iter_mut() {
         l.par_iter_mut()
             .for_each(|z| *z = user_depth(space, unit, *z));
     }
-    Ok((v, EyeMaps { grid, layers }))
+    Ok(MapShading {
+        visibility: v,
+        weighted,
+        maps: EyeMaps { grid, layers },
+    })
+}
+
+/// What both backends do with the kernel's weighted visibility `w`: 0 at a
+/// point not shaded (bound 0: it sees none of the light). The weights
+/// themselves leave out the part behind its tangent plane, so no cut.
+pub(crate) fn finish_weighted(w: &mut [f32], bound: &[f32]) {
+    w.par_iter_mut().zip(bound).for_each(|(w, b)| {
+        if *b <= 0.0 {
+            *w = 0.0;
+        }
+    });
 }
 
 /// What both backends do with the kernel's visibility `v`: each point's

@@ -41,6 +41,6 @@ pub mod tangent_plane;
 pub use call::{EyeCall, EyeImage, MAX_LIGHTS};
 pub use framing::Framed;
 pub use gbuffer::GBuffer;
-pub use maps::{Bias, EyeMaps, DEFAULT_BIAS, MAX_BIAS};
+pub use maps::{Bias, EyeMaps, MapShading, DEFAULT_BIAS, MAX_BIAS};
 pub use shading::{Lighting, Shaded};
 pub use stages::{CpuEye, EyeStages};

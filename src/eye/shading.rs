@@ -18,13 +18,16 @@
 //!   a = 0.265°); a disc straddling the horizon changes E by at most
 //!   `E_sun · sin a` absolute.
 //!
-//! Shadows multiply: `shaded = unshadowed · V` with V the method's
-//! visibility, the *unweighted* fraction of the light seen. That is an
-//! approximation: the exact shaded irradiance weights each visible part of
-//! the light by its cosine (and, for a rectangle, by 1/r² and the light's
-//! own cosine), `E = L ∫ V(ω) cos θ dω`; the two agree wherever V is 0 or 1
-//! and differ in penumbrae by how unevenly the light's parts are weighted
-//! (measured against Mitsuba's `direct` integrator in docs/shading.md).
+//! Shadows multiply: `shaded = unshadowed · V`. The exact shaded
+//! irradiance weights each visible part of the light by its cosine (and,
+//! for a planar light, by 1/r² and the light's own cosine), `E = L ∫ V(ω)
+//! cos θ dω`, so V is the *weighted* visibility where the method measured
+//! one (an area light's under `exact`, whose rays weigh, and `bitmask`,
+//! whose light samples weigh: methods/bitmask/weighted.rs), the ratio
+//! estimator of Heitz, Hill & McGuire 2018; else the plain fraction of the
+//! light seen, which agrees with it wherever V is 0 or 1 and differs in
+//! penumbrae by how unevenly the light's parts are weighted (measured
+//! against Mitsuba's `direct` integrator in docs/shading.md).
 //!
 //! Values are RGB. The checks of the user's emission and albedo live here
 //! (`Lighting::new`); the bindings only convert Python numbers and

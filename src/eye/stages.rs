@@ -7,7 +7,7 @@
 use super::call::EyeCall;
 use super::framing::Framed;
 use super::gbuffer::{self, GBuffer, SceneTriangles};
-use super::maps::{self, EyeMaps, LightTriangles};
+use super::maps::{self, LightTriangles, MapShading};
 use super::{rays, shadow_mapping};
 use crate::backend::Backend;
 use crate::error::Result;
@@ -60,7 +60,8 @@ pub trait EyeStages {
     ) -> Result<(Vec<f32>, Option<Vec<f32>>)>;
 
     /// The map methods: the occluder layers of `tris` on `grid`, and the
-    /// visibility of each visible point of `f` read from them.
+    /// visibility of each visible point of `f` read from them (and its
+    /// weighted visibility where the method weighs its samples).
     fn shade_maps(
         &mut self,
         call: &EyeCall,
@@ -69,7 +70,7 @@ pub trait EyeStages {
         grid: MapGrid,
         method: &MethodConfig,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps)>;
+    ) -> Result<MapShading>;
 
     /// The call's stage times: the host's laps `host` with the device's.
     fn timings(&mut self, host: Timings) -> Timings;
@@ -136,7 +137,7 @@ impl EyeStages for CpuEye {
         grid: MapGrid,
         method: &MethodConfig,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps)> {
+    ) -> Result<MapShading> {
         maps::shade(
             &f.space,
             f.unit,
@@ -150,6 +151,7 @@ impl EyeStages for CpuEye {
             &f.normals,
             &call.bias,
             call.map_size_arg(),
+            true,
             sw,
         )
     }

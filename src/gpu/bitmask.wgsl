@@ -205,3 +205,67 @@ fn bitmask_points_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
     }
     vis[idx] = 1.0 - f32(hidden_samples(idx)) / f32(gp.counted);
 }
+
+// The weighted visibility (methods/bitmask/weighted.rs): each sample not
+// hidden weighted by its share of the surface point's irradiance,
+// max(side, 0) p_z / r⁴ (eye/rays.rs's RayStart::weight), over every
+// sample's. A point with no sample hidden gives 1, with all 0, so only
+// penumbra points loop (gp.counted <= 1024 iterations).
+
+// Per sorted point: its surface point p (kernel space, the midpoint of its
+// ray starts) and its tangent plane's side(x, y) = a0 + x au + y av; valid
+// 0 where it has none. Shared with Rust (`GpuWeighPoint` in gather.rs).
+struct WeighPoint {
+    p: vec3<f32>,
+    valid: u32,
+    side: vec3<f32>,
+    _pad: u32,
+}
+
+@group(0) @binding(14) var<storage, read> weigh_points: array<WeighPoint>;
+// The counted samples: (x, y) on the light in kernel units, their bit in
+// the masks (as f32, exact below 2^24), 0 (`bitmask::light_samples`).
+@group(0) @binding(15) var<storage, read> light_samples: array<vec4<f32>>;
+
+// After bitmask_points_resolve: vis[n_points + idx], the weighted
+// visibility (1 where no receiver).
+@compute @workgroup_size(64)
+fn bitmask_points_weigh(@builtin(global_invocation_id) gid: vec3<u32>,
+                        @builtin(num_workgroups) groups: vec3<u32>) {
+    let idx = point_index(gid, groups);
+    if idx >= pp.n_points {
+        return;
+    }
+    let out = pp.n_points + idx;
+    let rc = point_receiver(idx);
+    let wp = weigh_points[idx];
+    if !rc.ok || wp.valid == 0u {
+        vis[out] = 1.0;
+        return;
+    }
+    let hidden = hidden_samples(idx);
+    if hidden == 0u {
+        vis[out] = 1.0;
+        return;
+    }
+    if hidden >= gp.counted {
+        vis[out] = 0.0;
+        return;
+    }
+    let p = wp.p;
+    var lit = 0.0;
+    var all = 0.0;
+    for (var k = 0u; k < gp.counted; k++) {
+        let s = light_samples[k];
+        let side = wp.side.x + s.x * wp.side.y + s.y * wp.side.z;
+        let q = vec3<f32>(s.x, s.y, 0.0) - p;
+        let r2 = dot(q, q);
+        let w = max(side, 0.0) * p.z / (r2 * r2);
+        all += w;
+        let b = u32(s.z);
+        if ((acc[idx * WORDS + b / 32u] >> (b % 32u)) & 1u) == 0u {
+            lit += w;
+        }
+    }
+    vis[out] = select(0.0, lit / all, all > 0.0);
+}

@@ -865,7 +865,11 @@ mod eye {
         use crate::methods::bitmask::Gaps;
         let meshes = scene();
         let cam = camera((80, 60));
-        for (lname, light) in lights() {
+        // And a disk: its own samples, weighed too.
+        let disk = AreaLight::disk([0.3, 4.0, 0.2], [0.0, -1.0, 0.0], 0.45)
+            .unwrap()
+            .into();
+        for (lname, light) in lights().into_iter().chain([("disk", disk)]) {
             for samples in [16, 1024] {
                 for passes in [1, 2] {
                     let mut by_gaps = vec![];
@@ -896,6 +900,26 @@ mod eye {
                         let seen = c.output.gbuffer.mesh_id.iter().filter(|&&m| m >= 0).count();
                         assert!(compared * 100 >= seen * 99 && penumbra > 20);
                         assert_eq!(differ, 0, "{lname} {samples} {passes} {gaps:?}");
+                        // The weighted visibility (the rectangle's and the
+                        // disk's; the sun weighs nothing): the same masks, summed in f32 on
+                        // the device and f64 on the CPU.
+                        match (&c.output.weighted, &g.output.weighted) {
+                            (Some(cw), Some(gw)) => {
+                                assert_ne!(lname, "sun");
+                                let worst = (0..cw.len())
+                                    .filter(|&k| same[k])
+                                    .map(|k| (cw[k] - gw[k]).abs())
+                                    .fold(0f32, f32::max);
+                                let weighed = (0..cw.len())
+                                    .filter(|&k| same[k] && (cw[k] - cv[k]).abs() > 1e-3)
+                                    .count();
+                                eprintln!("  weighted: worst {worst:e}, {weighed} weighed apart");
+                                assert!(worst < 1e-5, "{lname} {samples} {passes} {gaps:?}");
+                                assert!(weighed > 10, "the weights change nothing");
+                            }
+                            (None, None) => assert_eq!(lname, "sun"),
+                            _ => panic!("one backend weighs, the other not"),
+                        }
                         let names: Vec<&str> = g.output.timings.iter().map(|t| t.0).collect();
                         assert_eq!(names.contains(&"corners"), gaps == Gaps::Closed);
                         by_gaps.push(g.output.visibility);

@@ -16,7 +16,7 @@ use super::method_kernel::{
 use super::readback::words;
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::EyeMaps;
+use crate::eye::MapShading;
 use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -277,7 +277,7 @@ impl GpuKernel for ExactKernel {
         _method: Method,
         _inputs: &EyeInputs,
         _sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+    ) -> Result<(MapShading, Timings)> {
         Err(Error::gpu(
             "exact has no map stage: the eye view traces its rays (GpuEye::trace) \
              (a bug: please report it)",

@@ -44,7 +44,7 @@ use crate::eye::framing::resolve_at_camera;
 use crate::eye::gbuffer::{self, GBuffer, SceneTriangles};
 use crate::eye::maps::LightTriangles;
 use crate::eye::rays::{self, RayStart};
-use crate::eye::{EyeCall, EyeMaps, EyeStages, Framed};
+use crate::eye::{EyeCall, EyeStages, Framed, MapShading};
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -218,7 +218,7 @@ impl EyeStages for GpuEye {
         grid: MapGrid,
         method: &MethodConfig,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps)> {
+    ) -> Result<MapShading> {
         check_side("map_resolution", (grid.width, grid.height))?;
         let resolved = method.kernel();
         let inputs = EyeInputs {
@@ -228,9 +228,9 @@ impl EyeStages for GpuEye {
             passes: method.passes(),
             bias: &call.bias,
         };
-        let (v, m, t) = super::kernel(resolved).eye(gpu()?, resolved, &inputs, sw)?;
+        let (shading, t) = super::kernel(resolved).eye(gpu()?, resolved, &inputs, sw)?;
         self.device_timings.extend(t);
-        Ok((v, m))
+        Ok(shading)
     }
 
     // Several submissions time some stages more than once: summed.

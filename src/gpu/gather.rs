@@ -197,6 +197,29 @@ pub struct GpuPoint {
     pub live: u32,
 }
 
+/// `WeighPoint` of bitmask.wgsl: a sorted point's surface point (kernel
+/// space) and tangent plane, for the weighted resolve (`eye::rays::RayStart`:
+/// the midpoint of its starts, its `side`); valid 0 where it has none.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct GpuWeighPoint {
+    pub p: [f32; 3],
+    pub valid: u32,
+    pub side: [f32; 3],
+    pub _pad: u32,
+}
+
+impl GpuWeighPoint {
+    pub fn new(r: Option<&crate::eye::rays::RayStart>) -> GpuWeighPoint {
+        r.map_or_else(GpuWeighPoint::default, |r| GpuWeighPoint {
+            p: (0.5 * (r.above + r.below)).to_array(),
+            valid: 1,
+            side: r.side,
+            _pad: 0,
+        })
+    }
+}
+
 /// `GroupBounds` of gather.wgsl: a group's bounds over its active lanes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
@@ -359,6 +382,8 @@ struct PointsPipelines {
     /// Adds one chunk of one layer to the points' accumulators.
     chunk: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
+    /// The bitmask's weighted resolve (`bitmask_points_weigh`).
+    weigh: Option<wgpu::ComputePipeline>,
 }
 
 fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static PointsPipelines> {
@@ -370,6 +395,8 @@ fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static Po
         PointsPipelines {
             chunk: pipeline(device, &m, &format!("{name}_points")),
             resolve: pipeline(device, &m, &format!("{name}_points_resolve")),
+            weigh: matches!(v, Variant::Bitmask { .. })
+                .then(|| pipeline(device, &m, "bitmask_points_weigh")),
         }
     }))
 }
@@ -575,6 +602,10 @@ pub struct PointsBuffers<'a> {
     pub groups: &'a wgpu::Buffer,
     pub status: &'a wgpu::Buffer,
     pub params: PointsParams,
+    /// The bitmask's weighted resolve: the sorted points' `GpuWeighPoint`s
+    /// and the light's samples (`Bitmask::light_samples`); it writes
+    /// `vis[n_points + k]`, so `vis` then holds 2 n_points.
+    pub weigh: Option<(&'a wgpu::Buffer, &'a wgpu::Buffer)>,
 }
 
 /// Records the points-mode shading pass body: for every layer and chunk of
@@ -652,5 +683,24 @@ pub fn record_shade_points(
     pass.set_pipeline(&p.resolve);
     pass.set_bind_group(0, &bg, &[]);
     pass.dispatch_workgroups(groups.0, groups.1, 1);
+    if let Some((weigh_points, samples)) = pts.weigh {
+        let weigh = p.weigh.as_ref().ok_or_else(|| {
+            Error::gpu("only the bitmask weighs its samples (a bug: please report it)")
+        })?;
+        let mut buffers = vec![None; WEIGH_BINDING];
+        buffers[3] = Some(&u);
+        buffers[5] = Some(b.vis);
+        buffers[7] = Some(b.acc);
+        buffers[9] = Some(&pu);
+        buffers[10] = Some(pts.points);
+        buffers.extend([Some(weigh_points), Some(samples)]);
+        let bg = bind(device, weigh, &buffers);
+        pass.set_pipeline(weigh);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(groups.0, groups.1, 1);
+    }
     Ok(())
 }
+
+/// bitmask.wgsl's binding of the weighed points (the samples follow).
+const WEIGH_BINDING: usize = 14;

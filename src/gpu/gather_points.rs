@@ -19,6 +19,7 @@
 
 use super::context::Gpu;
 use super::dispatch::{storage, upload};
+use super::gather::GpuWeighPoint;
 use super::gather::{
     self, GatherBuffers, GpuGroup, GpuPoint, PointsBuffers, PointsParams, POINT_GROUP,
 };
@@ -30,10 +31,14 @@ use super::refusals::fits;
 use super::shading::{gather_params, Shading};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
+use crate::eye::framing::Framed;
 use crate::eye::maps;
-use crate::eye::EyeMaps;
+use crate::eye::rays::ray_starts;
+use crate::eye::{EyeMaps, MapShading};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
+use crate::geom::light_space::LightSpace;
+use crate::methods::bitmask::Bitmask;
 use crate::methods::gather::{point_group, point_order, POINTS_PER_GROUP};
 use crate::methods::{Input, LightPoint, Method};
 use crate::raster::setup_triangles;
@@ -79,7 +84,7 @@ impl GpuKernel for GatherKernel {
         method: Method,
         inputs: &EyeInputs,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+    ) -> Result<(MapShading, Timings)> {
         shade_points(g, method, inputs, sw)
     }
 }
@@ -171,14 +176,42 @@ fn point_axes(og: &MapGrid, light_shape: LightShape, p: &mut gather::GatherParam
     data
 }
 
+/// The bitmask's weighted resolve's inputs under an area light (as
+/// `maps::shade`'s receivers): each sorted lane's surface point and
+/// tangent plane, and the light's samples; None for the others.
+fn weigh_inputs(
+    method: Method,
+    f: &Framed,
+    order: &[u32],
+    n_lanes: usize,
+) -> Option<(Vec<GpuWeighPoint>, Vec<[f32; 4]>)> {
+    let Method::Bitmask { samples, gaps, .. } = method else {
+        return None;
+    };
+    if !matches!(f.space, LightSpace::Area(_)) || f.light_shape.is_point() {
+        return None;
+    }
+    let starts = ray_starts(&f.space, f.unit, &f.points, &f.normals);
+    let mut lanes: Vec<GpuWeighPoint> = order
+        .par_iter()
+        .map(|&n| GpuWeighPoint::new(starts[n as usize].as_ref()))
+        .collect();
+    lanes.resize(n_lanes, GpuWeighPoint::default());
+    let disk = matches!(f.light_shape, LightShape::Disk { .. });
+    let light_samples =
+        Bitmask::for_shape(samples, gaps, None, disk).light_samples(f.light_shape.half_extent());
+    Some((lanes, light_samples))
+}
+
 /// The gather methods in the eye view: `maps::shade`'s visibility per
-/// point and maps, and the device's stage times.
+/// point (and the bitmask's weighted visibility under an area light) and
+/// maps, and the device's stage times.
 fn shade_points(
     g: &Gpu,
     method: Method,
     e: &EyeInputs,
     sw: &mut Stopwatch,
-) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+) -> Result<(MapShading, Timings)> {
     debug_assert!(method.reads_input(Input::OccluderLayers));
     let (f, tris, grid, passes, bias) = (e.f, e.tris, e.grid, e.passes, e.bias);
     let layer_len = grid.len();
@@ -209,6 +242,7 @@ fn shade_points(
     let sorted: Vec<LightPoint> = order.iter().map(|&n| valid[n as usize]).collect();
     let (lanes, groups) = point_lanes(&sorted);
     let n_points = lanes.len();
+    let weigh = weigh_inputs(method, f, &order, n_points);
     let acc_words = gather::accumulator_words(method, passes) as u64 * n_points as u64;
     fits(g, "resolution", (acc_words * 4).max(n_points as u64 * 16))?;
     let quads = gather::needs_corners(method);
@@ -222,7 +256,8 @@ fn shade_points(
     let axes = point_axes(&grid, f.light_shape, &mut params);
     sw.lap("setup");
     let maps_bytes = texels * 4;
-    let vis_bytes = n_points as u64 * 4;
+    // The weighted visibility follows the plain one.
+    let vis_bytes = n_points as u64 * 4 * (1 + weigh.is_some() as u64);
     let out = with_error_scopes(g, || {
         let device = &g.device;
         let maps_buf = storage(device, "maps", maps_bytes, wgpu::BufferUsages::COPY_SRC);
@@ -256,6 +291,12 @@ fn shade_points(
         );
         let points_buf = upload(device, "points", &lanes);
         let groups_buf = upload(device, "point groups", &groups);
+        let weigh_bufs = weigh.as_ref().map(|(p, s)| {
+            (
+                upload(device, "weighed points", p),
+                upload(device, "light samples", s),
+            )
+        });
         let status = storage(
             device,
             "status",
@@ -324,6 +365,7 @@ fn shade_points(
                     chunks,
                     _pad: 0,
                 },
+                weigh: weigh_bufs.as_ref().map(|(p, s)| (p, s)),
             };
             gather::record_shade_points(device, &mut pass, method, &b, &params, &pts)?;
         }
@@ -351,12 +393,21 @@ fn shade_points(
         ));
     }
     let shaded = visibility(&out.buffers[1])?;
-    let mut v = vec![1f32; valid.len()];
-    for (&n, &s) in order.iter().zip(&shaded) {
-        v[n as usize] = s;
-    }
+    let unsort = |from: &[f32]| {
+        let mut v = vec![1f32; valid.len()];
+        for (&n, &s) in order.iter().zip(from) {
+            v[n as usize] = s;
+        }
+        v
+    };
+    let mut v = unsort(&shaded[..n_points]);
     // As maps::shade.
     maps::finish(&mut v, &sp.bound);
+    let weighted = weigh.is_some().then(|| {
+        let mut w = unsort(&shaded[n_points..]);
+        maps::finish_weighted(&mut w, &sp.bound);
+        w
+    });
     // The layers back in the user's depth; the farthest starts at 0 bits
     // (before its atomicMax): 0 means empty.
     let m = words(&out.buffers[0]);
@@ -376,7 +427,14 @@ fn shade_points(
                 .collect()
         })
         .collect();
-    Ok((v, EyeMaps { grid, layers }, out.device_timings))
+    Ok((
+        MapShading {
+            visibility: v,
+            weighted,
+            maps: EyeMaps { grid, layers },
+        },
+        out.device_timings,
+    ))
 }
 
 /// Points per group and per workgroup agree (gather.wgsl's POINTS_GROUP).

@@ -10,7 +10,7 @@ use super::readback::{submit_and_read, ReadBack};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::eye::maps::LightTriangles;
-use crate::eye::{Bias, EyeMaps, Framed};
+use crate::eye::{Bias, Framed, MapShading};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::methods::Method;
@@ -118,15 +118,16 @@ pub(super) trait GpuKernel: Sync {
     ) -> Result<Option<MakeStage<'a>>>;
 
     /// The eye view's map shading (`maps::shade` on the device): the
-    /// visibility per visible point, the maps in the user's depth, and the
-    /// device's stage times.
+    /// visibility per visible point (weighted too where the method weighs
+    /// its samples), the maps in the user's depth, and the device's stage
+    /// times.
     fn eye(
         &self,
         g: &Gpu,
         method: Method,
         inputs: &EyeInputs,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)>;
+    ) -> Result<(MapShading, Timings)>;
 }
 
 /// The kernel of a method the GPU has none for (ShadowMapping, whose eye
@@ -163,7 +164,7 @@ impl GpuKernel for NoKernel {
         method: Method,
         _inputs: &EyeInputs,
         _sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+    ) -> Result<(MapShading, Timings)> {
         Err(cpu_only(method))
     }
 }

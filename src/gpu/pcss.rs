@@ -22,7 +22,7 @@ use super::front_layer::FrontLayer;
 use super::method_kernel::{mismatch, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::EyeMaps;
+use crate::eye::{EyeMaps, MapShading};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::plane_gradient::{split, Plane};
@@ -451,10 +451,11 @@ impl GpuKernel for PcssKernel {
         method: Method,
         inputs: &EyeInputs,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+    ) -> Result<(MapShading, Timings)> {
         let Method::Pcss { max_taps } = method else {
             return Err(mismatch(method));
         };
-        shade_points(g, inputs, max_taps, sw)
+        let (v, maps, t) = shade_points(g, inputs, max_taps, sw)?;
+        Ok((MapShading::unweighted(v, maps), t))
     }
 }

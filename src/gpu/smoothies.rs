@@ -35,7 +35,7 @@ use super::raster::NONE;
 use super::readback::{submit_and_read, with_error_scopes};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::EyeMaps;
+use crate::eye::{EyeMaps, MapShading};
 use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -704,8 +704,9 @@ impl GpuKernel for SmoothiesKernel {
         method: Method,
         inputs: &EyeInputs,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-        shade_eye(g, inputs, &options(method)?, sw)
+    ) -> Result<(MapShading, Timings)> {
+        let (v, maps, t) = shade_eye(g, inputs, &options(method)?, sw)?;
+        Ok((MapShading::unweighted(v, maps), t))
     }
 }
 

@@ -320,6 +320,31 @@ pub fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -
     }
 }
 
+/// `shade_points`, and beside it each point's weighted visibility seen from
+/// `receivers` (its surface point and tangent plane: the share of its
+/// irradiance each part of the light gives, `RayOrigin::weight`) where the
+/// method samples the light (`bitmask`: `bitmask/weighted.rs`); `None` for
+/// the others.
+pub(crate) fn shade_points_weighted<R: shadow_rays::RayOrigin>(
+    method: Method,
+    inputs: &ShadowInputs,
+    pts: &[LightPoint],
+    receivers: &[Option<R>],
+) -> (Vec<f32>, Option<Vec<f32>>) {
+    match method {
+        Method::Bitmask {
+            samples,
+            hierarchy,
+            gaps,
+        } if !inputs.light_shape.is_point() => {
+            let m = bitmask::Bitmask::new(samples, gaps, hierarchy.then_some(HIERARCHY));
+            let (v, w) = m.weighted_points(inputs, pts, receivers);
+            (v, Some(w))
+        }
+        _ => (shade_points(method, inputs, pts), None),
+    }
+}
+
 /// A texel-aligned square plate over a parallel floor, whose visibility has
 /// a closed form: the methods' shared accuracy check.
 #[cfg(test)]

@@ -173,6 +173,7 @@ pub fn render_with<S: EyeStages>(
     let mut visibility = vec![1f32; g.len()];
     let mut maps = None;
     let mut estimate = None;
+    let mut weighted = None;
     let method;
     if !f.points.is_empty() {
         let casting = casting_faces(call, &scene, &f);
@@ -195,7 +196,7 @@ pub fn render_with<S: EyeStages>(
         // coarser map (`framing::coarser`): so wide a light casts only
         // shadows as wide. A size the user set is refused, naming it
         // (`methods::bounded`).
-        let (v, m) = loop {
+        let shaded = loop {
             match stages.shade_maps(call, &f, &tris, plan.grid, &plan.method, &mut sw) {
                 Err(e @ Error::TooCostly { .. }) => match coarser(call, &plan, S::BACKEND)? {
                     Some(p) => plan = p,
@@ -205,7 +206,8 @@ pub fn render_with<S: EyeStages>(
             }
         };
         method = plan.method;
-        maps = Some(m);
+        let v = shaded.visibility;
+        maps = Some(shaded.maps);
         sw.lap("maps_out");
         if let Some((how, traced)) = traced {
             let e = estimate::estimate(
@@ -222,6 +224,13 @@ pub fn render_with<S: EyeStages>(
         for (&k, v) in f.hits.iter().zip(v) {
             visibility[k] = v;
         }
+        weighted = shaded.weighted.map(|vw| {
+            let mut image = vec![1f32; g.len()];
+            for (&k, v) in f.hits.iter().zip(vw) {
+                image[k] = v;
+            }
+            image
+        });
     } else {
         method = resolve_at_camera(call, S::BACKEND)?;
     }
@@ -230,7 +239,7 @@ pub fn render_with<S: EyeStages>(
         EyeImage {
             gbuffer: g,
             visibility,
-            weighted: None,
+            weighted,
             maps,
             light_space: Some(f.space),
             timings,

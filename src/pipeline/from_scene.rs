@@ -112,7 +112,7 @@ pub fn from_scene(
             .par_iter()
             .map(|p| light.to_light(DVec3::from_array(*p)))
             .collect();
-        let (v, m) = maps::shade(
+        let shaded = maps::shade(
             light,
             unit,
             light_shape,
@@ -125,13 +125,14 @@ pub fn from_scene(
             &normals,
             bias,
             "occluder_resolution",
+            false,
             &mut sw,
         )?;
-        for (&k, v) in texels.iter().zip(v) {
+        for (&k, v) in texels.iter().zip(shaded.visibility) {
             visibility[k] = v;
         }
         // The layers come back in the user's depth already.
-        let mut layers = m.layers;
+        let mut layers = shaded.maps.layers;
         let back = (s.passes >= 2).then(|| layers.pop()).flatten();
         let front = Some(layers.remove(0));
         (front, back, layers)

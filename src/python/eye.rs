@@ -19,7 +19,10 @@ use crate::eye::{Bias, EyeCall, EyeImage, Lighting, Shaded};
 use crate::geom::mesh::MeshRef;
 use crate::timing::Timings;
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArrayDyn, PyReadonlyArray2, PyReadonlyArray3, PyReadonlyArrayDyn,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
@@ -94,6 +97,18 @@ pub fn irradiance<'py>(
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         Ok(a.into_pyarray(py).into_any().unbind())
     })
+}
+
+/// sRGB-encoded values in [0, 1] (any shape; clipped) -> linear f32
+/// (`eye::albedo::srgb_to_linear`).
+#[pyfunction]
+pub fn srgb_to_linear<'py>(
+    py: Python<'py>,
+    values: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    let a = values.as_array();
+    Ok(a.mapv(|x| crate::eye::albedo::srgb_to_linear(x) as f32)
+        .into_pyarray(py))
 }
 
 /// A scene seen through a camera -> the visibility image and its G-buffer.

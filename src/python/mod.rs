@@ -62,6 +62,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(eye::render, m)?)?;
     m.add_function(wrap_pyfunction!(eye::light_emission, m)?)?;
     m.add_function(wrap_pyfunction!(eye::irradiance, m)?)?;
+    m.add_function(wrap_pyfunction!(eye::srgb_to_linear, m)?)?;
     m.add_class::<capabilities::MethodInfo>()?;
     m.add_class::<capabilities::OptionInfo>()?;
     m.add_function(wrap_pyfunction!(capabilities::capabilities, m)?)?;

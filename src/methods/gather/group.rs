@@ -23,6 +23,7 @@ impl Group {
             x_hi: f32::NEG_INFINITY,
             y_lo: f32::INFINITY,
             y_hi: f32::NEG_INFINITY,
+            first: 0,
         };
         for (l, (x, y, z)) in pts.take(LANES).enumerate() {
             if !(z.is_finite() && z > 0.0) {
@@ -110,13 +111,15 @@ impl Kernel {
         &self,
         a: &A,
         pts: &[LightPoint],
+        first: usize,
         out: &mut [f32],
     ) {
-        for (o, p) in out.chunks_mut(LANES).zip(pts.chunks(LANES)) {
+        for (n, (o, p)) in out.chunks_mut(LANES).zip(pts.chunks(LANES)).enumerate() {
             if self.stopped() {
                 return;
             }
-            if let Some(g) = Group::new(p.iter().map(|p| (p.x, p.y, p.z)), false) {
+            if let Some(mut g) = Group::new(p.iter().map(|p| (p.x, p.y, p.z)), false) {
+                g.first = first + n * LANES;
                 let v = self.shade_counted(a, &g);
                 o.copy_from_slice(&v[..o.len()]);
             }

@@ -21,6 +21,13 @@ pub(in crate::methods) trait Accumulator: Sync {
     fn full(&self, acc: &Self::State, g: &Group) -> bool;
     /// Occlusion per lane in [0, 1].
     fn occlusion(&self, acc: &Self::State) -> Lanes;
+    /// `occlusion` of a group's final shared state (LAYERS_SHARE_STATE),
+    /// where the accumulator also reads what it knows of the group's points
+    /// (`Group::first`): the bitmask's weighted shading does.
+    #[inline(always)]
+    fn occlusion_at(&self, acc: &Self::State, _g: &Group) -> Lanes {
+        self.occlusion(acc)
+    }
     /// Whether occluder rows are visited top to bottom, the order in which
     /// the paper's GPU blended micro-patches (what FP16 emulation needs),
     /// rather than outward from the tile (what reaches umbra soonest).
@@ -188,6 +195,11 @@ pub(in crate::methods) struct Group {
     pub(super) x_hi: f32,
     pub(super) y_lo: f32,
     pub(super) y_hi: f32,
+    /// For a run of points (`visibility_points`): the rank of lane 0's point
+    /// in the order they are shaded in, so that lane l is point `first + l`
+    /// of that order (what `Accumulator::occlusion_at` looks up per point);
+    /// 0 for a tile of the output map.
+    pub first: usize,
 }
 
 /// One occluder depth layer at one level of the hierarchy, in the form the

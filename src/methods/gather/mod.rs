@@ -146,16 +146,30 @@ pub(super) fn visibility_points<A: Accumulator>(
     points: &[LightPoint],
     hierarchy: Option<Hierarchy>,
 ) -> Vec<f32> {
-    let k = Kernel::new(inputs, hierarchy, A::CORNERS);
     // Shade neighbours together: sort the points by the texel they fall in,
     // so that each group's union of extents stays small.
     let order = point_order(&inputs.occluder_grid, points);
+    visibility_points_in(a, inputs, points, &order, hierarchy)
+}
+
+/// `visibility_points` in a given shading `order` (`point_order`'s): lane l
+/// of a group is point `order[g.first + l]` (`Group::first`).
+pub(super) fn visibility_points_in<A: Accumulator>(
+    a: &A,
+    inputs: &ShadowInputs,
+    points: &[LightPoint],
+    order: &[u32],
+    hierarchy: Option<Hierarchy>,
+) -> Vec<f32> {
+    let k = Kernel::new(inputs, hierarchy, A::CORNERS);
     let sorted: Vec<LightPoint> = order.iter().map(|&n| points[n as usize]).collect();
     let mut shaded = vec![1f32; points.len()];
+    const CHUNK: usize = LANES * 4;
     shaded
-        .par_chunks_mut(LANES * 4)
-        .zip(sorted.par_chunks(LANES * 4))
-        .for_each(|(o, p)| k.shade_points(a, p, o));
+        .par_chunks_mut(CHUNK)
+        .zip(sorted.par_chunks(CHUNK))
+        .enumerate()
+        .for_each(|(c, (o, p))| k.shade_points(a, p, c * CHUNK, o));
     let mut out = vec![1f32; points.len()];
     for (&n, &v) in order.iter().zip(&shaded) {
         out[n as usize] = v;

@@ -30,19 +30,26 @@ impl Kernel {
         self.shade_row_generic(a, j, receiver, out)
     }
 
-    pub(super) fn shade_points<A: Accumulator>(&self, a: &A, pts: &[LightPoint], out: &mut [f32]) {
+    /// Shades `pts`, the points of ranks `first..` in the shading order.
+    pub(super) fn shade_points<A: Accumulator>(
+        &self,
+        a: &A,
+        pts: &[LightPoint],
+        first: usize,
+        out: &mut [f32],
+    ) {
         #[cfg(target_arch = "x86_64")]
         {
             if is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
                 // SAFETY: the CPU has the features the function is compiled for.
-                return unsafe { self.shade_points_avx512(a, pts, out) };
+                return unsafe { self.shade_points_avx512(a, pts, first, out) };
             }
             if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
                 // SAFETY: as above.
-                return unsafe { self.shade_points_avx2(a, pts, out) };
+                return unsafe { self.shade_points_avx2(a, pts, first, out) };
             }
         }
-        self.shade_points_generic(a, pts, out)
+        self.shade_points_generic(a, pts, first, out)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -75,14 +82,21 @@ impl Kernel {
         &self,
         a: &A,
         pts: &[LightPoint],
+        first: usize,
         out: &mut [f32],
     ) {
-        self.shade_points_generic(a, pts, out)
+        self.shade_points_generic(a, pts, first, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn shade_points_avx2<A: Accumulator>(&self, a: &A, pts: &[LightPoint], out: &mut [f32]) {
-        self.shade_points_generic(a, pts, out)
+    unsafe fn shade_points_avx2<A: Accumulator>(
+        &self,
+        a: &A,
+        pts: &[LightPoint],
+        first: usize,
+        out: &mut [f32],
+    ) {
+        self.shade_points_generic(a, pts, first, out)
     }
 }

@@ -208,7 +208,7 @@ impl Kernel {
                     break;
                 }
             }
-            a.occlusion(&acc)
+            a.occlusion_at(&acc, g)
         } else {
             // Separate sums merged by max (§3.5). Back layer first: it is the
             // cheaper one (farther, so its micro-patches reach less far) and, on

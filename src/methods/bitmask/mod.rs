@@ -698,6 +698,10 @@ macro_rules! with_kernel {
     };
 }
 
+// After `with_kernel!`, which it calls (macros are in scope from their
+// definition on).
+mod weighted;
+
 impl ShadowMethod for Bitmask {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         if let Some(disk) = self.on(inputs) {
