@@ -15,7 +15,9 @@ use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::methods::exact::Bvh;
 use crate::methods::probe::probed_visibilities_weighted;
-use crate::methods::shadow_rays::{tile_order, visibilities_weighted, Jitter, RayOrigin, Sampling};
+use crate::methods::shadow_rays::{
+    tile_order, visibilities_weighted, Jitter, RayOrigin, Sampling, SurfacePoint,
+};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -49,6 +51,16 @@ pub struct RayStart {
 }
 
 impl RayStart {
+    /// The surface point it starts from (the midpoint of its starts) and
+    /// its tangent plane.
+    #[inline(always)]
+    pub(crate) fn surface_point(&self) -> SurfacePoint {
+        SurfacePoint {
+            p: 0.5 * (self.above + self.below),
+            side: self.side,
+        }
+    }
+
     /// The origin of the ray toward the light point (x, y).
     #[inline]
     pub fn origin(&self, x: f32, y: f32) -> Vec3 {
@@ -98,16 +110,14 @@ impl RayOrigin for RayStart {
     }
     const WEIGHTED: bool = true;
     /// The light point (x, y, 0)'s share of the irradiance at the surface
-    /// point p (kernel space, the origins' midpoint), for a planar light
-    /// sampled uniformly over its area: cos θ cos θ' / r², with
-    /// cos θ = n · (y − p) / r = side(x, y) / r (0 below the horizon) and
-    /// cos θ' = p_z / r (the light faces +Z): side · p_z / r⁴.
+    /// point (kernel space, the origins' midpoint): `SurfacePoint::weight`.
     #[inline(always)]
     fn weight(&self, x: f32, y: f32) -> f32 {
-        let p = 0.5 * (self.above + self.below);
-        let side = self.side[0] + x * self.side[1] + y * self.side[2];
-        let r2 = (Vec3::new(x, y, 0.0) - p).length_squared();
-        side.max(0.0) * p.z / (r2 * r2)
+        self.surface_point().weight(x, y)
+    }
+    #[inline(always)]
+    fn surface(&self) -> Option<SurfacePoint> {
+        Some(self.surface_point())
     }
 }
 

@@ -22,8 +22,9 @@
 //! irradiance weights each visible part of the light by its cosine (and,
 //! for a planar light, by 1/r² and the light's own cosine), `E = L ∫ V(ω)
 //! cos θ dω`, so V is the *weighted* visibility where the method measured
-//! one (an area light's under `exact`, whose rays weigh, and `bitmask`,
-//! whose light samples weigh: methods/bitmask/weighted.rs), the ratio
+//! one (an area light's under `exact`, whose rays weigh, `bitmask`, whose
+//! light samples weigh, and `ssm`, whose micro-patches weigh:
+//! methods/bitmask/weighted.rs, methods/ssm/weighted.rs), the ratio
 //! estimator of Heitz, Hill & McGuire 2018; else the plain fraction of the
 //! light seen, which agrees with it wherever V is 0 or 1 and differs in
 //! penumbrae by how unevenly the light's parts are weighted (measured

@@ -207,22 +207,11 @@ fn bitmask_points_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
 }
 
 // The weighted visibility (methods/bitmask/weighted.rs): each sample not
-// hidden weighted by its share of the surface point's irradiance,
-// max(side, 0) p_z / r⁴ (eye/rays.rs's RayStart::weight), over every
-// sample's. A point with no sample hidden gives 1, with all 0, so only
-// penumbra points loop (gp.counted <= 1024 iterations).
+// hidden weighted by its share of the surface point's irradiance
+// (`irradiance_weight`, gather.wgsl), over every sample's. A point with no
+// sample hidden gives 1, with all 0, so only penumbra points loop
+// (gp.counted <= 1024 iterations).
 
-// Per sorted point: its surface point p (kernel space, the midpoint of its
-// ray starts) and its tangent plane's side(x, y) = a0 + x au + y av; valid
-// 0 where it has none. Shared with Rust (`GpuWeighPoint` in gather.rs).
-struct WeighPoint {
-    p: vec3<f32>,
-    valid: u32,
-    side: vec3<f32>,
-    _pad: u32,
-}
-
-@group(0) @binding(14) var<storage, read> weigh_points: array<WeighPoint>;
 // The counted samples: (x, y) on the light in kernel units, their bit in
 // the masks (as f32, exact below 2^24), 0 (`bitmask::light_samples`).
 @group(0) @binding(15) var<storage, read> light_samples: array<vec4<f32>>;
@@ -252,15 +241,11 @@ fn bitmask_points_weigh(@builtin(global_invocation_id) gid: vec3<u32>,
         vis[out] = 0.0;
         return;
     }
-    let p = wp.p;
     var lit = 0.0;
     var all = 0.0;
     for (var k = 0u; k < gp.counted; k++) {
         let s = light_samples[k];
-        let side = wp.side.x + s.x * wp.side.y + s.y * wp.side.z;
-        let q = vec3<f32>(s.x, s.y, 0.0) - p;
-        let r2 = dot(q, q);
-        let w = max(side, 0.0) * p.z / (r2 * r2);
+        let w = irradiance_weight(wp, s.x, s.y);
         all += w;
         let b = u32(s.z);
         if ((acc[idx * WORDS + b / 32u] >> (b % 32u)) & 1u) == 0u {

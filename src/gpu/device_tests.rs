@@ -742,6 +742,31 @@ mod eye {
                 // degrees make narrow ones).
                 assert!(penumbra > 20 && shadowed > 50, "{lname} {mname}");
                 assert!(mean <= 1e-4, "{lname} {mname}: mean |dV| {mean}");
+                // The weighted visibility (the shaded image's: the map
+                // methods' under the rectangle), summed in f32 on the
+                // device, f64 on the CPU.
+                match (&c.output.weighted, &g.output.weighted) {
+                    (Some(cw), Some(gw)) => {
+                        // (exact weighs under the sun too, alike: V_w = V.)
+                        assert!(lname == "rect" || mname == "exact", "{mname}");
+                        let dw: Vec<f64> = (0..cw.len())
+                            .filter(|&k| same[k])
+                            .map(|k| (cw[k] as f64 - gw[k] as f64).abs())
+                            .collect();
+                        let mean = dw.iter().sum::<f64>() / dw.len() as f64;
+                        let weighed = (0..cw.len())
+                            .filter(|&k| same[k] && (cw[k] - cv[k]).abs() > 1e-3)
+                            .count();
+                        eprintln!("  weighted: mean |dV_w| {mean:.2e}, {weighed} weighed apart");
+                        assert!(mean <= 1e-4, "{lname} {mname}: mean |dV_w| {mean}");
+                        assert!(
+                            weighed > 10 || lname == "sun",
+                            "{lname} {mname}: the weights change nothing"
+                        );
+                    }
+                    (None, None) => assert!(lname == "sun", "{mname} weighs on neither"),
+                    _ => panic!("{lname} {mname}: one backend weighs, the other not"),
+                }
                 match (&c.output.maps, &g.output.maps) {
                     (Some(a), Some(b)) => {
                         assert_eq!(a.grid, b.grid, "{lname} {mname}: grids");

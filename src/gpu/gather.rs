@@ -184,7 +184,8 @@ pub struct PointsParams {
     pub n_points: u32,
     pub steps_per_chunk: u32,
     pub chunks: u32,
-    pub _pad: u32,
+    /// 1 where the points are weighed (`PointsBuffers::weigh_points`).
+    pub weigh: u32,
 }
 
 /// `GatherPoint` of gather.wgsl: a lane's tangent (x, y) and 1/depth.
@@ -197,7 +198,7 @@ pub struct GpuPoint {
     pub live: u32,
 }
 
-/// `WeighPoint` of bitmask.wgsl: a sorted point's surface point (kernel
+/// `WeighPoint` of gather.wgsl: a sorted point's surface point (kernel
 /// space) and tangent plane, for the weighted resolve (`eye::rays::RayStart`:
 /// the midpoint of its starts, its `side`); valid 0 where it has none.
 #[repr(C)]
@@ -211,11 +212,14 @@ pub struct GpuWeighPoint {
 
 impl GpuWeighPoint {
     pub fn new(r: Option<&crate::eye::rays::RayStart>) -> GpuWeighPoint {
-        r.map_or_else(GpuWeighPoint::default, |r| GpuWeighPoint {
-            p: (0.5 * (r.above + r.below)).to_array(),
-            valid: 1,
-            side: r.side,
-            _pad: 0,
+        r.map_or_else(GpuWeighPoint::default, |r| {
+            let s = r.surface_point();
+            GpuWeighPoint {
+                p: s.p.to_array(),
+                valid: 1,
+                side: s.side,
+                _pad: 0,
+            }
         })
     }
 }
@@ -382,8 +386,8 @@ struct PointsPipelines {
     /// Adds one chunk of one layer to the points' accumulators.
     chunk: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
-    /// The bitmask's weighted resolve (`bitmask_points_weigh`).
-    weigh: Option<wgpu::ComputePipeline>,
+    /// The weighted resolve (`{name}_points_weigh`).
+    weigh: wgpu::ComputePipeline,
 }
 
 fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static PointsPipelines> {
@@ -395,8 +399,7 @@ fn points_pipelines(device: &wgpu::Device, method: Method) -> Result<&'static Po
         PointsPipelines {
             chunk: pipeline(device, &m, &format!("{name}_points")),
             resolve: pipeline(device, &m, &format!("{name}_points_resolve")),
-            weigh: matches!(v, Variant::Bitmask { .. })
-                .then(|| pipeline(device, &m, "bitmask_points_weigh")),
+            weigh: pipeline(device, &m, &format!("{name}_points_weigh")),
         }
     }))
 }
@@ -602,10 +605,13 @@ pub struct PointsBuffers<'a> {
     pub groups: &'a wgpu::Buffer,
     pub status: &'a wgpu::Buffer,
     pub params: PointsParams,
-    /// The bitmask's weighted resolve: the sorted points' `GpuWeighPoint`s
-    /// and the light's samples (`Bitmask::light_samples`); it writes
-    /// `vis[n_points + k]`, so `vis` then holds 2 n_points.
-    pub weigh: Option<(&'a wgpu::Buffer, &'a wgpu::Buffer)>,
+    /// The sorted points' `GpuWeighPoint`s where `params.weigh` (one unread
+    /// entry where not: the SSM's chunks bind it always). Weighed, the
+    /// weighted resolve writes `vis[n_points + k]`, so `vis` holds 2
+    /// n_points, and the SSM's accumulators twice its layers' sums.
+    pub weigh_points: Option<&'a wgpu::Buffer>,
+    /// The bitmask's light samples (`Bitmask::light_samples`), weighed.
+    pub light_samples: Option<&'a wgpu::Buffer>,
 }
 
 /// Records the points-mode shading pass body: for every layer and chunk of
@@ -624,6 +630,7 @@ pub fn record_shade_points(
     let u = uniform(device, "gather params", params);
     let pu = uniform(device, "points params", &pts.params);
     let groups = groups_1d(pts.params.n_points, POINT_GROUP);
+    let reads_weigh_points = variant(method)? == Variant::Ssm;
     pass.set_pipeline(&p.chunk);
     for layer in 0..params.n_layers {
         for chunk in 0..pts.params.chunks {
@@ -637,28 +644,31 @@ pub fn record_shade_points(
                     _pad1: 0,
                 },
             );
-            let bg = bind(
-                device,
-                &p.chunk,
-                &b.with_corners(
-                    method,
-                    vec![
-                        Some(b.maps),
-                        Some(b.rows),
-                        Some(b.layer_w_max),
-                        Some(&u),
-                        Some(b.axes),
-                        None,
-                        b.tables,
-                        Some(b.acc),
-                        Some(&c),
-                        Some(&pu),
-                        Some(pts.points),
-                        Some(pts.groups),
-                        Some(pts.status),
-                    ],
-                )?,
-            );
+            let mut buffers = b.with_corners(
+                method,
+                vec![
+                    Some(b.maps),
+                    Some(b.rows),
+                    Some(b.layer_w_max),
+                    Some(&u),
+                    Some(b.axes),
+                    None,
+                    b.tables,
+                    Some(b.acc),
+                    Some(&c),
+                    Some(&pu),
+                    Some(pts.points),
+                    Some(pts.groups),
+                    Some(pts.status),
+                ],
+            )?;
+            // The SSM's chunks read the points' weights (an unread entry
+            // where not weighed).
+            if reads_weigh_points {
+                buffers.resize(WEIGH_BINDING, None);
+                buffers.push(pts.weigh_points);
+            }
+            let bg = bind(device, &p.chunk, &buffers);
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, 1);
         }
@@ -683,9 +693,9 @@ pub fn record_shade_points(
     pass.set_pipeline(&p.resolve);
     pass.set_bind_group(0, &bg, &[]);
     pass.dispatch_workgroups(groups.0, groups.1, 1);
-    if let Some((weigh_points, samples)) = pts.weigh {
-        let weigh = p.weigh.as_ref().ok_or_else(|| {
-            Error::gpu("only the bitmask weighs its samples (a bug: please report it)")
+    if pts.params.weigh != 0 {
+        let weigh_points = pts.weigh_points.ok_or_else(|| {
+            Error::gpu("weighing without the points' weights (a bug: please report it)")
         })?;
         let mut buffers = vec![None; WEIGH_BINDING];
         buffers[3] = Some(&u);
@@ -693,14 +703,20 @@ pub fn record_shade_points(
         buffers[7] = Some(b.acc);
         buffers[9] = Some(&pu);
         buffers[10] = Some(pts.points);
-        buffers.extend([Some(weigh_points), Some(samples)]);
-        let bg = bind(device, weigh, &buffers);
-        pass.set_pipeline(weigh);
+        buffers.push(Some(weigh_points));
+        if matches!(variant(method)?, Variant::Bitmask { .. }) {
+            buffers.push(Some(pts.light_samples.ok_or_else(|| {
+                Error::gpu("the bitmask weighs without its samples (a bug: please report it)")
+            })?));
+        }
+        let bg = bind(device, &p.weigh, &buffers);
+        pass.set_pipeline(&p.weigh);
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(groups.0, groups.1, 1);
     }
     Ok(())
 }
 
-/// bitmask.wgsl's binding of the weighed points (the samples follow).
+/// gather.wgsl's binding of the weighed points (bitmask.wgsl's light
+/// samples follow).
 const WEIGH_BINDING: usize = 14;

@@ -176,19 +176,22 @@ fn point_axes(og: &MapGrid, light_shape: LightShape, p: &mut gather::GatherParam
     data
 }
 
-/// The bitmask's weighted resolve's inputs under an area light (as
-/// `maps::shade`'s receivers): each sorted lane's surface point and
-/// tangent plane, and the light's samples; None for the others.
-fn weigh_inputs(
-    method: Method,
-    f: &Framed,
-    order: &[u32],
-    n_lanes: usize,
-) -> Option<(Vec<GpuWeighPoint>, Vec<[f32; 4]>)> {
-    let Method::Bitmask { samples, gaps, .. } = method else {
-        return None;
-    };
-    if !matches!(f.space, LightSpace::Area(_)) || f.light_shape.is_point() {
+/// What the weighted resolve reads.
+struct Weighing {
+    /// Each sorted lane's surface point and tangent plane.
+    points: Vec<GpuWeighPoint>,
+    /// The bitmask's light samples.
+    light_samples: Option<Vec<[f32; 4]>>,
+}
+
+/// The weighted resolve's inputs under an area light (as `maps::shade`'s
+/// receivers) for the methods that weigh (`bitmask`, `ssm`); None for the
+/// others and other lights.
+fn weigh_inputs(method: Method, f: &Framed, order: &[u32], n_lanes: usize) -> Option<Weighing> {
+    if !matches!(method, Method::Bitmask { .. } | Method::Ssm { .. })
+        || !matches!(f.space, LightSpace::Area(_))
+        || f.light_shape.is_point()
+    {
         return None;
     }
     let starts = ray_starts(&f.space, f.unit, &f.points, &f.normals);
@@ -197,10 +200,18 @@ fn weigh_inputs(
         .map(|&n| GpuWeighPoint::new(starts[n as usize].as_ref()))
         .collect();
     lanes.resize(n_lanes, GpuWeighPoint::default());
-    let disk = matches!(f.light_shape, LightShape::Disk { .. });
-    let light_samples =
-        Bitmask::for_shape(samples, gaps, None, disk).light_samples(f.light_shape.half_extent());
-    Some((lanes, light_samples))
+    let light_samples = match method {
+        Method::Bitmask { samples, gaps, .. } => {
+            let disk = matches!(f.light_shape, LightShape::Disk { .. });
+            let b = Bitmask::for_shape(samples, gaps, None, disk);
+            Some(b.light_samples(f.light_shape.half_extent()))
+        }
+        _ => None,
+    };
+    Some(Weighing {
+        points: lanes,
+        light_samples,
+    })
 }
 
 /// The gather methods in the eye view: `maps::shade`'s visibility per
@@ -243,7 +254,11 @@ fn shade_points(
     let (lanes, groups) = point_lanes(&sorted);
     let n_points = lanes.len();
     let weigh = weigh_inputs(method, f, &order, n_points);
-    let acc_words = gather::accumulator_words(method, passes) as u64 * n_points as u64;
+    let ssm = matches!(method, Method::Ssm { .. });
+    // Weighed, the SSM's weighted sums follow its plain ones.
+    let acc_words = gather::accumulator_words(method, passes) as u64
+        * n_points as u64
+        * (1 + (ssm && weigh.is_some()) as u64);
     fits(g, "resolution", (acc_words * 4).max(n_points as u64 * 16))?;
     let quads = gather::needs_corners(method);
     if quads {
@@ -291,12 +306,15 @@ fn shade_points(
         );
         let points_buf = upload(device, "points", &lanes);
         let groups_buf = upload(device, "point groups", &groups);
-        let weigh_bufs = weigh.as_ref().map(|(p, s)| {
-            (
-                upload(device, "weighed points", p),
-                upload(device, "light samples", s),
-            )
-        });
+        // The SSM's chunks bind the weights even unweighed: one entry then.
+        let weigh_points = match &weigh {
+            Some(w) => Some(upload(device, "weighed points", &w.points)),
+            None => ssm.then(|| upload(device, "weighed points", &[GpuWeighPoint::default()])),
+        };
+        let light_samples = weigh
+            .as_ref()
+            .and_then(|w| w.light_samples.as_ref())
+            .map(|s| upload(device, "light samples", s));
         let status = storage(
             device,
             "status",
@@ -363,9 +381,10 @@ fn shade_points(
                     n_points: n_points as u32,
                     steps_per_chunk,
                     chunks,
-                    _pad: 0,
+                    weigh: weigh.is_some() as u32,
                 },
-                weigh: weigh_bufs.as_ref().map(|(p, s)| (p, s)),
+                weigh_points: weigh_points.as_ref(),
+                light_samples: light_samples.as_ref(),
             };
             gather::record_shade_points(device, &mut pass, method, &b, &params, &pts)?;
         }

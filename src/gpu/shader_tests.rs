@@ -5,9 +5,9 @@
 use super::exact::{ExactParams, SOURCE as EXACT_SOURCE};
 use super::eye::{GpuRayStart, HitsParams, HITS_SOURCE, RAYS_SOURCE};
 use super::gather::{
-    bitmask_source, module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, GpuWeighPoint,
-    PointsParams, RowSpan, Variant, BITMASK_CLOSED_SOURCE, BITMASK_OPEN_SOURCE, BITMASK_SOURCE,
-    GATHER_SOURCE, SSM_SOURCE,
+    module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, GpuWeighPoint, PointsParams,
+    RowSpan, Variant, BITMASK_CLOSED_SOURCE, BITMASK_OPEN_SOURCE, BITMASK_SOURCE, GATHER_SOURCE,
+    SSM_SOURCE,
 };
 use super::pcss::{Coord, GpuPcssPoint, PcssChunk, PcssParams, SOURCE as PCSS_SOURCE};
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
@@ -15,7 +15,6 @@ use super::shadow_mapping::{GpuBlurPixel, GpuSmPoint, GpuSmTri, SmParams, SOURCE
 use super::smoothies::{
     GpuSmoothie, SmoothieChunk, SmoothieParams, TentAxis, TentPoint, SOURCE as SMOOTHIES_SOURCE,
 };
-use crate::methods::bitmask::Gaps;
 
 /// Every shader module the backend builds, by name.
 fn modules() -> Vec<(String, String)> {
@@ -207,7 +206,7 @@ pub(super) fn assert_same(wgsl_src: &str, name: &str, rust: (Vec<(String, u32, u
 #[test]
 fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
     assert_same(
-        &bitmask_source(8, Gaps::Open),
+        &module_source(SSM_SOURCE),
         "WeighPoint",
         rust_layout!(GpuWeighPoint {
             p,
@@ -324,7 +323,7 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             n_points,
             steps_per_chunk,
             chunks,
-            _pad
+            weigh
         }),
     );
     assert_same(

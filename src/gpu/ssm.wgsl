@@ -10,6 +10,13 @@ const D2_MIN: f32 = 1e-36;
 // The receiver's sum of this layer while gather_chunk runs.
 var<private> sum: f32;
 
+// Points mode, weighed (pp.weigh, a receiver with a tangent plane): the
+// point's weights and its sum of this layer's contributions each weighted
+// at its clipped back-projection's centre (methods/ssm/weighted.rs).
+var<private> weighing: bool;
+var<private> weigh_point: WeighPoint;
+var<private> wsum: f32;
+
 // A flat micro-patch reaches as far as its own 1/depth.
 fn texel_reach(t: u32, w: f32) -> f32 {
     return w;
@@ -21,7 +28,15 @@ fn add_texel(t: u32, w: f32, x0: f32, x1: f32, xr_s: f32, r: RowReach, rc: Recei
     let d = w - rc.wr;
     let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
     let cy = min(r.ay1, d) + min(r.nay0, d);
-    sum += max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
+    let c = max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
+    sum += c;
+    if weighing && c > 0.0 {
+        // weighted.rs's centre, in half-light units, then kernel units.
+        let h = 0.5 / d;
+        let x = (min(x1 - xr_s, d) - min(xr_s - x0, d)) * h;
+        let y = (min(r.ay1, d) - min(r.nay0, d)) * h;
+        wsum += c * irradiance_weight(weigh_point, x * gp.half_lx, y * gp.half_ly);
+    }
 }
 
 // Adds this dispatch's chunk of rows of its layer to every receiver's sum.
@@ -88,8 +103,18 @@ fn ssm_points(@builtin(global_invocation_id) gid: vec3<u32>,
     if sum >= 4.0 {
         return;
     }
+    // The weighted sums follow the plain ones (gp.n_layers of each).
+    let wslot = (gp.n_layers + chunk.layer) * pp.n_points + rc.idx;
+    if pp.weigh != 0u {
+        weigh_point = weigh_points[rc.idx];
+        weighing = weigh_point.valid != 0u;
+        wsum = bitcast<f32>(acc[wslot]);
+    }
     gather_points_chunk(rc);
     acc[slot] = bitcast<u32>(sum);
+    if weighing {
+        acc[wslot] = bitcast<u32>(wsum);
+    }
 }
 
 @compute @workgroup_size(64)
@@ -110,4 +135,49 @@ fn ssm_points_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
         occ = max(occ, min(0.25 * sum, 1.0));
     }
     vis[idx] = 1.0 - occ;
+}
+
+// ssm/weighted.rs's QUAD: the midpoint rule's side over the whole light.
+const QUAD: u32 = 32u;
+
+// After ssm_points_resolve: vis[n_points + idx], the weighted visibility:
+// the weighted sum of the layer whose plain occlusion is the largest (the
+// back layer first, a later one only where strictly larger, as the CPU
+// merges them) over the weights of the whole light; vis[idx] where it is 0
+// or 1, or where the point has no receiver.
+@compute @workgroup_size(64)
+fn ssm_points_weigh(@builtin(global_invocation_id) gid: vec3<u32>,
+                    @builtin(num_workgroups) groups: vec3<u32>) {
+    let idx = point_index(gid, groups);
+    if idx >= pp.n_points {
+        return;
+    }
+    let out = pp.n_points + idx;
+    let v = vis[idx];
+    let wp = weigh_points[idx];
+    if !point_receiver(idx).ok || wp.valid == 0u || v <= 0.0 || v >= 1.0 {
+        vis[out] = v;
+        return;
+    }
+    var best = -1.0;
+    var hidden = 0.0;
+    for (var k = 0u; k < gp.n_layers; k++) {
+        let layer = gp.n_layers - 1u - k;
+        let occ = min(0.25 * bitcast<f32>(acc[layer * pp.n_points + idx]), 1.0);
+        if occ > best {
+            best = occ;
+            hidden = bitcast<f32>(acc[(gp.n_layers + layer) * pp.n_points + idx]);
+        }
+    }
+    let step = 2.0 / f32(QUAD);
+    var all = 0.0;
+    for (var j = 0u; j < QUAD; j++) {
+        let y = (-1.0 + (f32(j) + 0.5) * step) * gp.half_ly;
+        for (var i = 0u; i < QUAD; i++) {
+            let x = (-1.0 + (f32(i) + 0.5) * step) * gp.half_lx;
+            all += irradiance_weight(wp, x, y);
+        }
+    }
+    all *= step * step;
+    vis[out] = select(0.0, 1.0 - clamp(hidden / all, 0.0, 1.0), all > 0.0);
 }

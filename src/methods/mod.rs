@@ -323,9 +323,9 @@ pub fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -
 /// `shade_points`, and beside it each point's weighted visibility seen from
 /// `receivers` (its surface point and tangent plane: the share of its
 /// irradiance each part of the light gives, `RayOrigin::weight`) where the
-/// method samples the light (`bitmask`: `bitmask/weighted.rs`); `None` for
-/// the others.
-pub(crate) fn shade_points_weighted<R: shadow_rays::RayOrigin>(
+/// method has them (`bitmask`'s samples: `bitmask/weighted.rs`; `ssm`'s
+/// micro-patches: `ssm/weighted.rs`); `None` for the others.
+pub(crate) fn shade_points_weighted<R: shadow_rays::RayOrigin + Copy + Sync>(
     method: Method,
     inputs: &ShadowInputs,
     pts: &[LightPoint],
@@ -341,6 +341,17 @@ pub(crate) fn shade_points_weighted<R: shadow_rays::RayOrigin>(
             let (v, w) = m.weighted_points(inputs, pts, receivers);
             (v, Some(w))
         }
+        Method::Ssm {
+            hierarchy,
+            precision,
+        } if !inputs.light_shape.is_point() => {
+            let m = ssm::Ssm {
+                hierarchy: hierarchy.then_some(HIERARCHY),
+                precision,
+            };
+            let (v, w) = m.weighted_points(inputs, pts, receivers);
+            (v, Some(w))
+        }
         _ => (shade_points(method, inputs, pts), None),
     }
 }
@@ -349,9 +360,11 @@ pub(crate) fn shade_points_weighted<R: shadow_rays::RayOrigin>(
 /// a closed form: the methods' shared accuracy check.
 #[cfg(test)]
 pub(crate) mod plate_case {
-    use super::{ShadowInputs, ShadowMethod};
+    use super::shadow_rays::{RayOrigin, SurfacePoint};
+    use super::{LightPoint, ShadowInputs, ShadowMethod};
     use crate::geom::light::MapGrid;
     use crate::geom::light_shape::LightShape;
+    use glam::Vec3;
 
     /// Largest |V - V_exact| of `method` on an n x n map of a plate covering
     /// tangent [-1/4, 1/4]^2 at depth 2 over a floor at depth 4 (light 1 x 1).
@@ -418,5 +431,137 @@ pub(crate) mod plate_case {
             }
         }
         (sum / (n * n) as f64, max)
+    }
+
+    /// A surface point P (kernel space) with unit normal n, weighted as
+    /// `eye::rays::RayStart` weighs: max(n · (y - P), 0) P_z / r⁴.
+    #[derive(Clone, Copy)]
+    pub struct Surface {
+        pub p: Vec3,
+        pub n: Vec3,
+    }
+
+    impl RayOrigin for Surface {
+        fn bounds(&self) -> (Vec3, Vec3) {
+            (self.p, self.p)
+        }
+        fn origin(&self, _x: f32, _y: f32) -> Vec3 {
+            self.p
+        }
+        fn weight(&self, x: f32, y: f32) -> f32 {
+            let d = Vec3::new(x, y, 0.0) - self.p;
+            let r2 = d.length_squared();
+            self.n.dot(d).max(0.0) * self.p.z / (r2 * r2)
+        }
+        fn surface(&self) -> Option<SurfacePoint> {
+            // n · ((x, y, 0) - p) = -n · p + x n_x + y n_y.
+            Some(SurfacePoint {
+                p: self.p,
+                side: [-self.n.dot(self.p), self.n.x, self.n.y],
+            })
+        }
+    }
+
+    /// The plate of `max_error` over the floor, the floor's points as
+    /// Lambertian receivers of one tilted normal: their weighted visibility
+    /// (the methods' for the shaded image) against the integral.
+    pub struct WeightedPlate {
+        pub grid: MapGrid,
+        pub front: Vec<f32>,
+        pub pts: Vec<LightPoint>,
+        pub surfaces: Vec<Option<Surface>>,
+    }
+
+    impl WeightedPlate {
+        /// On an n x n map, the receivers' normal `normal` (toward the
+        /// light, -Z; tilted, it weighs the light's halves unevenly).
+        pub fn new(n: usize, normal: Vec3) -> WeightedPlate {
+            let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
+            let front = (0..n * n)
+                .map(|k| {
+                    let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
+                    if x.abs() < 0.25 && y.abs() < 0.25 {
+                        2.0
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+                .collect();
+            let pts: Vec<LightPoint> = (0..n * n)
+                .map(|k| LightPoint {
+                    x: grid.x_of(k % n) as f32,
+                    y: grid.y_of(k / n) as f32,
+                    z: 4.0,
+                })
+                .collect();
+            let normal = normal.normalize();
+            let surfaces = pts
+                .iter()
+                .map(|q| {
+                    Some(Surface {
+                        p: Vec3::new(q.x * q.z, q.y * q.z, q.z),
+                        n: normal,
+                    })
+                })
+                .collect();
+            WeightedPlate {
+                grid,
+                front,
+                pts,
+                surfaces,
+            }
+        }
+
+        /// Under the unit-square light.
+        pub fn inputs(&self) -> ShadowInputs<'_> {
+            ShadowInputs {
+                grid: self.grid,
+                occluder_grid: self.grid,
+                light_shape: LightShape::rect([1.0, 1.0]),
+                receiver: &[],
+                occluder_layers: vec![&self.front],
+                occluder_triangles: None,
+            }
+        }
+
+        /// Point k's weighted visibility by a 400² grid of the light: the
+        /// light point y is hidden where the segment to it crosses depth 2
+        /// inside the plate ((P + y)/2 within ±1/2).
+        pub fn integral(&self, k: usize) -> f64 {
+            let s = self.surfaces[k].as_ref().unwrap();
+            let m = 400;
+            let (mut lit, mut all) = (0f64, 0f64);
+            for i in 0..m {
+                for j in 0..m {
+                    let x = (i as f32 + 0.5) / m as f32 - 0.5;
+                    let y = (j as f32 + 0.5) / m as f32 - 0.5;
+                    let w = f64::from(s.weight(x, y));
+                    all += w;
+                    let (hx, hy) = (0.5 * (s.p.x + x), 0.5 * (s.p.y + y));
+                    if !(hx.abs() < 0.5 && hy.abs() < 0.5) {
+                        lit += w;
+                    }
+                }
+            }
+            lit / all
+        }
+
+        /// The largest |weighted - integral| and |plain - integral| over the
+        /// penumbra points of plain `v` and weighted `w` (asserting
+        /// that the others keep V), and how many there are.
+        pub fn errors(&self, v: &[f32], w: &[f32]) -> (f64, f64, usize) {
+            let (mut worst, mut plain_worst, mut penumbra) = (0f64, 0f64, 0);
+            for k in 0..self.pts.len() {
+                if v[k] <= 0.0 || v[k] >= 1.0 {
+                    assert_eq!(w[k], v[k], "at {k}");
+                    continue;
+                }
+                let want = self.integral(k);
+                penumbra += 1;
+                worst = worst.max((f64::from(w[k]) - want).abs());
+                plain_worst = plain_worst.max((f64::from(v[k]) - want).abs());
+            }
+            (worst, plain_worst, penumbra)
+        }
     }
 }

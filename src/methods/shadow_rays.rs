@@ -108,6 +108,32 @@ pub(crate) trait RayOrigin: Sync {
     fn weight(&self, _x: f32, _y: f32) -> f32 {
         1.0
     }
+    /// The Lambertian surface point behind `weight`, where it has one.
+    #[inline(always)]
+    fn surface(&self) -> Option<SurfacePoint> {
+        None
+    }
+}
+
+/// A Lambertian surface point p (kernel space) and its tangent plane,
+/// side(x, y) = side[0] + x side[1] + y side[2] (n · (y - p) up to a
+/// positive factor): the light point (x, y, 0)'s share of its irradiance
+/// under a planar light sampled uniformly over its area is cos θ cos θ' /
+/// r², with cos θ = side / r (0 below the horizon) and cos θ' = p_z / r
+/// (the light faces +Z): side · p_z / r⁴.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SurfacePoint {
+    pub p: Vec3,
+    pub side: [f32; 3],
+}
+
+impl SurfacePoint {
+    #[inline(always)]
+    pub fn weight(&self, x: f32, y: f32) -> f32 {
+        let side = self.side[0] + x * self.side[1] + y * self.side[2];
+        let r2 = (Vec3::new(x, y, 0.0) - self.p).length_squared();
+        side.max(0.0) * self.p.z / (r2 * r2)
+    }
 }
 
 /// A receiver point (the light view).

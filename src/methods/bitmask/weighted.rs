@@ -236,119 +236,28 @@ impl Bitmask {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::light::MapGrid;
-    use crate::geom::light_shape::LightShape;
+    use crate::methods::plate_case::WeightedPlate;
     use crate::methods::ShadowMethod;
     use glam::Vec3;
 
-    /// A surface point P (kernel space) with unit normal n, weighted as
-    /// `eye::rays::RayStart` weighs: max(n · (y - P), 0) P_z / r⁴.
-    struct Surface {
-        p: Vec3,
-        n: Vec3,
-    }
-
-    impl RayOrigin for Surface {
-        fn bounds(&self) -> (Vec3, Vec3) {
-            (self.p, self.p)
-        }
-        fn origin(&self, _x: f32, _y: f32) -> Vec3 {
-            self.p
-        }
-        fn weight(&self, x: f32, y: f32) -> f32 {
-            let d = Vec3::new(x, y, 0.0) - self.p;
-            let r2 = d.length_squared();
-            self.n.dot(d).max(0.0) * self.p.z / (r2 * r2)
-        }
-    }
-
-    /// The plate of `plate_case` (tangent [-1/4, 1/4]² at depth 2) over a
-    /// floor at depth 4, light the unit square: each floor point's weighted
-    /// visibility for a tilted normal against the integral by a fine grid
-    /// of the light (a light point y is hidden where the segment to it
-    /// crosses depth 2 inside the plate: (P + y)/2 within ±1/2). The tilt
-    /// weighs the light's two halves unevenly, so the plain fraction is
-    /// far from it in the penumbra.
+    /// The floor under the plate of `plate_case`, its points' normal
+    /// tilted: each penumbra point's weighted visibility against the
+    /// integral, where the plain fraction is far from it.
     #[test]
     fn weighted_visibility_matches_the_integral() {
-        let n = 32;
-        let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
-        let front: Vec<f32> = (0..n * n)
-            .map(|k| {
-                let (x, y) = (grid.x_of(k % n), grid.y_of(k / n));
-                if x.abs() < 0.25 && y.abs() < 0.25 {
-                    2.0
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
-        let normal = Vec3::new(0.7, 0.2, -1.0).normalize();
-        let pts: Vec<LightPoint> = (0..n * n)
-            .map(|k| LightPoint {
-                x: grid.x_of(k % n) as f32,
-                y: grid.y_of(k / n) as f32,
-                z: 4.0,
-            })
-            .collect();
-        let surfaces: Vec<Option<Surface>> = pts
-            .iter()
-            .map(|q| {
-                Some(Surface {
-                    p: Vec3::new(q.x * q.z, q.y * q.z, q.z),
-                    n: normal,
-                })
-            })
-            .collect();
-        let integral = |s: &Surface| {
-            let m = 400;
-            let (mut lit, mut all) = (0f64, 0f64);
-            for i in 0..m {
-                for j in 0..m {
-                    let x = (i as f32 + 0.5) / m as f32 - 0.5;
-                    let y = (j as f32 + 0.5) / m as f32 - 0.5;
-                    let w = f64::from(s.weight(x, y));
-                    all += w;
-                    let hx = 0.5 * (s.p.x + x);
-                    let hy = 0.5 * (s.p.y + y);
-                    if !(hx.abs() < 0.5 && hy.abs() < 0.5) {
-                        lit += w;
-                    }
-                }
-            }
-            lit / all
-        };
-        for shape in [LightShape::rect([1.0, 1.0])] {
-            let inputs = ShadowInputs {
-                grid,
-                occluder_grid: grid,
-                light_shape: shape,
-                receiver: &[],
-                occluder_layers: vec![&front],
-                occluder_triangles: None,
-            };
-            for gaps in Gaps::ALL {
-                let m = Bitmask::new(1024, gaps, None);
-                let (v, w) = m.weighted_points(&inputs, &pts, &surfaces);
-                assert_eq!(v, m.visibility_points(&inputs, &pts), "{gaps:?}");
-                let (mut worst, mut plain_worst, mut penumbra) = (0f64, 0f64, 0);
-                for k in 0..pts.len() {
-                    let want = integral(surfaces[k].as_ref().unwrap());
-                    if v[k] <= 0.0 || v[k] >= 1.0 {
-                        assert_eq!(f64::from(w[k]), f64::from(v[k]), "at {k}");
-                        continue;
-                    }
-                    penumbra += 1;
-                    worst = worst.max((f64::from(w[k]) - want).abs());
-                    plain_worst = plain_worst.max((f64::from(v[k]) - want).abs());
-                }
-                assert!(penumbra > 50, "{penumbra} penumbra points");
-                assert!(worst < 0.02, "{gaps:?}: weighted off by {worst}");
-                assert!(
-                    plain_worst > 0.05,
-                    "{gaps:?}: plain off by only {plain_worst}"
-                );
-            }
+        let plate = WeightedPlate::new(32, Vec3::new(0.7, 0.2, -1.0));
+        let inputs = plate.inputs();
+        for gaps in Gaps::ALL {
+            let m = Bitmask::new(1024, gaps, None);
+            let (v, w) = m.weighted_points(&inputs, &plate.pts, &plate.surfaces);
+            assert_eq!(v, m.visibility_points(&inputs, &plate.pts), "{gaps:?}");
+            let (worst, plain_worst, penumbra) = plate.errors(&v, &w);
+            assert!(penumbra > 50, "{penumbra} penumbra points");
+            assert!(worst < 0.02, "{gaps:?}: weighted off by {worst}");
+            assert!(
+                plain_worst > 0.05,
+                "{gaps:?}: plain off by only {plain_worst}"
+            );
         }
     }
 }

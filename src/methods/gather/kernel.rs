@@ -14,6 +14,13 @@ pub(in crate::methods) trait Accumulator: Sync {
     /// OR) rather than each into its own (sums: merged by max).
     const LAYERS_SHARE_STATE: bool;
     fn empty(&self) -> Self::State;
+    /// `empty` for group `g` (each layer's state, where they do not share
+    /// one): where the accumulator keeps what it knows of the group's
+    /// points (`Group::first`) in the state, as the SSM's weighted shading.
+    #[inline(always)]
+    fn empty_at(&self, _g: &Group) -> Self::State {
+        self.empty()
+    }
     /// Adds the micro-patch [x0, x1] x (row) at 1/depth w to every lane.
     /// x0, x1 and the row's lanes are in half-light units (see RowLanes).
     fn add_texel(&self, acc: &mut Self::State, w: f32, x0: f32, x1: f32, row: &RowLanes, g: &Group);
@@ -21,9 +28,10 @@ pub(in crate::methods) trait Accumulator: Sync {
     fn full(&self, acc: &Self::State, g: &Group) -> bool;
     /// Occlusion per lane in [0, 1].
     fn occlusion(&self, acc: &Self::State) -> Lanes;
-    /// `occlusion` of a group's final shared state (LAYERS_SHARE_STATE),
-    /// where the accumulator also reads what it knows of the group's points
-    /// (`Group::first`): the bitmask's weighted shading does.
+    /// `occlusion` of a group's final state (the shared one, or each
+    /// layer's in turn, back layer first), where the accumulator also reads
+    /// what it knows of the group's points (`Group::first`): the bitmask's
+    /// and the SSM's weighted shading do.
     #[inline(always)]
     fn occlusion_at(&self, acc: &Self::State, _g: &Group) -> Lanes {
         self.occlusion(acc)

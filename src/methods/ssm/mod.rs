@@ -30,6 +30,7 @@ use super::gather::{
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
+use super::shadow_rays::RayOrigin;
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -310,6 +311,32 @@ impl Accumulator for SumF16 {
     fn end_batch(&self, acc: &mut TwoLevel) {
         if self.batched {
             acc.close();
+        }
+    }
+}
+
+mod weighted;
+
+impl Ssm {
+    /// `visibility_points`, and beside it each point's weighted visibility
+    /// seen from `receivers[k]` (its surface point and tangent plane:
+    /// `weighted.rs`). The plain visibility has the same bits as
+    /// `visibility_points`'.
+    pub(crate) fn weighted_points<R: RayOrigin + Copy + Sync>(
+        &self,
+        inputs: &ShadowInputs,
+        points: &[LightPoint],
+        receivers: &[Option<R>],
+    ) -> (Vec<f32>, Vec<f32>) {
+        let h = self.hierarchy;
+        let (i, p, r) = (inputs, points, receivers);
+        match self.precision {
+            Precision::F32 => weighted::weighted_points(&Sum, i, p, r, h),
+            Precision::F64 => weighted::weighted_points(&Sum64, i, p, r, h),
+            Precision::F16 => weighted::weighted_points(&SumF16 { batched: false }, i, p, r, h),
+            Precision::F16Batched => {
+                weighted::weighted_points(&SumF16 { batched: true }, i, p, r, h)
+            }
         }
     }
 }
