@@ -55,9 +55,9 @@ fn light_view_disk() -> MethodConfig {
 /// target runs `auto` (the eye view's `exact` default; in the light view
 /// `bitmask`, the map method that takes a disk), a method that cannot is
 /// refused naming `method` and why. A target stays in the eye view for a
-/// disk (`plan_eye` plans `exact` for it) and is refused in the light view,
-/// whose planner plans the rectangle's maps, and for a sphere, whose rays
-/// make no error estimate.
+/// disk and a sphere (`plan_eye` plans `exact` for them) and is refused in
+/// the light view, whose planner plans the rectangle's maps (a sphere has
+/// no light view at all).
 fn for_light(
     method: MethodConfig,
     light: &Light,
@@ -73,14 +73,11 @@ fn for_light(
         return match method {
             MethodConfig::Exact(_) => Ok(method),
             MethodConfig::Auto(a) if a.target.is_none() => Ok(auto),
-            // A target is checked against the run's error estimate, which a
-            // sphere's rays do not make (`pipeline::eye_view::render_sphere`).
-            MethodConfig::Auto(_) => Err(Error::invalid(
-                "method",
-                "Auto with a target checks the image's error estimate, which a SphereLight's \
-                 rays do not make in this version; pass method=\"exact\" (Exact(samples=...))",
-            )),
-            MethodConfig::ShadowMapping(_) => Err(sphere_has_no_space()),
+            // A target plans `exact` by its error law and checks the run's
+            // estimate (`pipeline::eye_view::render_sphere`), in the eye
+            // view; a sphere has no light view.
+            MethodConfig::Auto(_) if eye => Ok(method),
+            MethodConfig::Auto(_) | MethodConfig::ShadowMapping(_) => Err(sphere_has_no_space()),
             m => Err(Error::invalid(
                 "method",
                 format!(
@@ -522,10 +519,13 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
                 ..a
             }),
             call.light.name(),
-            MethodConfig::Auto(a)
-                .kernel()
-                .refuses_shape(&call.light.kernel_shape())
-                .is_none(),
+            // A sphere has no plane to project maps onto (its kernel shape
+            // is only its silhouette's size).
+            !matches!(call.light, Light::Sphere(_))
+                && MethodConfig::Auto(a)
+                    .kernel()
+                    .refuses_shape(&call.light.kernel_shape())
+                    .is_none(),
         )),
         _ => None,
     };

@@ -28,10 +28,13 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::framing::Framed;
+use super::gbuffer::GBuffer;
 use super::rays::{self, RayStart};
+use super::sphere_rays::sphere_visibility;
 use crate::error_estimate::{
     add_batch, finish, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
 };
+use crate::geom::sphere_light::SphereLight;
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_rays::RayOrigin;
 
@@ -75,21 +78,13 @@ pub fn estimate(
     samples: u32,
     (how, spent): (Draw, f64),
 ) -> ErrorEstimate {
-    let budget = match how {
-        Draw::Timed => SHARE * spent,
-        Draw::Fixed => f64::INFINITY,
-    };
-    let units = match how {
-        Draw::Timed => MAX_UNITS,
-        Draw::Fixed => PLANNED_UNITS,
-    };
     estimate_with(
         f,
         size,
         Occluders::Triangles(triangles),
         visibility,
         samples,
-        (units, budget),
+        draw_limits(how, spent),
         true,
     )
 }
@@ -104,18 +99,46 @@ pub fn estimate_in(
     samples: u32,
     (how, spent): (Draw, f64),
 ) -> ErrorEstimate {
-    let (units, budget) = match how {
-        Draw::Timed => (MAX_UNITS, SHARE * spent),
-        Draw::Fixed => (PLANNED_UNITS, f64::INFINITY),
-    };
     estimate_with(
         f,
         size,
         Occluders::Tree(bvh),
         visibility,
         samples,
-        (units, budget),
+        draw_limits(how, spent),
         true,
+    )
+}
+
+/// The estimate of a sphere light's `visibility` (per point of `hits`,
+/// flat indices into `g`) against the sphere's own rays
+/// (`sphere_rays::sphere_visibility`, no probe) with `samples` samples over
+/// each point's cap through `bvh` (`sphere_bvh`), drawn as `how` says, the
+/// call having taken `spent` seconds so far. Each pixel's rays are keyed by
+/// its place in the image, as the result's are.
+pub fn estimate_sphere(
+    (bvh, light): (&Bvh, &SphereLight),
+    g: &GBuffer,
+    hits: &[usize],
+    visibility: &[f32],
+    samples: u32,
+    (how, spent): (Draw, f64),
+) -> ErrorEstimate {
+    let t0 = Instant::now();
+    let (most, budget) = draw_limits(how, spent);
+    let trace = |pixels: &[usize], _: &[usize], _: f64| {
+        let at: Vec<usize> = pixels.iter().map(|&j| hits[j]).collect();
+        sphere_visibility(bvh, light, g, &at, samples, None)
+            .into_iter()
+            .map(|[v, _]| v)
+            .collect()
+    };
+    drawn(
+        (hits, (g.width, g.height)),
+        visibility,
+        samples,
+        (most, budget, t0),
+        trace,
     )
 }
 
@@ -130,7 +153,7 @@ enum Occluders<'a> {
 /// whole scene (the tests hold that culling changes no ray).
 fn estimate_with(
     f: &Framed,
-    (width, height): (usize, usize),
+    size: (usize, usize),
     occluders: Occluders,
     visibility: &[f32],
     samples: u32,
@@ -138,17 +161,6 @@ fn estimate_with(
     cull: bool,
 ) -> ErrorEstimate {
     let t0 = Instant::now();
-    // Units: runs of UNIT visible points in 4 x 2 tile order (mostly whole
-    // tiles), in the result's shadow when any of their pixels is.
-    let tiled = rays::tiled(&f.hits, width, height);
-    let units: Vec<&[usize]> = tiled.chunks(UNIT).collect();
-    let (shadow, lit): (Vec<usize>, Vec<usize>) = (0..units.len()).partition(|&u| {
-        units[u]
-            .iter()
-            .any(|&k| 1.0 - visibility[k] > SHADOW_THRESHOLD)
-    });
-    let total = units.len().min(most);
-    let order = strata_order((&shadow, &lit), total, SHADOW_SHARE);
     let (given, triangles) = match occluders {
         Occluders::Tree(bvh) => (Some(bvh), vec![]),
         Occluders::Triangles(t) => (None, t),
@@ -158,17 +170,10 @@ fn estimate_with(
         .map(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])))
         .collect();
     let half = f.light_shape.half_extent().map(|h| h as f32);
-    let mut strata = [Stratum::default(), Stratum::default()];
-    strata[0].population = shadow.len();
-    strata[1].population = lit.len();
-    let (mut traced, mut culled, mut cull_seconds) = (0, 0usize, 0f64);
+    let (mut culled, mut cull_seconds) = (0usize, 0f64);
     let mut whole: Option<Bvh> =
         (!cull && given.is_none()).then(|| Bvh::build_fast(triangles.clone()));
-    for batch in order.chunks(BATCH) {
-        let elapsed = t0.elapsed().as_secs_f64();
-        if traced > 0 && elapsed > budget {
-            break;
-        }
+    let trace = |pixels: &[usize], lens: &[usize], elapsed: f64| {
         // Culling tests every triangle once a tile: past TESTS_PER_BUILD
         // tiles one BVH of the scene costs less, if it fits the budget.
         if given.is_none() && whole.is_none() && culled >= TESTS_PER_BUILD {
@@ -177,10 +182,6 @@ fn estimate_with(
                 whole = Some(Bvh::build_fast(triangles.clone()));
             }
         }
-        let pixels: Vec<usize> = batch
-            .iter()
-            .flat_map(|&(_, u)| units[u].iter().copied())
-            .collect();
         let points: Vec<[f64; 3]> = pixels.iter().map(|&k| f.points[k]).collect();
         let normals: Vec<[f32; 3]> = pixels.iter().map(|&k| f.normals[k]).collect();
         let starts = rays::ray_starts(&f.space, f.unit, &points, &normals);
@@ -189,14 +190,14 @@ fn estimate_with(
         // image's.
         let key = |j: usize| f.hits[pixels[j]] as u64;
         let identity: Vec<usize> = (0..pixels.len()).collect();
-        let exact = match given.or(whole.as_ref()) {
+        match given.or(whole.as_ref()) {
             Some(bvh) => {
                 rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples, None)
             }
             None => {
                 let t = Instant::now();
-                culled += batch.len();
-                let shafts = tile_boxes(&starts, batch.iter().map(|&(_, u)| units[u].len()));
+                culled += lens.len();
+                let shafts = tile_boxes(&starts, lens.iter().copied());
                 let kept: Vec<[Vec3; 3]> = triangles
                     .par_iter()
                     .zip(&boxes)
@@ -211,11 +212,71 @@ fn estimate_with(
                 let bvh = Bvh::build_fast(kept);
                 rays::visibility_in(&bvh, f.light_shape, &starts, key, &identity, samples, None)
             }
-        };
+        }
+    };
+    drawn(
+        (&f.hits, size),
+        visibility,
+        samples,
+        (most, budget, t0),
+        trace,
+    )
+}
+
+/// The draw (module doc), free of what the rays meet: the visible points
+/// `hits` (flat pixel indices of an image of `size`) in units of `UNIT`
+/// in tile order, in two strata by the result's `visibility` (per point of
+/// `hits`), drawn in batches of `BATCH` units while the time since `t0` is
+/// within `budget` (the first batch always), at most `most` units. `trace`
+/// takes a batch's points (indices into `hits`), its units' lengths and
+/// the time spent, and returns the points' reference visibility with
+/// `samples` light samples.
+pub(crate) fn drawn(
+    (hits, (width, height)): (&[usize], (usize, usize)),
+    visibility: &[f32],
+    samples: u32,
+    (most, budget, t0): (usize, f64, Instant),
+    mut trace: impl FnMut(&[usize], &[usize], f64) -> Vec<f32>,
+) -> ErrorEstimate {
+    // Units: runs of UNIT visible points in 4 x 2 tile order (mostly whole
+    // tiles), in the result's shadow when any of their pixels is.
+    let tiled = rays::tiled(hits, width, height);
+    let units: Vec<&[usize]> = tiled.chunks(UNIT).collect();
+    let (shadow, lit): (Vec<usize>, Vec<usize>) = (0..units.len()).partition(|&u| {
+        units[u]
+            .iter()
+            .any(|&k| 1.0 - visibility[k] > SHADOW_THRESHOLD)
+    });
+    let total = units.len().min(most);
+    let order = strata_order((&shadow, &lit), total, SHADOW_SHARE);
+    let mut strata = [Stratum::default(), Stratum::default()];
+    strata[0].population = shadow.len();
+    strata[1].population = lit.len();
+    let mut traced = 0;
+    for batch in order.chunks(BATCH) {
+        let elapsed = t0.elapsed().as_secs_f64();
+        if traced > 0 && elapsed > budget {
+            break;
+        }
+        let pixels: Vec<usize> = batch
+            .iter()
+            .flat_map(|&(_, u)| units[u].iter().copied())
+            .collect();
+        let lens: Vec<usize> = batch.iter().map(|&(_, u)| units[u].len()).collect();
+        let exact = trace(&pixels, &lens, elapsed);
         add_batch(&mut strata, batch, &units, visibility, &exact);
         traced += pixels.len();
     }
     finish(&strata, traced, samples, t0)
+}
+
+/// The draw of a `Draw`: (units at most, the time budget) for a call that
+/// has spent `spent` seconds.
+pub(crate) fn draw_limits(how: Draw, spent: f64) -> (usize, f64) {
+    match how {
+        Draw::Timed => (MAX_UNITS, SHARE * spent),
+        Draw::Fixed => (PLANNED_UNITS, f64::INFINITY),
+    }
 }
 
 /// The box of each tile's ray origins (`starts` in runs of `lens`); an
@@ -365,6 +426,62 @@ mod tests {
         let d = estimate(&f, size, tris, &v, 64, (Draw::Fixed, 1e9));
         assert_eq!(c.traced, PLANNED_UNITS * UNIT);
         assert_eq!((c.error, c.high, c.traced), (d.error, d.high, d.traced));
+    }
+
+    /// A sphere over a floor and a plate, on an image small enough that a
+    /// fixed draw takes every unit: the estimate is then the error itself,
+    /// mean |V - V_ref| over the pixels the finer rays shadow, with an
+    /// interval of zero width (no unit left undrawn).
+    #[test]
+    fn a_spheres_census_estimate_is_its_error() {
+        use crate::eye::sphere_rays::{sphere_bvh, sphere_visibility};
+        let quad = |y: f64, h: f64| vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
+        let faces = vec![[0u32, 2, 1], [0, 3, 2]];
+        let (floor, plate) = (quad(0.0, 3.0), quad(1.0, 0.4));
+        let meshes = [
+            MeshRef {
+                vertices: &floor,
+                faces: &faces,
+            },
+            MeshRef {
+                vertices: &plate,
+                faces: &faces,
+            },
+        ];
+        let light = SphereLight::new([0.3, 2.5, 0.2], 0.6).unwrap();
+        let camera = Camera::look_at(
+            [2.0, 3.0, 3.0],
+            [0.0, 0.3, 0.0],
+            [0.0, 1.0, 0.0],
+            50.0,
+            (32, 24),
+        )
+        .unwrap();
+        let scene = SceneTriangles::new(&meshes).unwrap();
+        let g = CpuEye.first_hits(&camera, &scene).unwrap();
+        let hits = g.hits();
+        let bvh = sphere_bvh(&light, &scene.corners);
+        let plain = |n: u32| -> Vec<f32> {
+            sphere_visibility(&bvh, &light, &g, &hits, n, None)
+                .into_iter()
+                .map(|[v, _]| v)
+                .collect()
+        };
+        let (result, reference) = (plain(4), plain(64));
+        let (mut sum, mut count) = (0f64, 0usize);
+        for (v, r) in result.iter().zip(&reference) {
+            if 1.0 - r > SHADOW_THRESHOLD {
+                sum += (v - r).abs() as f64;
+                count += 1;
+            }
+        }
+        assert!(hits.len() <= PLANNED_UNITS * UNIT && count > 50);
+        let e = estimate_sphere((&bvh, &light), &g, &hits, &result, 64, (Draw::Fixed, 0.0));
+        let truth = sum / count as f64;
+        assert!(truth > 0.01, "{truth}");
+        assert_eq!((e.traced, e.shadowed), (hits.len(), count));
+        assert!((e.error - truth).abs() < 1e-9, "{} {truth}", e.error);
+        assert!((e.high - e.low).abs() < 1e-9);
     }
 
     /// Every box a sampled segment from the origins' box to the light

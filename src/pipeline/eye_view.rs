@@ -157,7 +157,7 @@ pub fn render_with<S: EyeStages>(
         return Ok((image, method));
     }
     if let Light::Sphere(s) = call.light {
-        return render_sphere(stages, call, s);
+        return render_sphere(stages, call, s, start);
     }
     stages.check(call)?;
     if call.method.kernel().traces() {
@@ -251,24 +251,21 @@ pub fn render_with<S: EyeStages>(
 
 /// `exact` under a sphere (`eye::sphere_rays`): the first hits, then
 /// stratified rays over the cap each pixel sees, through one BVH of every
-/// triangle. A sphere has no light space, so no framing: its rays run on
-/// the CPU, and the error estimate (which frames its rays) is not made.
+/// triangle, and where asked the error estimate against the same rays with
+/// four times the samples (`estimate::estimate_sphere`), as `exact`'s under
+/// a planar light. A sphere has no light space, so no framing: its rays run
+/// on the CPU.
 fn render_sphere<S: EyeStages>(
     stages: &mut S,
     call: &EyeCall,
     light: &SphereLight,
+    start: Instant,
 ) -> Result<(EyeImage, MethodConfig)> {
     if S::BACKEND == Backend::Gpu {
         return Err(Error::invalid(
             "backend",
             "a SphereLight's rays are traced on the CPU in this version; use backend=\"cpu\" \
              (\"auto\" takes it)",
-        ));
-    }
-    if call.estimate_error.is_some() {
-        return Err(Error::invalid(
-            "estimate_error",
-            "is not made for a SphereLight in this version",
         ));
     }
     let method = resolve_at_camera(call, S::BACKEND)?;
@@ -284,6 +281,21 @@ fn render_sphere<S: EyeStages>(
     let v = sphere_visibility(&bvh, light, &g, &hits, samples, probe);
     crate::cancel::current().check()?;
     sw.lap("shadow");
+    let estimate = call.estimate_error.map(|how| {
+        let more = samples.saturating_mul(4).min(MAX_SAMPLES);
+        let plain: Vec<f32> = v.iter().map(|[v, _]| *v).collect();
+        let e = estimate::estimate_sphere(
+            (&bvh, light),
+            &g,
+            &hits,
+            &plain,
+            more,
+            (how, elapsed(start)),
+        );
+        sw.lap("estimate");
+        e
+    });
+    crate::cancel::current().check()?;
     let mut visibility = vec![1f32; g.len()];
     let mut weighted = vec![1f32; g.len()];
     for (&k, [v, w]) in hits.iter().zip(v) {
@@ -297,7 +309,7 @@ fn render_sphere<S: EyeStages>(
         maps: None,
         light_space: None,
         timings: stages.timings(sw.timings),
-        estimate: None,
+        estimate,
     };
     Ok((image, method))
 }

@@ -581,8 +581,7 @@ _PROBE_LIGHTS = {
 def _check_light_kinds(lights: tuple[LightSpec, ...], method: MethodSpec, light_maps: bool) -> None:
     """SpecError when the method cannot do with a kind of the spec's lights
     what every item drawing it would ask: shade it (naming ``method.name``:
-    the map methods refuse spheres, most of them disks too; an ``Auto`` with a
-    target refuses spheres), or, with ``light_maps``, make its light-view
+    the map methods refuse spheres, most of them disks too), or, with ``light_maps``, make its light-view
     maps (naming ``outputs.light_maps``: a sphere's shadows are traced).
     The core is asked, with a 4x4 render of a box under one light of that
     kind, as the items call it. Only disks and spheres are asked about
@@ -626,7 +625,7 @@ def _check_light_kinds(lights: tuple[LightSpec, ...], method: MethodSpec, light_
         if why is not None:
             raise SpecError(
                 f"method.name: {method.name!r} cannot shade lights[{i}], of kind = {kind!r} ({why}); "
-                '"exact" and "auto" (without a target for a sphere) shade every kind'
+                '"exact" and "auto" shade every kind'
             )
         if light_maps and rect[1] and not maps:
             raise SpecError(
