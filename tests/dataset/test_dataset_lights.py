@@ -349,10 +349,6 @@ REFUSED = [
         r"method.name: 'shadow_mapping' cannot shade lights\[1\], of kind = 'sphere'",
     ),
     (
-        {"lights": [{"kind": "sphere"}], "method": {"name": "auto", "options": {"error": 0.01}}},
-        r"method.name: 'auto' cannot shade lights\[0\], of kind = 'sphere'",
-    ),
-    (
         {"lights": [{"kind": "rect"}, {"kind": "sphere"}], "outputs": {"light_maps": True}},
         r"outputs.light_maps: method 'auto' makes no light-view maps for lights\[1\], of kind = 'sphere' \(its",
     ),
@@ -390,6 +386,9 @@ def test_methods_that_shade_every_kind_are_accepted():
     for method in ({"name": "auto"}, {"name": "exact"}, {"name": "auto", "options": {"error": 0.01}}):
         spec = parse_spec(_spec(method=method, lights_per_item=[1, 32]))
         assert spec.lights_per_item == (1, 32)
+    # A target under a sphere plans exact and checks its estimate.
+    every = [{"kind": "rect"}, {"kind": "disk"}, {"kind": "sphere"}, {"kind": "sun"}]
+    parse_spec(_spec(lights=every, method={"name": "auto", "options": {"error": 0.01}}))
     # shadow_mapping traces no disk but maps it; a sphere it refuses (above).
     parse_spec(_spec(method={"name": "shadow_mapping"}))
     with pytest.raises(SpecError, match="colors: must be one of"):
