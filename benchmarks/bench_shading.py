@@ -17,12 +17,12 @@ plus the reference's noise; ``V × unshadowed`` is the same visibility with
 the light's parts weighted alike (what the map methods other than the
 bitmask and the SSM shade with); the default method (``"auto"``) adds its
 visibility error; ``bitmask`` (1024 samples) weighs its light samples as
-``exact`` its rays, and ``ssm`` (its defaults; rectangles only) its
+``exact`` its rays, and ``ssm`` (its defaults; rectangles and disks) its
 micro-patches, so their error is their visibility's; ``unshadowed`` shows
 what the shadows are worth.
 Besides each scene's rectangle, the disk of the same area and the sphere of
 the same radius at its centre light it too (rows "disk", "sphere"; a sphere
-takes ``exact`` only, so no bitmask). Times: medians of
+takes ``exact`` only, so no bitmask or ssm). Times: medians of
 ``--repeats`` renders after a warm-up (the whole ``ss.render`` call, and its
 ``shading`` stage), Mitsuba's of one render (scene loading and its JIT
 included). Prints the table and writes it to ``docs/benchmarks/shading.md``.
@@ -88,7 +88,7 @@ def row(report: Report, name: str, kind: str, scene: Any, light: Any, cam: Any, 
     if not isinstance(light, ss.SphereLight):
         b = ss.render(scene, light, cam, method=ss.Bitmask(samples=1024))
         bitmask = f"{relative_error(b.shaded, reference, m):.4f}"
-    if not isinstance(light, (ss.SphereLight, ss.DiskLight)):
+    if not isinstance(light, ss.SphereLight):
         s = ss.render(scene, light, cam, method="ssm")
         ssm = f"{relative_error(s.shaded, reference, m):.4f}"
     report.line(

@@ -603,7 +603,9 @@ pub fn square_samples(n: u32, max: u32) -> u32 {
 /// where their measured error is within it, else `exact` with the samples
 /// its measured error law asks for. A time budget runs the rule (budgets
 /// are planned for light-view maps only). `rule`: the call's `Auto`
-/// without its target (the eye view sizes the rule's maps itself).
+/// without its target (the eye view sizes the rule's maps itself);
+/// `maps_ok` false where the rule's maps were not measured (any light but
+/// a rectangle or the sun): `exact` by its law at every target.
 pub fn plan_eye(target: &Target, rule: MethodConfig, light: &str, maps_ok: bool) -> Plan {
     let (config, why) = match target.error {
         Some(Real(e)) if e >= EYE_RULE_ERROR && maps_ok => (
@@ -630,7 +632,10 @@ pub fn plan_eye(target: &Target, rule: MethodConfig, light: &str, maps_ok: bool)
                      {EYE_RULE_ERROR})"
                 )
             } else {
-                format!("the map methods do not shade a {light}")
+                format!(
+                    "the rule's maps are planned under rectangles and the sun only (their error \
+                     was measured there), not under a {light}"
+                )
             };
             (
                 MethodConfig::Exact(ExactConfig::of(first)),
@@ -643,8 +648,8 @@ pub fn plan_eye(target: &Target, rule: MethodConfig, light: &str, maps_ok: bool)
         None if !maps_ok => (
             MethodConfig::Exact(ExactConfig::of(crate::methods::config::DEFAULT_SAMPLES)),
             format!(
-                "time budgets are planned for light-view maps only, which do not shade a \
-                 {light}: exact with its default samples"
+                "time budgets are planned for light-view maps under rectangles and the sun \
+                 only, not under a {light}: exact with its default samples"
             ),
         ),
         None => (
@@ -921,11 +926,12 @@ mod tests {
             true,
         );
         assert_eq!(budget.config, rule);
-        // A light the maps cannot shade (a disk) plans exact at every target.
+        // A light the rule's maps were not measured under (a disk) plans
+        // exact at every target.
         let disk = |t: Target| plan_eye(&t, rule, "DiskLight", false);
         let loose = disk(Target::new(Some(EYE_RULE_ERROR), None).unwrap());
         assert!(matches!(loose.config, MethodConfig::Exact(_)));
-        assert!(loose.decisions[0].why.contains("do not shade a DiskLight"));
+        assert!(loose.decisions[0].why.contains("not under a DiskLight"));
         let budget = disk(Target::new(None, Some(1.0)).unwrap());
         assert!(matches!(budget.config, MethodConfig::Exact(_)));
     }

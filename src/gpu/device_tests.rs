@@ -320,8 +320,12 @@ fn tilted_depth_maps(og: &crate::geom::light::MapGrid) -> (Vec<f32>, Vec<f32>) {
     (front, back)
 }
 
+/// Under a disk, the bitmask's pattern (its samples on the disk) is one
+/// table on both backends: the same bits. The SSM clips its micro-patches
+/// to the disk (`disk_clip`), the arcsine a polynomial on both: the same
+/// values to f32 rounding.
 #[test]
-fn gpu_bitmask_under_a_disk_is_the_cpus_bit_for_bit() {
+fn gpu_maps_under_a_disk_are_the_cpus() {
     if !device_or_skip() {
         return;
     }
@@ -331,23 +335,41 @@ fn gpu_bitmask_under_a_disk_is_the_cpus_bit_for_bit() {
     let receiver: Vec<f32> = (0..grid.len())
         .map(|k| 2.6 + 0.1 * ((k * 7) % 5) as f32)
         .collect();
-    let light = LightShape::disk(0.4);
-    let maps = pipeline::DepthMaps {
+    let maps = |light_shape| pipeline::DepthMaps {
         grid: &grid,
         occluder_grid: &grid,
-        light_shape: light,
+        light_shape,
         front: &front,
         back: Some(&back),
         receiver: &receiver,
     };
-    // The bitmask's disk pattern (its samples on the disk) is one table
-    // on both backends: the same bits.
+    let disk = maps(LightShape::disk(0.4));
     for method in bitmask_kernels() {
-        let (c, _) = pipeline::from_depth(&maps, method, Backend::Cpu).unwrap();
-        let (g, _) = pipeline::from_depth(&maps, method, Backend::Gpu).unwrap();
+        let (c, _) = pipeline::from_depth(&disk, method, Backend::Cpu).unwrap();
+        let (g, _) = pipeline::from_depth(&disk, method, Backend::Gpu).unwrap();
         assert!(c.iter().filter(|&&v| v > 0.01 && v < 0.99).count() > 50);
         assert_eq!(same_bits(&c, &g), 0, "{method:?}");
     }
+    let (c, _) = pipeline::from_depth(&disk, SSM, Backend::Cpu).unwrap();
+    let (g, _) = pipeline::from_depth(&disk, SSM, Backend::Gpu).unwrap();
+    let (square, _) =
+        pipeline::from_depth(&maps(LightShape::rect([0.8, 0.8])), SSM, Backend::Cpu).unwrap();
+    let penumbra = c.iter().filter(|&&v| v > 0.01 && v < 0.99).count();
+    let worst = c
+        .iter()
+        .zip(&g)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0f32, f32::max);
+    let apart = c
+        .iter()
+        .zip(&square)
+        .filter(|(a, b)| (*a - *b).abs() > 1e-3)
+        .count();
+    eprintln!(
+        "ssm disk: worst |dV| {worst:.2e}, {penumbra} penumbra, {apart} apart from the square"
+    );
+    assert!(penumbra > 50 && apart > 50);
+    assert!(worst < 1e-5, "{worst}");
 }
 
 #[test]
@@ -877,6 +899,49 @@ mod eye {
         let seen = c.gbuffer.mesh_id.iter().filter(|&&m| m >= 0).count();
         assert!(dv.len() * 100 >= 99 * seen, "{} of {seen}", dv.len());
         assert!(mean <= 1e-4 && differ * 1000 <= dv.len(), "{mean} {differ}");
+    }
+
+    /// The SSM under a disk in the eye view (the points mode): its
+    /// visibility and its weighted visibility, the patches clipped to the
+    /// disk and the weights' integral over it on both backends.
+    #[test]
+    fn gpu_ssm_renders_under_a_disk_are_the_cpus() {
+        if !device_or_skip() {
+            return;
+        }
+        let meshes = scene();
+        let cam = camera((80, 60));
+        let disk: Light = AreaLight::disk([0.3, 4.0, 0.2], [0.0, -1.0, 0.0], 0.45)
+            .unwrap()
+            .into();
+        let method = methods()[1].1;
+        let c = render(&meshes, &disk, &cam, method, BackendChoice::Cpu).unwrap();
+        let g = render(&meshes, &disk, &cam, method, BackendChoice::Gpu).unwrap();
+        let same = same_surface(&c.output, &g.output);
+        let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+        let (cw, gw) = (
+            c.output.weighted.as_ref().unwrap(),
+            g.output.weighted.as_ref().unwrap(),
+        );
+        let mean = |a: &[f32], b: &[f32]| {
+            let d: Vec<f64> = (0..a.len())
+                .filter(|&k| same[k])
+                .map(|k| (a[k] as f64 - b[k] as f64).abs())
+                .collect();
+            d.iter().sum::<f64>() / d.len() as f64
+        };
+        let penumbra = (0..cv.len())
+            .filter(|&k| same[k] && cv[k] > 0.02 && cv[k] < 0.98)
+            .count();
+        let weighed = (0..cw.len())
+            .filter(|&k| same[k] && (cw[k] - cv[k]).abs() > 1e-3)
+            .count();
+        let (dv, dw) = (mean(cv, gv), mean(cw, gw));
+        eprintln!(
+            "ssm disk: mean |dV| {dv:.2e}, |dV_w| {dw:.2e}, penumbra {penumbra}, {weighed} weighed"
+        );
+        assert!(penumbra > 20 && weighed > 10);
+        assert!(dv <= 1e-5 && dw <= 1e-4, "{dv} {dw}");
     }
 
     #[test]

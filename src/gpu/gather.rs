@@ -159,7 +159,8 @@ pub struct GatherParams {
     pub rows_per_chunk: u32,
     /// The light samples on the light (bitmask): `samples`, or a disk's.
     pub counted: u32,
-    pub _pad1: u32,
+    /// 1 under a disk light (ssm clips its micro-patches to it).
+    pub disk: u32,
 }
 
 /// `ChunkParams` of gather.wgsl: which layer and chunk of rows a dispatch adds.

@@ -73,7 +73,8 @@ struct GatherParams {
     rows_per_chunk: u32,
     // The light samples on the light (bitmask): samples, or a disk's.
     counted: u32,
-    _pad1: u32,
+    // 1 under a disk light (ssm clips its micro-patches to it).
+    disk: u32,
 }
 
 // Which chunk a dispatch adds. Shared with Rust (`ChunkParams` in gather.rs).

@@ -293,7 +293,7 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             wx,
             rows_per_chunk,
             counted,
-            _pad1
+            disk
         }),
     );
     assert_same(

@@ -94,6 +94,7 @@ pub(super) fn gather_params(
             ),
             _ => 0,
         },
+        disk: u32::from(matches!(light_shape, LightShape::Disk { .. })),
         tx: og.tx as f32,
         ty: og.ty as f32,
         hw: hw as f32,

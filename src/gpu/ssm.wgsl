@@ -22,13 +22,83 @@ fn texel_reach(t: u32, w: f32) -> f32 {
     return w;
 }
 
+// 4/pi, the f32 of ssm's FOUR_OVER_PI.
+const FOUR_OVER_PI: f32 = 1.2732395;
+
+// disk_clip.rs's twins: asin by Abramowitz and Stegun's 4.4.46 (asin_poly:
+// the device's own asin may be far looser), the area of the disk of radius
+// r (at the origin) with X <= a (left_half_area), with X <= a and Y <= b
+// (corner, corner_below), and of the rectangle [x0, x1] x [y0, y1] within
+// it (rect_overlap_f32).
+fn asin_poly(x: f32) -> f32 {
+    let t = min(abs(x), 1.0);
+    var p = -0.0012624911;
+    p = p * t + 0.00667009;
+    p = p * t - 0.017088126;
+    p = p * t + 0.03089188;
+    p = p * t - 0.050174303;
+    p = p * t + 0.08897899;
+    p = p * t - 0.2145988;
+    p = p * t + 0.5 * PI_F32;
+    let y = 0.5 * PI_F32 - sqrt(1.0 - t) * p;
+    return select(y, -y, x < 0.0);
+}
+
+fn left_half_area(r: f32, a0: f32) -> f32 {
+    let a = clamp(a0, -r, r);
+    let s = clamp(a / r, -1.0, 1.0);
+    return 0.5 * (a * sqrt(max(r * r - a * a, 0.0)) + r * r * asin_poly(s)) + 0.25 * PI_F32 * r * r;
+}
+
+fn corner_below(r: f32, a0: f32, b0: f32) -> f32 {
+    let b = max(b0, -r);
+    let xb = sqrt(max(r * r - b * b, 0.0));
+    let a = clamp(a0, -xb, xb);
+    return max(left_half_area(r, a) - left_half_area(r, -xb) + b * (a + xb), 0.0);
+}
+
+fn corner(r: f32, a0: f32, b: f32) -> f32 {
+    let a = clamp(a0, -r, r);
+    if b >= 0.0 {
+        return 2.0 * left_half_area(r, a) - corner_below(r, a, -b);
+    }
+    return corner_below(r, a, b);
+}
+
+fn disk_overlap(r: f32, x0: f32, x1: f32, y0: f32, y1: f32) -> f32 {
+    if !(r > 0.0) || !(x1 > x0) || !(y1 > y0) {
+        return 0.0;
+    }
+    let fx = max(abs(x0), abs(x1));
+    let fy = max(abs(y0), abs(y1));
+    if fx * fx + fy * fy <= r * r {
+        return (x1 - x0) * (y1 - y0);
+    }
+    let nx = clamp(0.0, x0, x1);
+    let ny = clamp(0.0, y0, y1);
+    if nx * nx + ny * ny >= r * r {
+        return 0.0;
+    }
+    let area = corner(r, x1, y1) - corner(r, x0, y1) - corner(r, x1, y0) + corner(r, x0, y0);
+    return clamp(area, 0.0, min((x1 - x0) * (y1 - y0), PI_F32 * r * r));
+}
+
+const PI_F32: f32 = 3.1415927;
+
 // Sum::add_texel's arithmetic for micro-patch [x0, x1] x (row r) at 1/depth w
-// (texel t of `maps`, which the sum does not need).
+// (texel t of `maps`, which the sum does not need); under a disk
+// (gp.disk), contribution::<true>'s: the patch clipped to the disk of
+// radius d.
 fn add_texel(t: u32, w: f32, x0: f32, x1: f32, xr_s: f32, r: RowReach, rc: Receiver) {
     let d = w - rc.wr;
-    let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
-    let cy = min(r.ay1, d) + min(r.nay0, d);
-    let c = max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
+    var c: f32;
+    if gp.disk != 0u {
+        c = FOUR_OVER_PI * disk_overlap(d, x0 - xr_s, x1 - xr_s, -r.nay0, r.ay1) / fma(d, d, D2_MIN);
+    } else {
+        let cx = min(x1 - xr_s, d) + min(xr_s - x0, d);
+        let cy = min(r.ay1, d) + min(r.nay0, d);
+        c = max(cx, 0.0) * max(cy, 0.0) / fma(d, d, D2_MIN);
+    }
     sum += c;
     if weighing && c > 0.0 {
         // weighted.rs's centre, in half-light units, then kernel units.
@@ -169,15 +239,22 @@ fn ssm_points_weigh(@builtin(global_invocation_id) gid: vec3<u32>,
             hidden = bitcast<f32>(acc[(gp.n_layers + layer) * pp.n_points + idx]);
         }
     }
+    // weighted.rs's light_weight: 4 times the mean weight at the midpoints
+    // on the light (under a disk, those inside it).
     let step = 2.0 / f32(QUAD);
     var all = 0.0;
+    var count = 0u;
     for (var j = 0u; j < QUAD; j++) {
-        let y = (-1.0 + (f32(j) + 0.5) * step) * gp.half_ly;
+        let v = -1.0 + (f32(j) + 0.5) * step;
+        let y = v * gp.half_ly;
         for (var i = 0u; i < QUAD; i++) {
-            let x = (-1.0 + (f32(i) + 0.5) * step) * gp.half_lx;
-            all += irradiance_weight(wp, x, y);
+            let u = -1.0 + (f32(i) + 0.5) * step;
+            if gp.disk == 0u || u * u + v * v <= 1.0 {
+                all += irradiance_weight(wp, u * gp.half_lx, y);
+                count += 1u;
+            }
         }
     }
-    all *= step * step;
+    all *= 4.0 / f32(count);
     vis[out] = select(0.0, 1.0 - clamp(hidden / all, 0.0, 1.0), all > 0.0);
 }

@@ -153,23 +153,22 @@ impl Method {
 
     /// Why the method cannot shade a light of `shape`, or None where it
     /// can. `exact` samples any shape, `bitmask` keeps the samples of its
-    /// pattern that lie on a disk (bitmask.rs), and ShadowMapping's hard
-    /// shadow reads the light's centre only. The others take the light as
-    /// the rectangle of its half-extents: `ssm` clips each micro-patch's
-    /// back-projection to it (`HalfLight`), PCSS's search box and the
-    /// smoothies' width are its sides; a disk would be shaded as the square
-    /// around it.
+    /// pattern that lie on a disk (bitmask.rs), `ssm` clips each
+    /// micro-patch's back-projection to the disk (`disk_clip`), and
+    /// ShadowMapping's hard shadow reads the light's centre only. PCSS and
+    /// the smoothies take the light as the rectangle of its half-extents
+    /// (PCSS's search box and the smoothies' width are its sides); a disk
+    /// would be shaded as the square around it.
     pub fn refuses_shape(&self, shape: &LightShape) -> Option<&'static str> {
         let rect = matches!(shape, LightShape::Rect { .. });
         match self {
-            Method::Exact { .. } | Method::ShadowMapping(_) | Method::Bitmask { .. } => None,
+            Method::Exact { .. }
+            | Method::ShadowMapping(_)
+            | Method::Bitmask { .. }
+            | Method::Ssm { .. } => None,
             _ if rect => None,
-            Method::Ssm { .. } => Some(
-                "clips each occluder texel's back-projection to a rectangular light; a disk runs \
-                 with \"bitmask\" or \"exact\"",
-            ),
             Method::Pcss { .. } | Method::Smoothies { .. } => Some(
-                "sizes its penumbrae from a rectangular light's sides; a disk runs with \
+                "sizes its penumbrae from a rectangular light's sides; a disk runs with \"ssm\", \
                  \"bitmask\" or \"exact\"",
             ),
         }
@@ -470,9 +469,17 @@ pub(crate) mod plate_case {
         pub front: Vec<f32>,
         pub pts: Vec<LightPoint>,
         pub surfaces: Vec<Option<Surface>>,
+        /// The unit square (`new`) or the disk of radius 1/2 (`under`).
+        pub shape: LightShape,
     }
 
     impl WeightedPlate {
+        /// The same plate under `shape`: the unit square or the disk of
+        /// radius 1/2 inscribed in it.
+        pub fn under(self, shape: LightShape) -> WeightedPlate {
+            WeightedPlate { shape, ..self }
+        }
+
         /// On an n x n map, the receivers' normal `normal` (toward the
         /// light, -Z; tilted, it weighs the light's halves unevenly).
         pub fn new(n: usize, normal: Vec3) -> WeightedPlate {
@@ -509,23 +516,24 @@ pub(crate) mod plate_case {
                 front,
                 pts,
                 surfaces,
+                shape: LightShape::rect([1.0, 1.0]),
             }
         }
 
-        /// Under the unit-square light.
+        /// Under the plate's light.
         pub fn inputs(&self) -> ShadowInputs<'_> {
             ShadowInputs {
                 grid: self.grid,
                 occluder_grid: self.grid,
-                light_shape: LightShape::rect([1.0, 1.0]),
+                light_shape: self.shape,
                 receiver: &[],
                 occluder_layers: vec![&self.front],
                 occluder_triangles: None,
             }
         }
 
-        /// Point k's weighted visibility by a 400² grid of the light: the
-        /// light point y is hidden where the segment to it crosses depth 2
+        /// Point k's weighted visibility by a 400² grid of the light (its
+        /// points on the disk, under one): the light point y is hidden where the segment to it crosses depth 2
         /// inside the plate ((P + y)/2 within ±1/2).
         pub fn integral(&self, k: usize) -> f64 {
             let s = self.surfaces[k].as_ref().unwrap();
@@ -535,6 +543,10 @@ pub(crate) mod plate_case {
                 for j in 0..m {
                     let x = (i as f32 + 0.5) / m as f32 - 0.5;
                     let y = (j as f32 + 0.5) / m as f32 - 0.5;
+                    let off = matches!(self.shape, LightShape::Disk { .. }) && x * x + y * y > 0.25;
+                    if off {
+                        continue;
+                    }
                     let w = f64::from(s.weight(x, y));
                     all += w;
                     let (hx, hy) = (0.5 * (s.p.x + x), 0.5 * (s.p.y + y));

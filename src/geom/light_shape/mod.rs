@@ -57,6 +57,7 @@
 //! f64, rounded once to f32), so moving it here changed no bit.
 
 pub(crate) mod disk;
+pub(crate) mod disk_clip;
 mod placement;
 mod rect;
 pub(crate) mod sphere;
