@@ -522,10 +522,9 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
             }),
             call.light.name(),
             // The rule's maps' error was measured under rectangles (and
-            // the sun) only; a sphere has no plane to project maps onto
-            // (its kernel shape is only its silhouette's size).
+            // the sun) only: not under a disk, nor a sphere (whose kernel
+            // shape is its silhouette's disk; it has no plane for maps).
             matches!(call.light.kernel_shape(), LightShape::Rect { .. })
-                && !matches!(call.light, Light::Sphere(_))
                 && MethodConfig::Auto(a)
                     .kernel()
                     .refuses_shape(&call.light.kernel_shape())

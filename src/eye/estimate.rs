@@ -336,28 +336,30 @@ mod tests {
     use crate::geom::mesh::MeshRef;
     use crate::methods::{ExactConfig, MethodConfig};
 
+    /// Horizontal squares (height y, half-width h) facing up: each one's
+    /// corners, and the two faces they share.
+    fn squares(levels: &[(f64, f64)]) -> (Vec<Vec<[f64; 3]>>, Vec<[u32; 3]>) {
+        let quad = |&(y, h): &(f64, f64)| vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
+        (
+            levels.iter().map(quad).collect(),
+            vec![[0, 2, 1], [0, 3, 2]],
+        )
+    }
+
+    fn meshes<'a>(squares: &'a [Vec<[f64; 3]>], faces: &'a [[u32; 3]]) -> Vec<MeshRef<'a>> {
+        squares
+            .iter()
+            .map(|vertices| MeshRef { vertices, faces })
+            .collect()
+    }
+
     /// A floor, a block on it and a plate over it, seen from above at an
     /// angle under a 1 x 1 light: the estimate with each batch's rays
     /// through a culled BVH gives the very numbers of one whole-scene BVH.
     #[test]
     fn culling_the_triangles_changes_no_ray() {
-        let quad = |y: f64, h: f64| vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
-        let faces = vec![[0u32, 2, 1], [0, 3, 2]];
-        let (floor, plate, high) = (quad(0.0, 3.0), quad(1.0, 0.4), quad(2.0, 0.2));
-        let meshes = [
-            MeshRef {
-                vertices: &floor,
-                faces: &faces,
-            },
-            MeshRef {
-                vertices: &plate,
-                faces: &faces,
-            },
-            MeshRef {
-                vertices: &high,
-                faces: &faces,
-            },
-        ];
+        let (squares, faces) = squares(&[(0.0, 3.0), (1.0, 0.4), (2.0, 0.2)]);
+        let meshes = meshes(&squares, &faces);
         let light = Light::Area(
             AreaLight::rect(
                 [0.5, 4.0, 0.3],
@@ -435,19 +437,8 @@ mod tests {
     #[test]
     fn a_spheres_census_estimate_is_its_error() {
         use crate::eye::sphere_rays::{sphere_bvh, sphere_visibility};
-        let quad = |y: f64, h: f64| vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
-        let faces = vec![[0u32, 2, 1], [0, 3, 2]];
-        let (floor, plate) = (quad(0.0, 3.0), quad(1.0, 0.4));
-        let meshes = [
-            MeshRef {
-                vertices: &floor,
-                faces: &faces,
-            },
-            MeshRef {
-                vertices: &plate,
-                faces: &faces,
-            },
-        ];
+        let (squares, faces) = squares(&[(0.0, 3.0), (1.0, 0.4)]);
+        let meshes = meshes(&squares, &faces);
         let light = SphereLight::new([0.3, 2.5, 0.2], 0.6).unwrap();
         let camera = Camera::look_at(
             [2.0, 3.0, 3.0],

@@ -910,18 +910,32 @@ mod tests {
         // At 48² each micro-patch of the plate hides (1/24)² of the light,
         // above FP16's 2^-10 limit (Appendix A), so every precision holds;
         // f16 rounds each of about 300 contributions, each by 2^-11 at most.
-        for (precision, bound) in [
-            (Precision::F32, 1e-5),
-            (Precision::F64, 1e-5),
-            (Precision::F16, 2e-2),
-            (Precision::F16Batched, 2e-2),
+        // Under the disk inscribed in the light the plate's back-projection
+        // is a rectangle clipped to the disk, which the micro-patches'
+        // clipped areas tile exactly again (the patches across the rim carry
+        // a few ulp of the disk's area each); the square's answer there
+        // errs by the corners' area.
+        use crate::geom::light_shape::LightShape;
+        for (shape, exact) in [
+            (LightShape::rect([1.0, 1.0]), 1e-5),
+            (LightShape::disk(0.5), 2e-5),
         ] {
-            let ssm = Ssm {
-                precision,
-                ..Default::default()
-            };
-            let max = crate::methods::plate_case::max_error(&ssm, 48);
-            assert!(max < bound, "{precision:?}: max error {max}");
+            for (precision, bound) in [
+                (Precision::F32, exact),
+                (Precision::F64, exact),
+                (Precision::F16, 2e-2),
+                (Precision::F16Batched, 2e-2),
+            ] {
+                let ssm = Ssm {
+                    precision,
+                    ..Default::default()
+                };
+                let (mean, max) = crate::methods::plate_case::mean_and_max_error(&ssm, 48, shape);
+                assert!(
+                    max < bound,
+                    "{shape:?} {precision:?}: max {max}, mean {mean}"
+                );
+            }
         }
     }
 
@@ -931,37 +945,6 @@ mod tests {
         // exactly, so only f32 rounding remains.
         let max = crate::methods::plate_case::max_error(&Ssm::default(), 64);
         assert!(max < 1e-5, "max error {max}");
-    }
-
-    /// Under a disk the plate's back-projection is a rectangle clipped to
-    /// it, which the micro-patches' clipped areas tile exactly again: only
-    /// f32 rounding remains (the patches across the rim carry a few ulp of
-    /// the disk's area each), at every precision where fp16 suffices.
-    #[test]
-    fn plate_under_a_disk_matches_the_closed_form() {
-        use crate::geom::light_shape::LightShape;
-        for (precision, bound) in [
-            (Precision::F32, 2e-5),
-            (Precision::F64, 2e-5),
-            (Precision::F16, 2e-2),
-            (Precision::F16Batched, 2e-2),
-        ] {
-            let ssm = Ssm {
-                precision,
-                ..Default::default()
-            };
-            let (mean, max) =
-                crate::methods::plate_case::mean_and_max_error(&ssm, 48, LightShape::disk(0.5));
-            assert!(max < bound, "{precision:?}: max error {max}, mean {mean}");
-        }
-        // The square's answer is far off there: the clipping matters.
-        let square = crate::methods::plate_case::max_error(&Ssm::default(), 48);
-        let disk = crate::methods::plate_case::mean_and_max_error(
-            &Ssm::default(),
-            48,
-            LightShape::disk(0.5),
-        );
-        assert!(square < 1e-5 && disk.1 < 2e-5);
     }
 
     /// A plate over a floor under a light as wide as the map: every tile

@@ -45,22 +45,19 @@ pub fn light_weight(s: &SurfacePoint, half: [f32; 2], disk: bool) -> f64 {
     let step = 2.0 / QUAD as f32;
     let us: [f32; QUAD] = std::array::from_fn(|i| -1.0 + (i as f32 + 0.5) * step);
     let xs: [f32; QUAD] = us.map(|u| u * half[0]);
+    let on = |u: f32, v: f32| !disk || u * u + v * v <= 1.0;
     let (mut sum, mut count) = (0f64, 0usize);
     for &v in &us {
         let y = v * half[1];
         let row: [f32; QUAD] = std::array::from_fn(|i| {
-            if !disk || us[i] * us[i] + v * v <= 1.0 {
+            if on(us[i], v) {
                 s.weight(xs[i], y)
             } else {
                 0.0
             }
         });
         sum += f64::from(row.iter().sum::<f32>());
-        count += if disk {
-            us.iter().filter(|&&u| u * u + v * v <= 1.0).count()
-        } else {
-            QUAD
-        };
+        count += us.iter().filter(|&&u| on(u, v)).count();
     }
     4.0 * sum / count as f64
 }
