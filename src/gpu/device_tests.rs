@@ -1810,14 +1810,18 @@ mod pcss {
         assert!(chunking(MAX_TAPS).1 > 1);
         let mut seed = 3u64;
         let (front, receiver) = depth_maps(&grid, &og, &mut seed);
+        // Under a disk (pcf_disk.rs: the ellipse inscribed in each box, its
+        // cells weighted by their overlap with it) too.
         for (taps, light) in [
-            (MAX_TAPS, [1.5, 1.2]),
-            (12, [1.5, 1.2]),
-            (32, [0.2, 1e-3]),
-            (32, [1e4, 1e4]),
-            (7, [1e30, 0.5]),
+            (MAX_TAPS, LightShape::rect([1.5, 1.2])),
+            (12, LightShape::rect([1.5, 1.2])),
+            (32, LightShape::rect([0.2, 1e-3])),
+            (32, LightShape::rect([1e4, 1e4])),
+            (7, LightShape::rect([1e30, 0.5])),
+            (MAX_TAPS, LightShape::disk(0.7)),
+            (12, LightShape::disk(0.7)),
+            (32, LightShape::disk(0.05)),
         ] {
-            let light = LightShape::rect(light);
             let method = Method::Pcss { max_taps: taps };
             let maps = pipeline::DepthMaps {
                 grid: &grid,
@@ -1906,12 +1910,13 @@ mod pcss {
             pts.push(LightPoint { x, y, z });
         }
         for (taps, light) in [
-            (32, [1.0, 0.7]),
-            (3, [1.0, 0.7]),
-            (MAX_TAPS, [2.0, 2.0]),
-            (32, [1.0, 0.0]),
+            (32, LightShape::rect([1.0, 0.7])),
+            (3, LightShape::rect([1.0, 0.7])),
+            (MAX_TAPS, LightShape::rect([2.0, 2.0])),
+            (32, LightShape::rect([1.0, 0.0])),
+            (32, LightShape::disk(0.5)),
+            (3, LightShape::disk(0.5)),
         ] {
-            let light = LightShape::rect(light);
             let inputs = ShadowInputs {
                 grid: og,
                 occluder_grid: og,

@@ -25,7 +25,11 @@ use rayon::prelude::*;
 use std::sync::OnceLock;
 
 pub const GATHER_SOURCE: &str = include_str!("gather.wgsl");
-pub const SSM_SOURCE: &str = include_str!("ssm.wgsl");
+pub const SSM_SOURCE: &str = concat!(
+    include_str!("disk_overlap.wgsl"),
+    "\n",
+    include_str!("ssm.wgsl")
+);
 pub const BITMASK_SOURCE: &str = include_str!("bitmask.wgsl");
 pub const BITMASK_OPEN_SOURCE: &str = include_str!("bitmask_open.wgsl");
 pub const BITMASK_CLOSED_SOURCE: &str = include_str!("bitmask_closed.wgsl");

@@ -33,7 +33,12 @@ use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-pub const SOURCE: &str = include_str!("pcss.wgsl");
+/// pcss.wgsl after the disk overlap it weighs cells by under a disk.
+pub const SOURCE: &str = concat!(
+    include_str!("disk_overlap.wgsl"),
+    "\n",
+    include_str!("pcss.wgsl")
+);
 
 /// Invocations per workgroup (pcss.wgsl's @workgroup_size).
 const GROUP: u32 = 64;
@@ -59,6 +64,11 @@ pub struct PcssParams {
     pub rows_per_chunk: u32,
     pub half_per_w_x: f32,
     pub half_per_w_y: f32,
+    /// 1 under a disk light: the boxes' inscribed ellipses (`pcf_disk.rs`).
+    pub disk: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `PcssChunk` of pcss.wgsl.
@@ -207,6 +217,7 @@ impl PcssShading {
         params.rows_per_chunk = rows_per_chunk;
         params.half_per_w_x = hx as f32;
         params.half_per_w_y = hy as f32;
+        params.disk = u32::from(matches!(light_shape, LightShape::Disk { .. }));
         let vis_bytes = params.n as u64 * 4;
         PcssShading {
             params,

@@ -42,6 +42,13 @@
 // iterations per invocation; the y entries beyond one chunk take more
 // dispatches, each adding into the point's accumulators in `acc`.
 //
+// Under a disk light (pp.disk, pcf_disk.rs) both boxes are the ellipses
+// inscribed in them: the same cells, each weighted by its overlap with the
+// ellipse over the ellipse's area (disk_overlap.wgsl, in the coordinates
+// where the ellipse is the unit disk) times the share each of its texels
+// reads (1 for a texel's part, 1 - t and t for a tap); the ellipse's part
+// outside the map (1 - its overlap with the map) is lit.
+//
 // Two modes, one kernel: map mode (mode 0), one invocation per output texel,
 // its coordinates from per-column and per-row tables and its depth from the
 // receiver map; points mode (mode 1, the eye view), one invocation per
@@ -67,6 +74,11 @@ struct PcssParams {
     // (L/2) per axis divided by the texel's tangent width.
     half_per_w_x: f32,
     half_per_w_y: f32,
+    // 1 under a disk light: the boxes' inscribed ellipses.
+    disk: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Which chunk of y entries a dispatch reads. Shared with Rust (`PcssChunk`).
@@ -183,6 +195,9 @@ fn point(idx: u32, z_near: f32) -> Pt {
 struct Axis {
     base: i32,
     n: i32,
+    // The centre (relative to base) and the half-width after the raise.
+    frac: f32,
+    h: f32,
     a: f32,
     b: f32,
     inv_full: f32,
@@ -204,6 +219,8 @@ fn make_axis(base: i32, frac: f32, h_in: f32, n_texels: u32) -> Axis {
     var ax: Axis;
     ax.base = base;
     ax.n = i32(n_texels);
+    ax.frac = frac;
+    ax.h = h;
     ax.inv_full = 0.5 / h;
     let lo = frac - h;
     let hi = frac + h;
@@ -234,27 +251,36 @@ fn make_axis(base: i32, frac: f32, h_in: f32, n_texels: u32) -> Axis {
 }
 
 // Entry k of an axis: texel i with weight w0 and texel i + 1 with w1 (0
-// where the texel is outside the map, or in exact mode), as Axis::for_each.
+// where the texel is outside the map, or in exact mode), as Axis::for_each;
+// its cell [c0, c1] (relative to base). Under a disk the weights are the
+// shares the cell's texels read (Axis::cells), the cell's own weight its
+// overlap with the ellipse (`cell_weight`).
 struct Entry {
     i: i32,
     w0: f32,
     w1: f32,
+    c0: f32,
+    c1: f32,
 }
 
 fn entry(ax: Axis, k: u32) -> Entry {
+    let disk = pp.disk != 0u;
     if !ax.stratified {
         let i = ax.i0 + i32(k);
         let x0 = max(f32(i - ax.base), ax.a);
         let x1 = min(f32(i + 1 - ax.base), ax.b);
-        return Entry(i, max((x1 - x0) * ax.inv_full, 0.0), 0.0);
+        let w = select(max((x1 - x0) * ax.inv_full, 0.0), select(0.0, 1.0, x1 > x0), disk);
+        return Entry(i, w, 0.0, x0, x1);
     }
     // The tap's one-texel box [q, q + 1] overlaps texels floor(q) and the
     // next by 1 - t and t.
+    let c0 = ax.a + f32(k) * ax.step;
     let q = ax.a + (f32(k) + 0.5) * ax.step - 0.5;
     let fi = floor(q);
     let t = q - fi;
     let i = ax.base + i32(fi);
-    var e = Entry(i, ax.wt * (1.0 - t), ax.wt * t);
+    let wt = select(ax.wt, 1.0, disk);
+    var e = Entry(i, wt * (1.0 - t), wt * t, c0, c0 + ax.step);
     if i < 0 || i >= ax.n {
         e.w0 = 0.0;
     }
@@ -324,6 +350,21 @@ fn add(i: i32, j: i32, w: f32, p: Pt, z_near: f32, search: bool) {
     }
 }
 
+// The cell (ex, ey)'s weight: 1 for the box (its entries' weights are the
+// cell's), under a disk its overlap with the ellipse over the ellipse's
+// area, the ellipse the unit disk in ((x - frac) / h, (y - frac) / h)
+// (pcf_disk.rs's visit).
+fn cell_weight(ax: Axis, ay: Axis, ex: Entry, ey: Entry) -> f32 {
+    if pp.disk == 0u {
+        return 1.0;
+    }
+    let u0 = (ex.c0 - ax.frac) / ax.h;
+    let u1 = (ex.c1 - ax.frac) / ax.h;
+    let v0 = (ey.c0 - ay.frac) / ay.h;
+    let v1 = (ey.c1 - ay.frac) / ay.h;
+    return disk_overlap(1.0, u0, u1, v0, v1) / PI_F32;
+}
+
 fn visit(ax: Axis, ay: Axis, p: Pt, z_near: f32, search: bool) {
     let k0 = chunk.chunk * pp.rows_per_chunk;
     let k1 = min(k0 + pp.rows_per_chunk, ay.count);
@@ -332,20 +373,24 @@ fn visit(ax: Axis, ay: Axis, p: Pt, z_near: f32, search: bool) {
         row = vec2<f32>(0.0);
         for (var kx = 0u; kx < ax.count; kx++) {
             let ex = entry(ax, kx);
+            let c = cell_weight(ax, ay, ex, ey);
+            if !(c > 0.0) {
+                continue;
+            }
             if ey.w0 > 0.0 {
                 if ex.w0 > 0.0 {
-                    add(ex.i, ey.i, ey.w0 * ex.w0, p, z_near, search);
+                    add(ex.i, ey.i, c * ey.w0 * ex.w0, p, z_near, search);
                 }
                 if ex.w1 > 0.0 {
-                    add(ex.i + 1, ey.i, ey.w0 * ex.w1, p, z_near, search);
+                    add(ex.i + 1, ey.i, c * ey.w0 * ex.w1, p, z_near, search);
                 }
             }
             if ey.w1 > 0.0 {
                 if ex.w0 > 0.0 {
-                    add(ex.i, ey.i + 1, ey.w1 * ex.w0, p, z_near, search);
+                    add(ex.i, ey.i + 1, c * ey.w1 * ex.w0, p, z_near, search);
                 }
                 if ex.w1 > 0.0 {
-                    add(ex.i + 1, ey.i + 1, ey.w1 * ex.w1, p, z_near, search);
+                    add(ex.i + 1, ey.i + 1, c * ey.w1 * ex.w1, p, z_near, search);
                 }
             }
         }
@@ -404,6 +449,28 @@ fn pcss_filter(@builtin(global_invocation_id) gid: vec3<u32>,
     acc[idx] = s;
 }
 
+// The filter's part outside the map: the box's, from its ends per axis;
+// under a disk the ellipse's, 1 - its overlap with the map (0 when its box
+// is inside, 1 when the box is off the map; pcf_disk.rs's outside).
+fn outside(ax: Axis, ay: Axis) -> f32 {
+    let ox = ax.outside;
+    let oy = ay.outside;
+    if pp.disk == 0u {
+        return clamp(ox + oy - ox * oy, 0.0, 1.0);
+    }
+    if ox == 0.0 && oy == 0.0 {
+        return 0.0;
+    }
+    if ox >= 1.0 || oy >= 1.0 {
+        return 1.0;
+    }
+    let u0 = (f32(-ax.base) - ax.frac) / ax.h;
+    let u1 = (f32(ax.n - ax.base) - ax.frac) / ax.h;
+    let v0 = (f32(-ay.base) - ay.frac) / ay.h;
+    let v1 = (f32(ay.n - ay.base) - ay.frac) / ay.h;
+    return clamp(1.0 - disk_overlap(1.0, u0, u1, v0, v1) / PI_F32, 0.0, 1.0);
+}
+
 // The visibility: 1 without blockers; else the filter's weighted mean with
 // the box's part outside the map lit (pcf.rs's box_filter, Constant(1)).
 @compute @workgroup_size(64)
@@ -421,9 +488,7 @@ fn pcss_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
         return;
     }
     let axes = filter_axes(p, z_near, s);
-    let ox = axes[0].outside;
-    let oy = axes[1].outside;
-    let out = clamp(ox + oy - ox * oy, 0.0, 1.0);
+    let out = outside(axes[0], axes[1]);
     let num = s.z + out;
     let den = s.w + out;
     if !(den > 0.0) {

@@ -25,7 +25,10 @@ fn modules() -> Vec<(String, String)> {
         ("exact.wgsl + eye_rays.wgsl".into(), RAYS_SOURCE.to_string()),
         ("smoothies.wgsl".into(), SMOOTHIES_SOURCE.to_string()),
         ("shadow_mapping.wgsl".into(), SM_SOURCE.to_string()),
-        ("pcss.wgsl".into(), PCSS_SOURCE.to_string()),
+        (
+            "disk_overlap.wgsl + pcss.wgsl".into(),
+            PCSS_SOURCE.to_string(),
+        ),
     ];
     // The occluder-map methods' modules: ssm and the four bitmask ones.
     m.extend(
@@ -549,7 +552,11 @@ fn pcss_structs_have_the_same_layout_in_rust_and_wgsl() {
             taps,
             rows_per_chunk,
             half_per_w_x,
-            half_per_w_y
+            half_per_w_y,
+            disk,
+            _pad0,
+            _pad1,
+            _pad2
         }),
     );
     assert_same(

@@ -28,6 +28,7 @@ pub mod inputs;
 pub mod keywords;
 pub(crate) mod packet;
 pub mod pcf;
+mod pcf_disk;
 pub mod pcss;
 pub mod point_light;
 pub(crate) mod probe;
@@ -155,21 +156,22 @@ impl Method {
     /// can. `exact` samples any shape, `bitmask` keeps the samples of its
     /// pattern that lie on a disk (bitmask.rs), `ssm` clips each
     /// micro-patch's back-projection to the disk (`disk_clip`), and
-    /// ShadowMapping's hard shadow reads the light's centre only. PCSS and
-    /// the smoothies take the light as the rectangle of its half-extents
-    /// (PCSS's search box and the smoothies' width are its sides); a disk
-    /// would be shaded as the square around it.
+    /// ShadowMapping's hard shadow reads the light's centre only, and PCSS
+    /// filters over the ellipse inscribed in its box (`pcf_disk`). The
+    /// smoothies take the light as the rectangle of its half-extents (their
+    /// width is its sides); a disk would be shaded as the square around it.
     pub fn refuses_shape(&self, shape: &LightShape) -> Option<&'static str> {
         let rect = matches!(shape, LightShape::Rect { .. });
         match self {
             Method::Exact { .. }
             | Method::ShadowMapping(_)
             | Method::Bitmask { .. }
-            | Method::Ssm { .. } => None,
+            | Method::Ssm { .. }
+            | Method::Pcss { .. } => None,
             _ if rect => None,
-            Method::Pcss { .. } | Method::Smoothies { .. } => Some(
+            Method::Smoothies { .. } => Some(
                 "sizes its penumbrae from a rectangular light's sides; a disk runs with \"ssm\", \
-                 \"bitmask\" or \"exact\"",
+                 \"pcss\", \"bitmask\" or \"exact\"",
             ),
         }
     }

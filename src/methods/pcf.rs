@@ -73,6 +73,9 @@ pub(crate) struct Axis {
     /// The box clipped to the map, [a, b] (pixel units); empty when !(a < b).
     a: f64,
     b: f64,
+    /// The box's centre p and half-width h (after the raise to 1/2).
+    p: f64,
+    half: f64,
     /// 1 / (2h): a length in pixels -> a weight.
     inv_full: f64,
     /// Exact mode: texels i0..=i1. Stratified mode: `taps` > 0 taps.
@@ -99,6 +102,8 @@ impl Axis {
         let nf = n as f64;
         let mut axis = Axis {
             n,
+            p,
+            half: h,
             a: 0.0,
             b: 0.0,
             inv_full,
@@ -206,6 +211,58 @@ impl Axis {
                 }
             }
         }
+    }
+
+    /// Calls `f(x0, x1, reads)` for every cell of the box inside the map
+    /// (pixel units): in exact mode each texel's part [max(i, a), min(i+1,
+    /// b)], read from texel i alone; in stratified mode each stratum, read
+    /// at its centre bilinearly from its two nearest texels (their shares
+    /// summing to 1, a texel off the map dropped). The clamp border is no
+    /// cell: `pcf_disk`, which weighs cells by their own area, takes the
+    /// part outside the map apart.
+    #[inline]
+    pub(crate) fn cells(&self, mut f: impl FnMut(f64, f64, &[(usize, f64)])) {
+        if !(self.a < self.b) {
+            return;
+        }
+        if self.taps == 0 {
+            for i in self.i0..=self.i1 {
+                let x0 = (i as f64).max(self.a);
+                let x1 = ((i + 1) as f64).min(self.b);
+                if x1 > x0 {
+                    f(x0, x1, &[(i, 1.0)]);
+                }
+            }
+            return;
+        }
+        let step = (self.b - self.a) / self.taps as f64;
+        let last = self.n as isize - 1;
+        for k in 0..self.taps {
+            let x0 = self.a + k as f64 * step;
+            let q = x0 + 0.5 * step - 0.5;
+            let fi = q.floor();
+            let t = q - fi;
+            let i = fi as isize;
+            let mut reads = [(0usize, 0f64); 2];
+            let mut count = 0;
+            for (idx, w) in [(i, 1.0 - t), (i + 1, t)] {
+                if w > 0.0 && (0..=last).contains(&idx) {
+                    reads[count] = (idx as usize, w);
+                    count += 1;
+                }
+            }
+            f(x0, x0 + step, &reads[..count]);
+        }
+    }
+
+    /// The box's centre and half-width (pixels), after the raise to 1/2.
+    pub(crate) fn centre_half(&self) -> (f64, f64) {
+        (self.p, self.half)
+    }
+
+    /// Texels along the axis.
+    pub(crate) fn texels(&self) -> usize {
+        self.n
     }
 
     /// The fraction of the box outside the map, computed from the box's

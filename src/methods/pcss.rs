@@ -45,6 +45,11 @@
 //! makes Fernando's approximations: one average blocker depth per receiver,
 //! and no account of occluders hiding one another.
 //!
+//! Under a disk light of radius ρ the same map takes the disk to the disk
+//! t_r ± ρ (1/z - 1/z_r): both boxes become the ellipses inscribed in them
+//! (circles when the texels are square), each cell weighted by its overlap
+//! with the ellipse (`pcf_disk.rs`), and the plate case stays exact.
+//!
 //! Kernel details (both boxes, per axis, in texels of the occluder grid;
 //! `pcf::box_filter` and `pcf::Axis`):
 //! * A half-width below half a texel is raised to half a texel: the filter
@@ -90,6 +95,7 @@ use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::inputs::{is_receiver, MIN_RECEIVERS};
 use super::keywords::{count, resolution, KeywordForm, Keywords};
 use super::pcf::{self, occludes, Axis, Border};
+use super::pcf_disk;
 use super::Input;
 use super::{point_light, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -134,6 +140,9 @@ struct Kernel<'a> {
     /// times this is a half-width in texels.
     half_per_w: [f64; 2],
     max_taps: u32,
+    /// A disk light: both boxes are the ellipses inscribed in them
+    /// (`pcf_disk`).
+    disk: bool,
 }
 
 /// A light size component usable in the kernel: NaN and negatives are 0.
@@ -180,6 +189,7 @@ impl<'a> Kernel<'a> {
             z_near,
             half_per_w: half_per_w(&grid, inputs.light_shape),
             max_taps,
+            disk: matches!(inputs.light_shape, LightShape::Disk { .. }),
         })
     }
 
@@ -228,13 +238,18 @@ impl<'a> Kernel<'a> {
         let ax = Axis::new(px, hs[0], g.width, m, false);
         let ay = Axis::new(py, hs[1], g.height, m, false);
         let (mut sw, mut swz) = (0f64, 0f64);
-        pcf::visit(&ax, &ay, g.width, |k, w| {
+        let blocker = |k: usize, w: f64| {
             let d = self.front[k];
             if occludes(d, z_at(k)) {
                 sw += w;
                 swz += w * d as f64;
             }
-        });
+        };
+        if self.disk {
+            pcf_disk::visit(&ax, &ay, g.width, blocker);
+        } else {
+            pcf::visit(&ax, &ay, g.width, blocker);
+        }
         if !(sw > 0.0) {
             return 1.0;
         }
@@ -242,13 +257,20 @@ impl<'a> Kernel<'a> {
         let z_avg = swz / sw;
         let hf = self.half(1.0 / z_avg, wr);
         // 3. PCF of the binary test over that box; outside the map is lit.
-        let v = pcf::box_filter(g, px, py, hf, m, Border::Constant(1.0), |k| {
+        let lit = |k: usize| {
             if occludes(self.front[k], z_at(k)) {
                 0.0
             } else {
                 1.0
             }
-        });
+        };
+        let v = if self.disk {
+            let ax = Axis::new(px, hf[0], g.width, m, false);
+            let ay = Axis::new(py, hf[1], g.height, m, false);
+            pcf_disk::filter(&ax, &ay, g.width, lit)
+        } else {
+            pcf::box_filter(g, px, py, hf, m, Border::Constant(1.0), lit)
+        };
         v.clamp(0.0, 1.0)
     }
 }
@@ -581,6 +603,23 @@ mod tests {
         assert!(max < 0.5 / 12.0, "12 taps: max error {max}");
         let max = plate_case::max_error(&Pcss { max_taps: 4 }, 128);
         assert!(max < 1.0 / 4.0, "4 taps: max error {max}");
+    }
+
+    /// Under a disk the filter's ellipse is the set of occluder points that
+    /// hide part of the disk (pcf_disk.rs): exact up to rounding with every
+    /// texel read (measured 3.0e-8 at 64² and at 128²); with strata each
+    /// cell is weighted by its part inside the ellipse and read at its
+    /// centre, so a stratum's share again bounds the error (measured 0.019
+    /// with 12 taps at 64²).
+    #[test]
+    fn plate_under_a_disk_matches_the_closed_form() {
+        let disk = LightShape::disk(0.5);
+        for n in [64, 128] {
+            let (_, max) = plate_case::mean_and_max_error(&Pcss { max_taps: 64 }, n, disk);
+            assert!(max < 1e-6, "{n}²: max error {max}");
+        }
+        let (_, max) = plate_case::mean_and_max_error(&Pcss { max_taps: 12 }, 64, disk);
+        assert!(max < 0.5 / 12.0, "12 taps: max error {max}");
     }
 
     #[test]

@@ -581,8 +581,9 @@ _PROBE_LIGHTS = {
 def _check_light_kinds(lights: tuple[LightSpec, ...], method: MethodSpec, light_maps: bool) -> None:
     """SpecError when the method cannot do with a kind of the spec's lights
     what every item drawing it would ask: shade it (naming ``method.name``:
-    the map methods refuse spheres, most of them disks too), or, with ``light_maps``, make its light-view
-    maps (naming ``outputs.light_maps``: a sphere's shadows are traced).
+    the map methods refuse spheres, ``smoothies`` disks too), or, with
+    ``light_maps``, make its light-view maps (naming ``outputs.light_maps``:
+    a sphere's shadows are traced).
     The core is asked, with a 4x4 render of a box under one light of that
     kind, as the items call it. Only disks and spheres are asked about
     (every method shades rectangles and the sun); a render the core refuses
