@@ -51,15 +51,16 @@ fn light_view_disk() -> MethodConfig {
     MethodConfig::Bitmask(crate::methods::BitmaskConfig::default())
 }
 
-/// The config a call on `light` runs. A rectangle or the sun take every
-/// method; a disk takes those that can shade it (`Method::refuses_shape`),
-/// a sphere, which has no light space, `exact` only: "auto" without a
-/// target runs `auto` (the eye view's `exact` default; in the light view
-/// `bitmask`, the map method that takes a disk), a method that cannot is
-/// refused naming `method` and why. A target stays in the eye view for a
-/// disk and a sphere (`plan_eye` plans `exact` for them) and is refused in
-/// the light view, whose planner plans the rectangle's maps (a sphere has
-/// no light view at all).
+/// The config a call on `light` runs. A rectangle, the sun and a disk take
+/// every method (`exact` and `bitmask` sample the disk, `ssm` clips its
+/// micro-patches to it, PCSS filters over the ellipse inscribed in its box,
+/// the smoothies' width is its diameter, ShadowMapping reads its centre); a
+/// sphere, which has no light space, `exact` only, any other method refused
+/// naming `method` and why. "auto" without a target runs `auto` (the eye
+/// view's `exact` default; in the light view `bitmask`). A target stays in
+/// the eye view for a disk and a sphere (`plan_eye` plans `exact` for them)
+/// and is refused in the light view, whose planner plans the rectangle's
+/// maps (a sphere has no light view at all).
 fn for_light(
     method: MethodConfig,
     light: &Light,
@@ -100,13 +101,7 @@ fn for_light(
                  method=\"exact\" (Exact(samples=...))"
             ),
         )),
-        m => match m.kernel().refuses_shape(&shape) {
-            Some(why) => Err(Error::invalid(
-                "method",
-                format!("{:?} cannot shade a {name}: it {why}", m.name()),
-            )),
-            None => Ok(m),
-        },
+        m => Ok(m),
     }
 }
 
@@ -524,11 +519,7 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
             // The rule's maps' error was measured under rectangles (and
             // the sun) only: not under a disk, nor a sphere (whose kernel
             // shape is its silhouette's disk; it has no plane for maps).
-            matches!(call.light.kernel_shape(), LightShape::Rect { .. })
-                && MethodConfig::Auto(a)
-                    .kernel()
-                    .refuses_shape(&call.light.kernel_shape())
-                    .is_none(),
+            matches!(call.light.kernel_shape(), LightShape::Rect { .. }),
         )),
         _ => None,
     };

@@ -40,7 +40,6 @@ pub mod smoothies;
 pub mod ssm;
 pub mod target;
 
-use crate::geom::light_shape::LightShape;
 pub use auto_config::{auto_rule, AutoConfig};
 pub use bitmask::{BitmaskConfig, HIERARCHY_DEFAULT_BITMASK};
 pub use exact::ExactConfig;
@@ -150,30 +149,6 @@ impl Method {
     /// tangent plane already, and ShadowMapping has its own.)
     pub fn tests_planes(&self) -> bool {
         matches!(self, Method::Pcss { .. } | Method::Smoothies { .. })
-    }
-
-    /// Why the method cannot shade a light of `shape`, or None where it
-    /// can. `exact` samples any shape, `bitmask` keeps the samples of its
-    /// pattern that lie on a disk (bitmask.rs), `ssm` clips each
-    /// micro-patch's back-projection to the disk (`disk_clip`), and
-    /// ShadowMapping's hard shadow reads the light's centre only, and PCSS
-    /// filters over the ellipse inscribed in its box (`pcf_disk`). The
-    /// smoothies take the light as the rectangle of its half-extents (their
-    /// width is its sides); a disk would be shaded as the square around it.
-    pub fn refuses_shape(&self, shape: &LightShape) -> Option<&'static str> {
-        let rect = matches!(shape, LightShape::Rect { .. });
-        match self {
-            Method::Exact { .. }
-            | Method::ShadowMapping(_)
-            | Method::Bitmask { .. }
-            | Method::Ssm { .. }
-            | Method::Pcss { .. } => None,
-            _ if rect => None,
-            Method::Smoothies { .. } => Some(
-                "sizes its penumbrae from a rectangular light's sides; a disk runs with \"ssm\", \
-                 \"pcss\", \"bitmask\" or \"exact\"",
-            ),
-        }
     }
 
     /// Whether the method reads `input`.

@@ -339,7 +339,10 @@ def _spec(**top):
 
 
 REFUSED = [
-    ({"method": {"name": "smoothies"}}, r"method.name: 'smoothies' cannot shade lights\[1\], of kind = 'disk'.*\"exact\""),
+    (
+        {"lights": [{"kind": "rect"}, {"kind": "sphere"}], "method": {"name": "pcss"}},
+        r"method.name: 'pcss' cannot shade lights\[1\], of kind = 'sphere'.*\"exact\"",
+    ),
     (
         {"lights": [{"kind": "rect"}, {"kind": "sphere"}], "method": {"name": "bitmask"}},
         r"method.name: 'bitmask' cannot shade lights\[1\], of kind = 'sphere'",

@@ -11,7 +11,13 @@
 //! 2. Silhouette edges w.r.t. the light's centre (`silhouette.rs`).
 //! 3. Smoothie edges and corners of width t in the image plane (`construct.rs`),
 //!    t = width (L/2) / b_ref, b_ref the median depth of the silhouette
-//!    edges' midpoints, per axis (Lu across u, Lv across v).
+//!    edges' midpoints, per axis (Lu across u, Lv across v). Under a disk
+//!    of radius ρ, L = 2ρ on both: the penumbra across a straight edge is
+//!    the diameter wide whatever the edge's direction. Its profile across
+//!    the edge is a circular segment's area, not a line, but the smoothies'
+//!    linear alpha kept under a disk erred less against Mitsuba than that
+//!    profile on all six calibration scenes and four of six held-out ones
+//!    (docs/methods/smoothies.md): the ramp is not the method's error.
 //! 4. The smoothie buffer: depth and remapped alpha alpha / (1 - b/r), minimum
 //!    blending (`buffer.rs`).
 //! 5. The lookup: umbra from the shadow map, penumbra from the smoothie

@@ -637,3 +637,28 @@ fn a_tilted_receiver_on_its_own_plane_does_not_shadow_itself() {
         s.visibility_points(&g, &front, &buf, &p, &[[0.0; 2]])
     );
 }
+
+/// Under a disk of radius ρ the smoothies are those of the square of side
+/// 2ρ (the penumbra across any straight edge is the disk's diameter wide):
+/// the same buffer and visibility, bit for bit.
+#[test]
+fn a_disk_is_shaded_as_its_diameter_wide_square() {
+    let g = grid();
+    let (v, f) = plate(A, ZO, [0.0, 0.0]);
+    let receiver = vec![4.0f32; g.len()];
+    let front = shadow_map(&plate_front(&g), &receiver);
+    let s = sm(Falloff::Linear);
+    let run = |shape| {
+        let buf = s.buffer(&g, shape, &front, &v, &f);
+        (
+            s.visibility_map(&g, &front, &buf, &receiver),
+            buf.stats.texels,
+        )
+    };
+    let (disk, texels) = run(LightShape::disk(0.5));
+    let (square, _) = run(LightShape::rect([1.0, 1.0]));
+    assert!(texels > 0 && disk.iter().any(|v| *v > 0.05 && *v < 0.95));
+    assert_eq!(disk, square);
+    let (small, _) = run(LightShape::disk(0.25));
+    assert_ne!(disk, small);
+}
