@@ -687,8 +687,32 @@ pub fn render_lights(
         }
     }
     let cap = threads::resolve(call.threads)?;
+    let target = match call.method {
+        MethodConfig::Auto(a) => a.target.error.map(|e| e.0),
+        _ => None,
+    };
+    let mut dim: Vec<Option<f64>> = vec![None; lights.len()];
     let mut runs: Vec<Run<EyeImage>> = Vec::with_capacity(lights.len());
-    for (light, _) in lights {
+    for (k, (light, _)) in lights.iter().enumerate() {
+        if let (1, Some(e)) = (k, target) {
+            let pairs: Vec<(&Light, [f64; 3])> =
+                lights.iter().map(|(l, lt)| (l, lt.emission)).collect();
+            let t0 = std::time::Instant::now();
+            let g = &runs[0].output.gbuffer;
+            let (found, _) = threads::run_capped(cap, || {
+                Ok(crate::auto::dim_lights::unshadowed(&pairs, g, e))
+            })?;
+            for (j, share) in found {
+                dim[j] = Some(share);
+            }
+            // Timed with the first light, whose first hits it reads.
+            let seconds = t0.elapsed().as_secs_f64();
+            runs[0].output.timings.push(("dim_lights", seconds));
+        }
+        if let (Some(share), Some(e)) = (dim[k], target) {
+            runs.push(unshadowed_run(call.method, &runs[0], share, e));
+            continue;
+        }
         let shared = runs.first().map(|r| &r.output.gbuffer);
         let c = EyeCall {
             light,
@@ -724,6 +748,49 @@ pub fn render_lights(
         out.push((run, shaded));
     }
     Ok(out)
+}
+
+/// A light of a call under `Auto(error=e)` too dim to shadow
+/// (`auto::dim_lights`): visibility 1 on the first light's first hits, its
+/// plan saying why.
+fn unshadowed_run(
+    method: MethodConfig,
+    first: &Run<EyeImage>,
+    share: f64,
+    e: f64,
+) -> Run<EyeImage> {
+    let g = first.output.gbuffer.clone();
+    let n = g.len();
+    let why = format!(
+        "not shadowed: with the call's other unshadowed lights it adds at most {share:.4} of the \
+         unshadowed irradiance at any pixel, within the target {e}, so its shadow cannot move the \
+         shaded image by more"
+    );
+    Run {
+        output: EyeImage {
+            gbuffer: g,
+            visibility: vec![1.0; n],
+            weighted: None,
+            maps: None,
+            light_space: None,
+            timings: Timings::default(),
+            estimate: None,
+        },
+        method,
+        backend: first.backend,
+        threads: first.threads,
+        plan: Some(crate::auto::Plan {
+            decisions: vec![crate::auto::Decision {
+                name: "unshadowed",
+                taken: true,
+                why,
+            }],
+            hard: false,
+            config: method,
+            planned: None,
+            slack: None,
+        }),
+    }
 }
 
 /// The error estimate, reported in a plan (`at`: "pixels" or "texels").

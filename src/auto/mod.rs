@@ -4,9 +4,10 @@
 //! features, the layers tried on coarse maps), `driver.rs` the order in
 //! which a planned light-view call frames, measures, plans and runs,
 //! `refine.rs` the runs after it while its error estimate misses the
-//! target.
+//! target, `dim_lights.rs` the lights of a call too dim to shadow.
 //! Above the orchestrators (it runs them), below the API.
 
+pub mod dim_lights;
 pub mod driver;
 pub mod measure;
 pub mod plan;

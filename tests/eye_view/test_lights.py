@@ -61,6 +61,36 @@ def test_several_lights_are_the_sum_of_each_alone():
     assert ss.render(scene, RECT, cam).visibility.shape == (48, 64)
 
 
+def test_a_light_too_dim_for_the_target_is_not_shadowed():
+    """Under Auto(error=e) a light adding at most e of the unshadowed
+    irradiance at every pixel keeps visibility 1: its shaded part then errs
+    by at most that share of the total, checked against its exact shadow."""
+    scene, cam = _scene()
+    bright = ss.RectLight((0.3, 2.0, 0.2), (-0.3, -2.0, -0.2), (0, 0, 1), 0.7, radiance=20.0)
+    dim = ss.DiskLight((-0.4, 1.8, 0.3), (0.3, -1.0, -0.1), 0.4, radiance=0.05)
+    img = ss.render(scene, [bright, dim], cam, method=ss.Auto(error=0.02))
+    part = img.parts[1]
+    assert part.plan is not None and [d.name for d in part.plan.decisions] == ["unshadowed"]
+    assert part.method == ss.Auto(error=0.02) and part.error_estimate is None
+    assert np.all(img.visibility[1] == 1.0) and "dim_lights" in img.timings
+    m = img.mask
+    assert not np.all(img.visibility[0][m] == 1.0)
+    # Its share of the unshadowed irradiance, per pixel and channel.
+    total = img.unshadowed[m]
+    share = float((part.unshadowed[m] / total).max())
+    assert 0.0 < share <= 0.02
+    truth = ss.render(scene, dim, cam, method=ss.Exact(samples=1024))
+    assert np.any(truth.visibility[m] < 0.5)
+    assert np.all(np.abs(part.shaded[m] - truth.shaded[m]) <= share * total + 1e-7)
+    # A tighter target shadows it; so does no target; the first light is
+    # always shadowed, however dim.
+    tight = ss.render(scene, [bright, dim], cam, method=ss.Auto(error=share / 2))
+    assert tight.parts[1].plan is None or "not shadowed" not in str(tight.parts[1].plan)
+    assert not np.all(ss.render(scene, [bright, dim], cam).visibility[1][m] == 1.0)
+    first = ss.render(scene, [dim, bright], cam, method=ss.Auto(error=0.02))
+    assert not np.all(first.visibility[0][m] == 1.0)
+
+
 def test_a_list_of_lights_is_checked_by_name():
     scene, cam = _scene()
     with pytest.raises(ValueError, match="light"):
