@@ -486,7 +486,9 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
         depth_layers: None,
         eye: true,
     };
-    // ShadowMapping is a hard shadow: it takes hard lights on the GPU.
+    // ShadowMapping is a hard shadow: it takes hard lights on the GPU. A
+    // sphere's rays run on the GPU when asked (backend="gpu"), without the
+    // CPU's probe and not yet timed on a real GPU: "auto" keeps the CPU.
     let hard_ok = matches!(call.method, MethodConfig::ShadowMapping(_));
     let backend = pick(
         call.backend,

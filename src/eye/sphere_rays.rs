@@ -79,6 +79,31 @@ fn cap_sample(s: &Sampling, key: u64, sa: u32, sb: u32) -> [f64; 3] {
     }
 }
 
+/// The shared pattern of `samples` strata (`Jitter::Shared`): its grid
+/// na x nb and the cap sample of each stratum, sb * na + sa (`cap_sample`),
+/// which every pixel traces; the GPU's table (gpu/sphere_rays.rs).
+pub fn shared_cap_samples(samples: u32) -> ((u32, u32), Vec<[f64; 3]>) {
+    let s = pattern(samples, Jitter::Shared);
+    (s.light.grid, cap_table(&s))
+}
+
+/// Each stratum's cap sample of `s`'s pattern for jitter key 0, row-major.
+fn cap_table(s: &Sampling) -> Vec<[f64; 3]> {
+    let (na, nb) = s.light.grid;
+    (0..nb)
+        .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
+        .map(|(sa, sb)| cap_sample(s, 0, sa, sb))
+        .collect()
+}
+
+/// A ray's two origins from surface point `p` with normal `n` (after
+/// Mitsuba's `spawn_ray_to`, as rays.rs's): moved off the surface along n,
+/// for a ray leaving on n's side, and against it.
+pub fn ray_origins(p: DVec3, n: DVec3) -> [DVec3; 2] {
+    let mag = (1.0 + p.abs().max_element()) * RAY_EPSILON;
+    [p + mag * n, p - mag * n]
+}
+
 /// A pixel's surface point `p` and normal `n` (facing the camera), and its
 /// jitter key.
 #[derive(Clone, Copy)]
@@ -116,8 +141,7 @@ fn trace_packet(
             live |= 1 << i;
         }
     }
-    let mag: [f64; LANES] =
-        std::array::from_fn(|i| (1.0 + lane(i).p.abs().max_element()) * RAY_EPSILON);
+    let origins: [[DVec3; 2]; LANES] = std::array::from_fn(|i| ray_origins(lane(i).p, lane(i).n));
     let frames: [Option<CapFrame>; LANES] = std::array::from_fn(|i| CapFrame::new(c, r, lane(i).p));
     let (na, nb) = s.light.grid;
     let mut clear = [0u32; LANES];
@@ -142,11 +166,7 @@ fn trace_packet(
                 let dir = frame.direction(u1, cos_phi, sin_phi);
                 w[i] = px.n.dot(dir).max(0.0);
                 w_all[i] += w[i];
-                let origin = if px.n.dot(dir) >= 0.0 {
-                    px.p + mag[i] * px.n
-                } else {
-                    px.p - mag[i] * px.n
-                };
+                let origin = origins[i][usize::from(px.n.dot(dir) < 0.0)];
                 let t = sphere::cap_hit(c, r, origin, dir);
                 if !(t.is_finite() && t > 0.0) {
                     open &= !(1 << i);
@@ -215,13 +235,7 @@ pub fn sphere_visibility(
     // a shared pattern's cap samples computed once.
     let run = |pixels: &[usize], s: &Sampling| -> Vec<[f32; 2]> {
         let order = tiled(pixels, g.width, g.height);
-        let (na, nb) = s.light.grid;
-        let table: Option<Vec<[f64; 3]>> = (s.jitter == Jitter::Shared).then(|| {
-            (0..nb)
-                .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
-                .map(|(sa, sb)| cap_sample(s, 0, sa, sb))
-                .collect()
-        });
+        let table: Option<Vec<[f64; 3]>> = (s.jitter == Jitter::Shared).then(|| cap_table(s));
         let packets: Vec<(Vec<usize>, [[f32; 2]; LANES])> = order
             .par_chunks(LANES)
             .with_min_len(4)

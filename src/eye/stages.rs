@@ -8,11 +8,12 @@ use super::call::EyeCall;
 use super::framing::Framed;
 use super::gbuffer::{self, GBuffer, SceneTriangles};
 use super::maps::{self, LightTriangles, MapShading};
-use super::{rays, shadow_mapping};
+use super::{rays, shadow_mapping, sphere_rays};
 use crate::backend::Backend;
 use crate::error::Result;
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
+use crate::geom::sphere_light::SphereLight;
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::MethodConfig;
@@ -58,6 +59,23 @@ pub trait EyeStages {
         probe: Option<u32>,
         sw: &mut Stopwatch,
     ) -> Result<(Vec<f32>, Option<Vec<f32>>)>;
+
+    /// `exact` under a sphere (`sphere_rays.rs`): each pixel of `hits` (flat
+    /// indices into `g`) traced over the cap it sees through `bvh` (every
+    /// triangle relative to the sphere's centre, `sphere_rays::sphere_bvh`),
+    /// its visibility and weighted visibility; with a `probe`, only where a
+    /// first pass is unsure (the CPU's).
+    #[allow(clippy::too_many_arguments)]
+    fn trace_sphere(
+        &mut self,
+        bvh: &Bvh,
+        light: &SphereLight,
+        g: &GBuffer,
+        hits: &[usize],
+        samples: u32,
+        probe: Option<u32>,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<[f32; 2]>>;
 
     /// The map methods: the occluder layers of `tris` on `grid`, and the
     /// visibility of each visible point of `f` read from them (and its
@@ -127,6 +145,21 @@ impl EyeStages for CpuEye {
         );
         Ok(both.into_iter().map(|[v, w]| (v, w)).unzip())
             .map(|(v, w): (Vec<f32>, Vec<f32>)| (v, Some(w)))
+    }
+
+    fn trace_sphere(
+        &mut self,
+        bvh: &Bvh,
+        light: &SphereLight,
+        g: &GBuffer,
+        hits: &[usize],
+        samples: u32,
+        probe: Option<u32>,
+        _sw: &mut Stopwatch,
+    ) -> Result<Vec<[f32; 2]>> {
+        Ok(sphere_rays::sphere_visibility(
+            bvh, light, g, hits, samples, probe,
+        ))
     }
 
     fn shade_maps(

@@ -901,6 +901,56 @@ mod eye {
         assert!(mean <= 1e-4 && differ * 1000 <= dv.len(), "{mean} {differ}");
     }
 
+    /// `exact` under a sphere: each pixel's rays over its cap, set up on the
+    /// CPU in f64 and cast in f32 on both (the directions from one table of
+    /// cap samples): where both see the same surface point, the same
+    /// visibility but where a ray grazes an edge (a sample is 1/64 of V),
+    /// and the weighted visibility likewise.
+    #[test]
+    fn gpu_sphere_renders_are_the_cpus() {
+        if !device_or_skip() {
+            return;
+        }
+        use crate::geom::sphere_light::SphereLight;
+        let meshes = scene();
+        let cam = camera((80, 60));
+        let light = Light::Sphere(SphereLight::new([0.3, 2.6, 0.2], 0.4).unwrap());
+        let method = MethodConfig::Exact(ExactConfig::of(64));
+        let c = render(&meshes, &light, &cam, method, BackendChoice::Cpu).unwrap();
+        let g = render(&meshes, &light, &cam, method, BackendChoice::Gpu).unwrap();
+        assert_eq!(g.backend, Backend::Gpu);
+        let same = same_surface(&c.output, &g.output);
+        let seen = same.iter().filter(|s| **s).count();
+        let (cv, gv) = (&c.output.visibility, &g.output.visibility);
+        let (cw, gw) = (
+            c.output.weighted.as_ref().unwrap(),
+            g.output.weighted.as_ref().unwrap(),
+        );
+        let diffs = |a: &[f32], b: &[f32]| -> (f64, f64, usize) {
+            let d: Vec<f64> = (0..a.len())
+                .filter(|&k| same[k])
+                .map(|k| (a[k] as f64 - b[k] as f64).abs())
+                .collect();
+            let max = d.iter().fold(0f64, |m, x| m.max(*x));
+            (
+                d.iter().sum::<f64>() / d.len() as f64,
+                max,
+                d.iter().filter(|x| **x > 1e-6).count(),
+            )
+        };
+        let penumbra = (0..cv.len())
+            .filter(|&k| same[k] && cv[k] > 0.02 && cv[k] < 0.98)
+            .count();
+        let ((dv, mv, nv), (dw, mw, _)) = (diffs(cv, gv), diffs(cw, gw));
+        eprintln!(
+            "sphere: {seen} same, {penumbra} penumbra; |dV| mean {dv:.2e} max {mv:.2e} ({nv} differ), \
+             |dV_w| mean {dw:.2e} max {mw:.2e}"
+        );
+        assert!(seen > 3000 && penumbra > 100, "{seen} {penumbra}");
+        assert!(dv <= 1e-3 && mv <= 2.0 / 64.0 + 1e-6, "{dv} {mv}");
+        assert!(dw <= 1e-3 && mw <= 0.05, "{dw} {mw}");
+    }
+
     /// The SSM under a disk in the eye view (the points mode): its
     /// visibility and its weighted visibility, the patches clipped to the
     /// disk and the weights' integral over it on both backends.

@@ -20,6 +20,9 @@
 //!   CPU in f64, shared), t in (0, 1 - RAY_EPS), the jitter exact.rs's hash
 //!   of the point's pixel (its flat index in the image) and the sample, as
 //!   `rays::visibility`.
+//! * `exact` under a sphere (`sphere_rays.wgsl`, `sphere_rays.rs`): each
+//!   pixel's rays over the cap it sees, the frames and origins made on the
+//!   CPU in f64, as `eye::sphere_rays` traces them (without a probe).
 //! * The map methods (`ssm`, `bitmask`, `pcss`, `smoothies`): the method's
 //!   kernel (`super::kernel`, `GpuKernel::eye`: `gather_points.rs`,
 //!   `pcss.rs`, `smoothies.rs`) rasterizes the occluder layers on the
@@ -48,6 +51,7 @@ use crate::eye::{EyeCall, EyeStages, Framed, MapShading};
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
+use crate::geom::sphere_light::SphereLight;
 use crate::methods::exact::{Bvh, RAY_EPS};
 use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::MethodConfig;
@@ -195,10 +199,7 @@ impl EyeStages for GpuEye {
     ) -> Result<(Vec<f32>, Option<Vec<f32>>)> {
         // `ExactConfig::resolve` refuses a probe on the GPU.
         if probe.is_some() {
-            return Err(Error::invalid(
-                "probe",
-                "the GPU backend traces every sample at every pixel (it has no probe); use backend=\"cpu\"",
-            ));
+            return Err(no_probe());
         }
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()
@@ -208,6 +209,25 @@ impl EyeStages for GpuEye {
             exact_visibility(gpu()?, bvh, &starts, samples, f.light_shape, sw)?;
         self.device_timings.extend(t);
         Ok((v, Some(weighted)))
+    }
+
+    fn trace_sphere(
+        &mut self,
+        bvh: &Bvh,
+        light: &SphereLight,
+        g: &GBuffer,
+        hits: &[usize],
+        samples: u32,
+        probe: Option<u32>,
+        sw: &mut Stopwatch,
+    ) -> Result<Vec<[f32; 2]>> {
+        if probe.is_some() {
+            return Err(no_probe());
+        }
+        let (v, t) =
+            super::sphere_rays::sphere_visibility(gpu()?, bvh, light, g, hits, samples, sw)?;
+        self.device_timings.extend(t);
+        Ok(v)
     }
 
     fn shade_maps(
@@ -239,6 +259,14 @@ impl EyeStages for GpuEye {
         timings.extend(std::mem::take(&mut self.device_timings));
         merged(timings)
     }
+}
+
+/// A probe asked of the GPU, which has none.
+fn no_probe() -> Error {
+    Error::invalid(
+        "probe",
+        "the GPU backend traces every sample at every pixel (it has no probe); use backend=\"cpu\"",
+    )
 }
 
 /// The triangle (input index) each pixel's ray hits first, cast on the

@@ -68,6 +68,7 @@ mod shader_tests;
 mod shading;
 mod shadow_mapping;
 mod smoothies;
+mod sphere_rays;
 mod timing;
 
 pub use context::{GpuInfo, ENV_SWITCH};

@@ -15,6 +15,7 @@ use super::shadow_mapping::{GpuBlurPixel, GpuSmPoint, GpuSmTri, SmParams, SOURCE
 use super::smoothies::{
     GpuSmoothie, SmoothieChunk, SmoothieParams, TentAxis, TentPoint, SOURCE as SMOOTHIES_SOURCE,
 };
+use super::sphere_rays::{GpuSphereStart, SphereParams, SOURCE as SPHERE_SOURCE};
 
 /// Every shader module the backend builds, by name.
 fn modules() -> Vec<(String, String)> {
@@ -23,6 +24,10 @@ fn modules() -> Vec<(String, String)> {
         ("exact.wgsl".into(), EXACT_SOURCE.to_string()),
         ("exact.wgsl + eye_hits.wgsl".into(), HITS_SOURCE.to_string()),
         ("exact.wgsl + eye_rays.wgsl".into(), RAYS_SOURCE.to_string()),
+        (
+            "exact.wgsl + sphere_rays.wgsl".into(),
+            SPHERE_SOURCE.to_string(),
+        ),
         ("smoothies.wgsl".into(), SMOOTHIES_SOURCE.to_string()),
         ("shadow_mapping.wgsl".into(), SM_SOURCE.to_string()),
         (
@@ -58,6 +63,7 @@ fn every_wgsl_file_is_used_by_a_module() {
         EXACT_SOURCE,
         HITS_SOURCE,
         RAYS_SOURCE,
+        SPHERE_SOURCE,
         SMOOTHIES_SOURCE,
         SM_SOURCE,
         PCSS_SOURCE,
@@ -356,6 +362,42 @@ fn shared_structs_have_the_same_layout_in_rust_and_wgsl() {
             budget,
             _pad0,
             _pad1
+        }),
+    );
+    assert_same(
+        SPHERE_SOURCE,
+        "SphereStart",
+        rust_layout!(GpuSphereStart {
+            ax,
+            ay,
+            az,
+            valid,
+            bx,
+            by,
+            bz,
+            omc,
+            nx,
+            ny,
+            nz,
+            wx,
+            wy,
+            wz,
+            e1x,
+            e1y,
+            e1z,
+            e2x,
+            e2y,
+            e2z
+        }),
+    );
+    assert_same(
+        SPHERE_SOURCE,
+        "SphereParams",
+        rust_layout!(SphereParams {
+            radius,
+            _pad0,
+            _pad1,
+            _pad2
         }),
     );
     assert_same(

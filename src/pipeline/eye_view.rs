@@ -21,7 +21,7 @@ use crate::eye::framing::{
 };
 use crate::eye::gbuffer::{GBuffer, SceneTriangles};
 use crate::eye::prepared::Found;
-use crate::eye::sphere_rays::{sphere_bvh, sphere_visibility};
+use crate::eye::sphere_rays::sphere_bvh;
 use crate::eye::{shadow_mapping, CpuEye, EyeCall, EyeImage, EyeStages};
 use crate::geom::light::MapGrid;
 use crate::geom::light_space::Light;
@@ -261,13 +261,6 @@ fn render_sphere<S: EyeStages>(
     light: &SphereLight,
     start: Instant,
 ) -> Result<(EyeImage, MethodConfig)> {
-    if S::BACKEND == Backend::Gpu {
-        return Err(Error::invalid(
-            "backend",
-            "a SphereLight's rays are traced on the CPU in this version; use backend=\"cpu\" \
-             (\"auto\" takes it)",
-        ));
-    }
     let method = resolve_at_camera(call, S::BACKEND)?;
     let (samples, probe) = exact_samples(call, &method);
     let mut sw = Stopwatch::new();
@@ -278,7 +271,7 @@ fn render_sphere<S: EyeStages>(
     crate::cancel::current().check()?;
     sw.lap("bvh");
     let hits = g.hits();
-    let v = sphere_visibility(&bvh, light, &g, &hits, samples, probe);
+    let v = stages.trace_sphere(&bvh, light, &g, &hits, samples, probe, &mut sw)?;
     crate::cancel::current().check()?;
     sw.lap("shadow");
     let estimate = call.estimate_error.map(|how| {

@@ -156,6 +156,12 @@ impl CapFrame {
         })
     }
 
+    /// The axis w, the pair (e1, e2) about it, and 1 − cos α: what the
+    /// GPU's twin of `direction` reads (gpu/sphere_rays.wgsl).
+    pub fn parts(&self) -> ([DVec3; 3], f64) {
+        ([self.w, self.e1, self.e2], self.one_minus_cos_a)
+    }
+
     /// `cap_direction` with u1 and the azimuth's cosine and sine given:
     /// cos θ = 1 − u1 (1 − cos α).
     #[inline]
