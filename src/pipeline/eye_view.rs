@@ -46,10 +46,11 @@ fn elapsed(start: Instant) -> f64 {
 /// reads again: the first hits, the framing and the BVH of the triangles
 /// the rays meet. A run that reuses them times none of those stages (the
 /// run that built them did).
-pub struct Traced {
-    g: GBuffer,
-    f: Framed,
-    bvh: Bvh,
+pub enum Traced {
+    /// A planar light's or the sun's: the BVH in kernel light space.
+    Planar { g: GBuffer, f: Framed, bvh: Bvh },
+    /// A sphere's (no framing): the BVH relative to its centre.
+    Sphere { g: GBuffer, bvh: Bvh },
 }
 
 /// The call's triangles: kept by its preparation, or gathered and checked
@@ -157,7 +158,7 @@ pub fn render_with<S: EyeStages>(
         return Ok((image, method));
     }
     if let Light::Sphere(s) = call.light {
-        return render_sphere(stages, call, s, start);
+        return render_sphere(stages, call, s, reuse, start);
     }
     stages.check(call)?;
     if call.method.kernel().traces() {
@@ -251,25 +252,35 @@ pub fn render_with<S: EyeStages>(
 
 /// `exact` under a sphere (`eye::sphere_rays`): the first hits, then
 /// stratified rays over the cap each pixel sees, through one BVH of every
-/// triangle, and where asked the error estimate against the same rays with
-/// four times the samples (`estimate::estimate_sphere`), as `exact`'s under
-/// a planar light. A sphere has no light space, so no framing: its rays run
-/// on the CPU.
+/// triangle (`EyeStages::trace_sphere`), and where asked the error estimate
+/// against the same rays with four times the samples
+/// (`estimate::estimate_sphere`), as `exact`'s under a planar light. A
+/// sphere has no light space, so no framing; the first hits and the BVH
+/// come from `reuse` where a run of the same call left them, and are left
+/// there for the next.
 fn render_sphere<S: EyeStages>(
     stages: &mut S,
     call: &EyeCall,
     light: &SphereLight,
+    mut reuse: Option<&mut Option<Traced>>,
     start: Instant,
 ) -> Result<(EyeImage, MethodConfig)> {
     let method = resolve_at_camera(call, S::BACKEND)?;
     let (samples, probe) = exact_samples(call, &method);
     let mut sw = Stopwatch::new();
-    let (scene, _) = scene_of(call)?;
-    let g = first_hits(stages, call, &scene)?;
-    sw.lap("first_hits");
-    let bvh = sphere_bvh(light, &scene.corners);
-    crate::cancel::current().check()?;
-    sw.lap("bvh");
+    let (g, bvh) = match reuse.as_mut().and_then(|r| r.take()) {
+        Some(Traced::Sphere { g, bvh }) => (g, bvh),
+        _ => {
+            check_traced_fit(call)?;
+            let (scene, _) = scene_of(call)?;
+            let g = first_hits(stages, call, &scene)?;
+            sw.lap("first_hits");
+            let bvh = sphere_bvh(light, &scene.corners);
+            crate::cancel::current().check()?;
+            sw.lap("bvh");
+            (g, bvh)
+        }
+    };
     let hits = g.hits();
     let v = stages.trace_sphere(&bvh, light, &g, &hits, samples, probe, &mut sw)?;
     crate::cancel::current().check()?;
@@ -295,13 +306,22 @@ fn render_sphere<S: EyeStages>(
         visibility[k] = v;
         weighted[k] = w;
     }
+    let timings = stages.timings(sw.timings);
+    let gbuffer = match reuse {
+        Some(r) => {
+            let kept = g.clone();
+            *r = Some(Traced::Sphere { g, bvh });
+            kept
+        }
+        None => g,
+    };
     let image = EyeImage {
-        gbuffer: g,
+        gbuffer,
         visibility,
         weighted: Some(weighted),
         maps: None,
         light_space: None,
-        timings: stages.timings(sw.timings),
+        timings,
         estimate,
     };
     Ok((image, method))
@@ -330,6 +350,19 @@ fn check_maps_fit(call: &EyeCall, grid: &MapGrid, method: &MethodConfig) -> Resu
     )
 }
 
+/// Refuses, before anything is built, a traced call whose BVH, first hits
+/// and rays' working memory do not fit, naming `meshes`.
+fn check_traced_fit(call: &EyeCall) -> Result<()> {
+    let triangles = call.meshes.iter().map(|m| m.faces.len()).sum();
+    let vertices = call.meshes.iter().map(|m| m.vertices.len()).sum();
+    let (w, h) = (call.camera.width, call.camera.height);
+    check_fits(
+        "meshes",
+        &format!("{triangles} triangles traced at {w}x{h} pixels"),
+        traced_bytes(triangles, vertices, w.saturating_mul(h)),
+    )
+}
+
 /// `exact`: shadow rays from each visible point (`EyeStages::trace`) through
 /// one BVH, which the error estimate traces too; the first hits, framing
 /// and BVH from `reuse` where a run of the same call left them.
@@ -345,17 +378,10 @@ fn render_traced<S: EyeStages>(
     let mut sw = Stopwatch::new();
     // Where this call's new tree's shape goes once it has been traced.
     let mut keep_for = None;
-    let Traced { g, f, mut bvh } = match reuse.as_mut().and_then(|r| r.take()) {
-        Some(t) => t,
-        None => {
-            let triangles = call.meshes.iter().map(|m| m.faces.len()).sum();
-            let vertices = call.meshes.iter().map(|m| m.vertices.len()).sum();
-            let (w, h) = size;
-            check_fits(
-                "meshes",
-                &format!("{triangles} triangles traced at {w}x{h} pixels"),
-                traced_bytes(triangles, vertices, w.saturating_mul(h)),
-            )?;
+    let (g, f, mut bvh) = match reuse.as_mut().and_then(|r| r.take()) {
+        Some(Traced::Planar { g, f, bvh }) => (g, f, bvh),
+        _ => {
+            check_traced_fit(call)?;
             let (scene, found) = scene_of(call)?;
             let g = first_hits(stages, call, &scene)?;
             sw.lap("first_hits");
@@ -381,7 +407,7 @@ fn render_traced<S: EyeStages>(
                     bvh
                 }
             };
-            Traced { g, f, bvh }
+            (g, f, bvh)
         }
     };
     let (v, vw) = stages.trace(&f, &bvh, call.camera, samples, probe, &mut sw)?;
@@ -419,7 +445,7 @@ fn render_traced<S: EyeStages>(
     let (gbuffer, light_space) = match reuse {
         Some(r) => {
             let kept = (g.clone(), f.space);
-            *r = Some(Traced { g, f, bvh });
+            *r = Some(Traced::Planar { g, f, bvh });
             kept
         }
         None => (g, f.space),

@@ -258,6 +258,21 @@ def test_a_sphere_planned_for_a_target_meets_it_against_mitsuba(target):
     assert _shadowed_error(img.visibility, ref.visibility, ref.mask) < target
 
 
+def test_a_spheres_refinements_reuse_the_pilots_first_hits_and_bvh():
+    """Auto(error=...) under a sphere: the pilot's estimate misses, the call
+    runs again on the pilot's first hits and BVH (no first_hits or bvh
+    stage of its own), with the same bits as that setting rendered
+    afresh."""
+    scene, cam = _scene()
+    img = ss.render(scene, SPHERE, cam, method=ss.Auto(error=0.008))
+    assert img.plan is not None and "refine" in [d.name for d in img.plan.decisions]
+    assert img.timings["replaced"] > 0
+    assert "first_hits" not in img.timings and "bvh" not in img.timings
+    fresh = ss.render(scene, SPHERE, cam, method=img.method)
+    assert "first_hits" in fresh.timings and "bvh" in fresh.timings
+    assert np.array_equal(fresh.visibility, img.visibility) and np.array_equal(fresh.shaded, img.shaded)
+
+
 @pytest.mark.parametrize("light", [RECT, DISK, SPHERE], ids=["rect", "disk", "sphere"])
 def test_shaded_images_match_mitsuba_direct(light):
     """``mean|shaded - Mitsuba| / mean(Mitsuba)`` over the hit pixels at
