@@ -48,7 +48,11 @@ fn elapsed(start: Instant) -> f64 {
 /// run that built them did).
 pub enum Traced {
     /// A planar light's or the sun's: the BVH in kernel light space.
-    Planar { g: GBuffer, f: Framed, bvh: Bvh },
+    Planar {
+        g: GBuffer,
+        f: Box<Framed>,
+        bvh: Bvh,
+    },
     /// A sphere's (no framing): the BVH relative to its centre.
     Sphere { g: GBuffer, bvh: Bvh },
 }
@@ -379,7 +383,7 @@ fn render_traced<S: EyeStages>(
     // Where this call's new tree's shape goes once it has been traced.
     let mut keep_for = None;
     let (g, f, mut bvh) = match reuse.as_mut().and_then(|r| r.take()) {
-        Some(Traced::Planar { g, f, bvh }) => (g, f, bvh),
+        Some(Traced::Planar { g, f, bvh }) => (g, *f, bvh),
         _ => {
             check_traced_fit(call)?;
             let (scene, found) = scene_of(call)?;
@@ -445,7 +449,11 @@ fn render_traced<S: EyeStages>(
     let (gbuffer, light_space) = match reuse {
         Some(r) => {
             let kept = (g.clone(), f.space);
-            *r = Some(Traced::Planar { g, f, bvh });
+            *r = Some(Traced::Planar {
+                g,
+                f: Box::new(f),
+                bvh,
+            });
             kept
         }
         None => (g, f.space),
