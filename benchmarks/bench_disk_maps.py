@@ -51,17 +51,6 @@ def segment(v: np.ndarray) -> np.ndarray:
     return (np.arccos(c) - c * np.sqrt(np.maximum(1.0 - c * c, 0.0))) / np.pi
 
 
-@dataclasses.dataclass
-class Visible:
-    """An image's fields that ``compare_images`` reads, with another visibility."""
-
-    visibility: np.ndarray
-    mask: np.ndarray
-    depth: np.ndarray
-    position: np.ndarray
-    mesh_id: np.ndarray
-
-
 def cell(image: Any, reference: Any) -> str:
     c = compare_images(image, reference)
     return f"{c.shadow_error:.4f} ({100 * c.acne:.2f}%, {100 * c.leak:.2f}%)"
@@ -79,7 +68,7 @@ def rows(report: Report, name: str, group: str, scene: Any, light: Any, cam: Any
             img = ss.render(scene, lt, cam, method=method)
             cells[label] = cell(img, reference)
             if label == "smoothies":
-                shaped = Visible(segment(img.visibility), img.mask, img.depth, img.position, img.mesh_id)
+                shaped = dataclasses.replace(img, visibility=segment(img.visibility))
                 cells["smoothies, segment"] = cell(shaped, reference)
         order = ["pcss", "smoothies", "smoothies, segment", "ssm", "bitmask 1024"]
         report.line(

@@ -31,43 +31,49 @@ use rayon::prelude::*;
 /// the error target `e` on the surface points of `g` (module doc), each
 /// with the worst share of the irradiance the unshadowed set then has
 /// where it is added; never the first light. In the order found.
+///
+/// Memory: two RGB images of the visible points (the total and the set's
+/// sum) whatever the number of lights; each light's irradiance is
+/// evaluated again where needed (at most three times a point: the total,
+/// its own worst share, its trial in the set).
 pub fn unshadowed(lights: &[(&Light, [f64; 3])], g: &GBuffer, e: f64) -> Vec<(usize, f64)> {
     if lights.len() < 2 || !(e > 0.0) {
         return vec![];
     }
     let hits = g.hits();
-    // Per light, per hit pixel, per channel: E_k,c(p).
-    let each: Vec<Vec<[f64; 3]>> = lights
-        .iter()
-        .map(|(light, emission)| {
-            hits.par_iter()
-                .map(|&k| {
-                    let x = DVec3::from_array(g.position[k]);
-                    let n = Vec3::from_array(g.normal[k]).as_dvec3().normalize_or_zero();
-                    let e = irradiance(light, x, n);
-                    emission.map(|c| c * e)
-                })
-                .collect()
-        })
-        .collect();
+    let at = |k: usize| {
+        (
+            DVec3::from_array(g.position[k]),
+            Vec3::from_array(g.normal[k]).as_dvec3().normalize_or_zero(),
+        )
+    };
+    // E_k,c at visible point p: the closed form times the emission.
+    let each = |light: usize, p: usize| -> [f64; 3] {
+        let (l, emission) = lights[light];
+        let (x, n) = at(hits[p]);
+        let e = irradiance(l, x, n);
+        emission.map(|c| c * e)
+    };
     let total: Vec<[f64; 3]> = (0..hits.len())
         .into_par_iter()
         .map(|p| {
             let mut t = [0.0; 3];
-            for e in &each {
+            for k in 0..lights.len() {
+                let x = each(k, p);
                 for c in 0..3 {
-                    t[c] += e[p][c];
+                    t[c] += x[c];
                 }
             }
             t
         })
         .collect();
-    // The worst share of the set `sum` at any pixel and channel; a channel
-    // no light reaches is 0 / 0: no share.
-    let worst = |sum: &[[f64; 3]]| -> f64 {
-        sum.par_iter()
-            .zip(&total)
-            .map(|(s, t)| {
+    // The worst share at any point and channel of the set whose sum at
+    // point p is `sum(p)`; a channel no light reaches is 0 / 0: no share.
+    let worst = |sum: &(dyn Fn(usize) -> [f64; 3] + Sync)| -> f64 {
+        (0..hits.len())
+            .into_par_iter()
+            .map(|p| {
+                let (s, t) = (sum(p), total[p]);
                 (0..3)
                     .filter(|&c| t[c] > 0.0)
                     .map(|c| s[c] / t[c])
@@ -75,7 +81,9 @@ pub fn unshadowed(lights: &[(&Light, [f64; 3])], g: &GBuffer, e: f64) -> Vec<(us
             })
             .reduce(|| 0.0, f64::max)
     };
-    let mut order: Vec<(usize, f64)> = (1..lights.len()).map(|k| (k, worst(&each[k]))).collect();
+    let mut order: Vec<(usize, f64)> = (1..lights.len())
+        .map(|k| (k, worst(&|p| each(k, p))))
+        .collect();
     order.sort_by(|a, b| a.1.total_cmp(&b.1));
     let mut sum = vec![[0.0; 3]; hits.len()];
     let mut out = vec![];
@@ -83,16 +91,15 @@ pub fn unshadowed(lights: &[(&Light, [f64; 3])], g: &GBuffer, e: f64) -> Vec<(us
         if !(share <= e) {
             break;
         }
-        let next: Vec<[f64; 3]> = sum
-            .iter()
-            .zip(&each[k])
-            .map(|(s, x)| [s[0] + x[0], s[1] + x[1], s[2] + x[2]])
-            .collect();
-        let w = worst(&next);
+        let with = |p: usize| {
+            let (s, x) = (sum[p], each(k, p));
+            [s[0] + x[0], s[1] + x[1], s[2] + x[2]]
+        };
+        let w = worst(&with);
         if !(w <= e) {
             continue;
         }
-        sum = next;
+        sum = (0..hits.len()).into_par_iter().map(with).collect();
         out.push((k, w));
     }
     out

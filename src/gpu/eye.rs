@@ -408,7 +408,7 @@ impl GpuRayStart {
 }
 
 /// Per ray start: the visibility, and the weighted visibility.
-type Visibilities = (Vec<f32>, Vec<f32>);
+pub(super) type Visibilities = (Vec<f32>, Vec<f32>);
 
 /// `exact`'s visibility per ray start and its weighted visibility
 /// (eye_rays.wgsl), through a BVH of `tris` (kernel light space) on the
@@ -426,26 +426,72 @@ fn exact_visibility(
         return Ok(((vec![], vec![]), vec![]));
     }
     fits(g, "resolution", n as u64 * size_of::<GpuRayStart>() as u64)?;
-    let has_tris = !bvh.is_empty();
     let mut params = ExactParams {
         rec_w: n as u32,
-        rec_h: 1,
-        budget: BUDGET,
-        has_tris: has_tris as u32,
-        // rays.rs's segments: t in (0, 1 - RAY_EPS).
-        t0: 0.0,
-        t1: 1.0 - RAY_EPS,
         ..Default::default()
     };
     params.set_light(light_shape, samples);
+    let rays = PointRays {
+        label: "softshadow eye exact",
+        pipelines: |d| {
+            let p = pipelines(d);
+            (&p.rays, &p.rays_resolve)
+        },
+        buffers: |d: &wgpu::Device| (upload(d, "ray starts", starts), vec![]),
+    };
+    cast_point_rays(g, bvh, params, rays, sw)
+}
+
+/// A ray-casting module of the eye view appended to exact.wgsl (eye_rays.wgsl,
+/// sphere_rays.wgsl): its cast and resolve entry points, and the buffers it
+/// binds beside the BVH, the counts and the weights, made on the device:
+/// the points' starts (binding 8) and its own, from binding 10 on (the cast
+/// pass only).
+pub(super) struct PointRays<B> {
+    pub label: &'static str,
+    /// The cast and resolve pipelines.
+    pub pipelines: RayPipelines,
+    pub buffers: B,
+}
+
+/// A module's cast and resolve pipelines, built once on the device.
+pub(super) type RayPipelines = fn(
+    &wgpu::Device,
+) -> (
+    &'static wgpu::ComputePipeline,
+    &'static wgpu::ComputePipeline,
+);
+
+/// Casts `params`' strata (its light's na x nb) from each of its `rec_w`
+/// points through `bvh`, a chunk of SAMPLES_PER_CHUNK samples per dispatch
+/// (lavapipe's loop budget), each point's clear rays counted into `seen`
+/// and their weights and every ray's summed into the weights (binding 9),
+/// then the resolve into the visibility and the weighted visibility; and
+/// the device's stage times. Segments t in (0, 1 - RAY_EPS) of each ray.
+pub(super) fn cast_point_rays<B>(
+    g: &Gpu,
+    bvh: &Bvh,
+    mut params: ExactParams,
+    rays: PointRays<B>,
+    sw: &mut Stopwatch,
+) -> Result<(Visibilities, Timings)>
+where
+    B: FnOnce(&wgpu::Device) -> (wgpu::Buffer, Vec<wgpu::Buffer>),
+{
+    let n = params.rec_w as usize;
+    params.rec_h = 1;
+    params.budget = BUDGET;
+    params.has_tris = u32::from(!bvh.is_empty());
+    params.t0 = 0.0;
+    params.t1 = 1.0 - RAY_EPS;
     let (na, nb) = params.strata();
     let bytes = n as u64 * 4;
     let out = with_error_scopes(g, || {
         let device = &g.device;
-        let p = pipelines(device);
+        let (cast, resolve) = (rays.pipelines)(device);
         let nodes = upload(device, "bvh nodes", &bvh.node_words());
         let tri_buf = upload(device, "bvh triangles", &bvh.triangle_floats());
-        let start_buf = upload(device, "ray starts", starts);
+        let (start_buf, own) = (rays.buffers)(device);
         let seen = storage(device, "seen samples", bytes, wgpu::BufferUsages::COPY_DST);
         let status = storage(
             device,
@@ -468,7 +514,7 @@ fn exact_visibility(
         sw.lap("upload");
         let timer = StageTimer::new(g, 1);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("softshadow eye exact"),
+            label: Some(rays.label),
         });
         enc.clear_buffer(&seen, 0, None);
         enc.clear_buffer(&weights, 0, None);
@@ -476,7 +522,7 @@ fn exact_visibility(
         {
             let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
             let groups = groups_1d(n as u32, GROUP);
-            pass.set_pipeline(&p.rays);
+            pass.set_pipeline(cast);
             for chunk_start in (0..na * nb).step_by(SAMPLES_PER_CHUNK as usize) {
                 let u = uniform(
                     device,
@@ -487,29 +533,27 @@ fn exact_visibility(
                         ..params
                     },
                 );
-                let bg = bind(
-                    device,
-                    &p.rays,
-                    &[
-                        None,
-                        Some(&nodes),
-                        Some(&tri_buf),
-                        Some(&u),
-                        None,
-                        None,
-                        Some(&seen),
-                        Some(&status),
-                        Some(&start_buf),
-                        Some(&weights),
-                    ],
-                );
+                let mut buffers = vec![
+                    None,
+                    Some(&nodes),
+                    Some(&tri_buf),
+                    Some(&u),
+                    None,
+                    None,
+                    Some(&seen),
+                    Some(&status),
+                    Some(&start_buf),
+                    Some(&weights),
+                ];
+                buffers.extend(own.iter().map(Some));
+                let bg = bind(device, cast, &buffers);
                 pass.set_bind_group(0, &bg, &[]);
                 pass.dispatch_workgroups(groups.0, groups.1, 1);
             }
             let u = uniform(device, "exact params", &params);
             let bg = bind(
                 device,
-                &p.rays_resolve,
+                resolve,
                 &[
                     None,
                     None,
@@ -523,7 +567,7 @@ fn exact_visibility(
                     Some(&weights),
                 ],
             );
-            pass.set_pipeline(&p.rays_resolve);
+            pass.set_pipeline(resolve);
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, 1);
         }

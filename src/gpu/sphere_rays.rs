@@ -2,24 +2,24 @@
 //! of `eye::sphere_rays::sphere_visibility` without its probe: the CPU sets
 //! every pixel up in f64 (its two ray origins and its cap frame, relative
 //! to the sphere's centre, `GpuSphereStart::new`) and the shared pattern's
-//! cap samples (`shared_cap_samples`); the device casts a chunk of samples
-//! per dispatch through the BVH of every triangle relative to the centre
-//! (`sphere_bvh`, exact.wgsl's traversal) and resolves the counts and
+//! cap samples (`shared_cap_samples`); the device casts them through the
+//! BVH of every triangle relative to the centre (`sphere_bvh`, exact.wgsl's
+//! traversal), a chunk of samples per dispatch, as `exact`'s planar rays
+//! (`eye::cast_point_rays`, which both drive), and resolves the counts and
 //! weights into the visibility and the weighted visibility.
 
 use super::context::Gpu;
-use super::dispatch::{bind, groups_1d, module, pipeline, storage, uniform, upload};
-use super::exact::{budget_error, ExactParams, BUDGET, SAMPLES_PER_CHUNK};
-use super::readback::{submit_and_read, visibility, with_error_scopes, words};
+use super::dispatch::{module, pipeline, uniform, upload};
+use super::exact::ExactParams;
+use super::eye::{cast_point_rays, PointRays};
 use super::refusals::fits;
-use super::timing::StageTimer;
 use crate::error::Result;
 use crate::eye::gbuffer::GBuffer;
 use crate::eye::sphere_rays::{ray_origins, shared_cap_samples};
 use crate::geom::light_shape::sphere::CapFrame;
 use crate::geom::light_shape::LightShape;
 use crate::geom::sphere_light::SphereLight;
-use crate::methods::exact::{Bvh, RAY_EPS};
+use crate::methods::exact::Bvh;
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -37,9 +37,6 @@ pub const SOURCE: &str = concat!(
     "\n",
     include_str!("sphere_rays.wgsl")
 );
-
-/// Invocations per workgroup (sphere_rays.wgsl's SPHERE_GROUP).
-const GROUP: u32 = 64;
 
 /// `SphereStart` of sphere_rays.wgsl: a pixel's two ray origins, normal and
 /// cap frame, relative to the sphere's centre; `valid` 0 inside the sphere.
@@ -164,12 +161,6 @@ pub(super) fn sphere_visibility(
     let table: Vec<f32> = table.iter().flat_map(|s| s.map(|x| x as f32)).collect();
     let mut params = ExactParams {
         rec_w: n as u32,
-        rec_h: 1,
-        budget: BUDGET,
-        has_tris: u32::from(!bvh.is_empty()),
-        // trace_packet's segments: t in (0, 1 - RAY_EPS).
-        t0: 0.0,
-        t1: 1.0 - RAY_EPS,
         ..Default::default()
     };
     // The strata of the shared pattern (the unit square's, as the CPU's).
@@ -179,109 +170,23 @@ pub(super) fn sphere_visibility(
         radius: light.radius as f32,
         ..Default::default()
     };
-    let bytes = n as u64 * 4;
-    let out = with_error_scopes(g, || {
-        let device = &g.device;
-        let p = pipelines(device);
-        let nodes = upload(device, "sphere bvh nodes", &bvh.node_words());
-        let tris = upload(device, "sphere bvh triangles", &bvh.triangle_floats());
-        let caps = upload(device, "sphere starts", &starts);
-        let table = upload(device, "cap samples", &table);
-        let su = uniform(device, "sphere params", &sphere);
-        let seen = storage(device, "seen samples", bytes, wgpu::BufferUsages::COPY_DST);
-        let status = storage(
-            device,
-            "status",
-            4,
-            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
-        let vis = storage(
-            device,
-            "visibility",
-            2 * bytes,
-            wgpu::BufferUsages::COPY_SRC,
-        );
-        let weights = storage(
-            device,
-            "cap weights",
-            2 * bytes,
-            wgpu::BufferUsages::COPY_DST,
-        );
-        sw.lap("upload");
-        let timer = StageTimer::new(g, 1);
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("softshadow eye sphere"),
-        });
-        enc.clear_buffer(&seen, 0, None);
-        enc.clear_buffer(&weights, 0, None);
-        enc.clear_buffer(&status, 0, None);
-        {
-            let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
-            let groups = groups_1d(n as u32, GROUP);
-            pass.set_pipeline(&p.cast);
-            for chunk_start in (0..na * nb).step_by(SAMPLES_PER_CHUNK as usize) {
-                let u = uniform(
-                    device,
-                    "exact params",
-                    &ExactParams {
-                        chunk_start,
-                        chunk_len: SAMPLES_PER_CHUNK.min(na * nb - chunk_start),
-                        ..params
-                    },
-                );
-                let bg = bind(
-                    device,
-                    &p.cast,
-                    &[
-                        None,
-                        Some(&nodes),
-                        Some(&tris),
-                        Some(&u),
-                        None,
-                        None,
-                        Some(&seen),
-                        Some(&status),
-                        Some(&caps),
-                        Some(&weights),
-                        Some(&table),
-                        Some(&su),
-                    ],
-                );
-                pass.set_bind_group(0, &bg, &[]);
-                pass.dispatch_workgroups(groups.0, groups.1, 1);
-            }
-            let u = uniform(device, "exact params", &params);
-            let bg = bind(
-                device,
-                &p.resolve,
-                &[
-                    None,
-                    None,
-                    None,
-                    Some(&u),
-                    None,
-                    Some(&vis),
-                    Some(&seen),
-                    None,
-                    Some(&caps),
-                    Some(&weights),
-                    None,
-                    None,
-                ],
-            );
-            pass.set_pipeline(&p.resolve);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(groups.0, groups.1, 1);
-        }
-        submit_and_read(g, enc, &timer, &[(&vis, 2 * bytes), (&status, 4)], sw)
-    })?;
-    if words(&out.buffers[1])[0] != 0 {
-        return Err(budget_error());
-    }
-    let mut v = visibility(&out.buffers[0])?;
-    let weighted = v.split_off(n);
+    let rays = PointRays {
+        label: "softshadow eye sphere",
+        pipelines: |d| {
+            let p = pipelines(d);
+            (&p.cast, &p.resolve)
+        },
+        buffers: |d: &wgpu::Device| {
+            let own = vec![
+                upload(d, "cap samples", &table),
+                uniform(d, "sphere params", &sphere),
+            ];
+            (upload(d, "sphere starts", &starts), own)
+        },
+    };
+    let ((v, weighted), timings) = cast_point_rays(g, bvh, params, rays, sw)?;
     Ok((
         v.into_iter().zip(weighted).map(|(v, w)| [v, w]).collect(),
-        out.device_timings,
+        timings,
     ))
 }
