@@ -60,6 +60,7 @@ mod light;
 pub(crate) mod light_view;
 mod method_kernel;
 mod pcss;
+mod point_rays;
 mod raster;
 mod readback;
 mod refusals;

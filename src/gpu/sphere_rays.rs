@@ -5,13 +5,13 @@
 //! cap samples (`shared_cap_samples`); the device casts them through the
 //! BVH of every triangle relative to the centre (`sphere_bvh`, exact.wgsl's
 //! traversal), a chunk of samples per dispatch, as `exact`'s planar rays
-//! (`eye::cast_point_rays`, which both drive), and resolves the counts and
+//! (`point_rays::cast_point_rays`), and resolves the counts and
 //! weights into the visibility and the weighted visibility.
 
 use super::context::Gpu;
 use super::dispatch::{module, pipeline, uniform, upload};
 use super::exact::ExactParams;
-use super::eye::{cast_point_rays, PointRays};
+use super::point_rays::{cast_point_rays, PointRays};
 use super::refusals::fits;
 use crate::error::Result;
 use crate::eye::gbuffer::GBuffer;
