@@ -84,18 +84,19 @@ def row(report: Report, name: str, kind: str, scene: Any, light: Any, cam: Any, 
     auto, auto_s, shading_s = timed_render(scene, light, cam, "auto", args.repeats)
     m = exact.mask
     plain = exact.unshadowed * exact.visibility[..., None]
-    bitmask = ssm = "–"
+    bitmask = ssm = pcss = "–"
     if not isinstance(light, ss.SphereLight):
         b = ss.render(scene, light, cam, method=ss.Bitmask(samples=1024))
         bitmask = f"{relative_error(b.shaded, reference, m):.4f}"
-    if not isinstance(light, ss.SphereLight):
         s = ss.render(scene, light, cam, method="ssm")
         ssm = f"{relative_error(s.shaded, reference, m):.4f}"
+        c = ss.render(scene, light, cam, method=ss.PCSS())
+        pcss = f"{relative_error(c.shaded, reference, m):.4f}"
     report.line(
         f"| {name} | {kind} | {relative_error(second, reference, m):.4f} | "
         f"{relative_error(exact.shaded, reference, m):.4f} | {relative_error(plain, reference, m):.4f} | "
         f"{exact_s * 1e3:.0f} | {relative_error(auto.shaded, reference, m):.4f} | {auto_s * 1e3:.0f} | "
-        f"{shading_s * 1e3:.1f} | {bitmask} | {ssm} | {relative_error(exact.unshadowed, reference, m):.4f} | "
+        f"{shading_s * 1e3:.1f} | {bitmask} | {ssm} | {pcss} | {relative_error(exact.unshadowed, reference, m):.4f} | "
         f"{mitsuba_seconds * 1e3:.0f} |"
     )
 
@@ -114,9 +115,9 @@ def main() -> None:
     report.line(
         f"| scene | light | Mitsuba noise (seed 1 vs 0) | exact {args.exact_samples}: error | "
         "V × unshadowed: error | time (ms) | auto: error | time (ms) | shading stage (ms) | bitmask: error | "
-        "ssm: error | unshadowed: error | Mitsuba direct (ms) |"
+        "ssm: error | pcss: error | unshadowed: error | Mitsuba direct (ms) |"
     )
-    report.line("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    report.line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in args.scenes:
         scene, light, cam = EYE_SCENES[name](res)
         for kind, lt in lights_of(light):
@@ -130,8 +131,8 @@ def main() -> None:
         "warm-up; Mitsuba's is one render, scene loading and JIT included. The lights emit 1 and every "
         "mesh's albedo is 0.8; `city`'s sun is made hard (Mitsuba's directional emitter is a delta), so "
         "`exact` casts one ray a pixel there. `V × unshadowed` is exact's visibility with every part of the "
-        "light weighted alike (what the map methods but `bitmask` and `ssm` shade with; they weigh their light "
-        "samples and micro-patches, docs/shading.md). The disk has the rectangle's "
+        "light weighted alike (what `smoothies` and `shadow_mapping` shade with; `bitmask`, `ssm` and `pcss` "
+        "weigh their light samples, micro-patches and filter cells, docs/shading.md). The disk has the rectangle's "
         "area, the sphere the disk's radius, both at its centre. The shading stage is "
         "`img.timings['shading']` of the `auto` renders (the albedo image, the closed form at every pixel that "
         "sees a surface)."

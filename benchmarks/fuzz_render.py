@@ -998,12 +998,13 @@ def check_image(img: Any, ns: dict) -> list[str]:
                 bad.append(f"{name}: negative values")
             if (a[miss] != 0).any():
                 bad.append(f"{name}: non-zero where no surface")
-        # exact, and ssm and bitmask under an area light, weigh their
+        # exact, and ssm, bitmask and pcss under an area light, weigh their
         # samples (shaded = unshadowed * V_w): where V is 0 or 1 so is V_w,
         # and V_w lies in [0, 1] everywhere; the other methods shade with V.
         want = un * vis[..., None]
         kind = type(img.method).__name__
-        weighs = kind == "Exact" or (kind in ("Ssm", "Bitmask") and not isinstance(img.light, ss.DirectionalLight))
+        area = not isinstance(img.light, ss.DirectionalLight)
+        weighs = kind == "Exact" or (kind in ("Ssm", "Bitmask", "PCSS") and area)
         settled = (vis == 0) | (vis == 1) if weighs else np.ones_like(vis, bool)
         off = (np.abs(sh.astype(np.float64) - want) > 1e-5 * np.abs(want) + 1e-30) & settled[..., None]
         if off.any():

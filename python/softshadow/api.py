@@ -361,12 +361,14 @@ def render(
     (docs/shading.md): ``unshadowed = albedo / pi * E``, E the irradiance
     from the light's ``radiance`` (or the sun's ``irradiance``) in closed
     form at the pixel's point and geometric normal (facing the camera), and
-    ``shaded`` the shadowed direct light: ``exact`` weighs each of its
-    samples by what it adds to the irradiance (cos θ cos θ' / r^2), so
-    ``shaded = unshadowed * V_w`` with V_w the share of the irradiance the
-    clear samples carry; the map methods shade with ``unshadowed *
-    visibility``, which weights every part of the light alike (exact where
-    a pixel is fully lit or in umbra). ``img.albedo`` is the albedo shaded
+    ``shaded`` the shadowed direct light: ``exact``, ``bitmask``, ``ssm``
+    and ``pcss`` weigh each of their samples (rays, light samples,
+    micro-patches, filter cells) by what it adds to the irradiance
+    (cos θ cos θ' / r^2), so ``shaded = unshadowed * V_w`` with V_w the
+    share of the irradiance the clear ones carry; ``smoothies`` and
+    ``shadow_mapping`` shade with ``unshadowed * visibility``, which weights
+    every part of the light alike (exact where a pixel is fully lit or in
+    umbra). ``img.albedo`` is the albedo shaded
     with: each mesh's colours, materials and textures read by
     :meth:`Scene.from_trimesh`, or ``albedo=``. The shading runs on the CPU
     after the visibility, on every backend.

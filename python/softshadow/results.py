@@ -257,11 +257,12 @@ class Image:
     (H, W) for one light; (L, H, W), one per light in order, when
     :func:`softshadow.render` was given a list of lights."""
     shaded: np.ndarray
-    """float32 (H, W, 3) RGB radiance toward the camera, ``unshadowed *
-    visibility`` summed over the lights; 0 where no surface. An
-    approximation of the shadowed direct light: the exact one weights each
-    visible part of the light by its cosine (and 1/r^2), the visibility
-    weights them alike (see docs/shading.md for its measured size)."""
+    """float32 (H, W, 3) RGB radiance toward the camera, the shadowed
+    direct light summed over the lights; 0 where no surface. It weights
+    each visible part of the light by its cosine (and 1/r^2) where the
+    method weighs its samples (``exact``, ``bitmask``, ``ssm``, ``pcss``),
+    else it is ``unshadowed * visibility``, which weights them alike (see
+    docs/shading.md for the measured difference)."""
     unshadowed: np.ndarray
     """float32 (H, W, 3) RGB radiance toward the camera without shadows,
     ``albedo / pi * E`` with E the lights' irradiance in closed form, summed

@@ -238,7 +238,9 @@ pub fn shading_points(
 
 /// What the map methods give for the visible points: each one's visibility,
 /// beside it its weighted visibility where the method weighs its samples
-/// (the bitmask under an area light: `methods::shade_points_weighted`),
+/// (under an area light the bitmask's and the SSM's,
+/// `methods::shade_points_weighted`, and PCSS's filter cells,
+/// `Pcss::weighted_on_planes`),
 /// and the maps.
 pub struct MapShading {
     pub visibility: Vec<f32>,
@@ -315,11 +317,19 @@ pub(crate) fn shade(
             .shade(&inputs, &tris.verts, tris.faces, &sp.points, &sp.planes),
             None,
         ),
-        Method::Pcss { max_taps } => (
-            crate::methods::pcss::Pcss { max_taps }
-                .visibility_on_planes(&inputs, &sp.points, &sp.planes),
-            None,
-        ),
+        Method::Pcss { max_taps } => {
+            let pcss = crate::methods::pcss::Pcss { max_taps };
+            match &receivers {
+                Some(r) => {
+                    let (v, w) = pcss.weighted_on_planes(&inputs, &sp.points, &sp.planes, r);
+                    (v, Some(w))
+                }
+                None => (
+                    pcss.visibility_on_planes(&inputs, &sp.points, &sp.planes),
+                    None,
+                ),
+            }
+        }
         _ => match &receivers {
             Some(r) => crate::methods::shade_points_weighted(method, &inputs, &sp.points, r),
             None => (

@@ -658,6 +658,30 @@ mod eye {
 
     /// The pixels where both images see the same surface point (the same
     /// mesh, the same f64 position: the same triangle).
+    /// The CPU's and the GPU's weighted visibilities (the shaded image's;
+    /// summed in f64 and in f32): their mean |difference| over the pixels
+    /// both backends see alike (`same`), and how many of those the weights
+    /// move off the plain visibility by more than 1e-3. None where neither
+    /// weighs; a panic where one does and the other not.
+    fn weighted_apart(c: &EyeImage, g: &EyeImage, same: &[bool]) -> Option<(f64, usize)> {
+        match (&c.weighted, &g.weighted) {
+            (Some(cw), Some(gw)) => {
+                let dw: Vec<f64> = (0..cw.len())
+                    .filter(|&k| same[k])
+                    .map(|k| (cw[k] as f64 - gw[k] as f64).abs())
+                    .collect();
+                let mean = dw.iter().sum::<f64>() / dw.len() as f64;
+                let weighed = (0..cw.len())
+                    .filter(|&k| same[k] && (cw[k] - c.visibility[k]).abs() > 1e-3)
+                    .count();
+                eprintln!("  weighted: mean |dV_w| {mean:.2e}, {weighed} weighed apart");
+                Some((mean, weighed))
+            }
+            (None, None) => None,
+            _ => panic!("one backend weighs, the other not"),
+        }
+    }
+
     fn same_surface(a: &EyeImage, b: &EyeImage) -> Vec<bool> {
         let (a, b) = (&a.gbuffer, &b.gbuffer);
         (0..a.len())
@@ -767,27 +791,17 @@ mod eye {
                 // The weighted visibility (the shaded image's: the map
                 // methods' under the rectangle), summed in f32 on the
                 // device, f64 on the CPU.
-                match (&c.output.weighted, &g.output.weighted) {
-                    (Some(cw), Some(gw)) => {
+                match weighted_apart(&c.output, &g.output, &same) {
+                    Some((mean, weighed)) => {
                         // (exact weighs under the sun too, alike: V_w = V.)
                         assert!(lname == "rect" || mname == "exact", "{mname}");
-                        let dw: Vec<f64> = (0..cw.len())
-                            .filter(|&k| same[k])
-                            .map(|k| (cw[k] as f64 - gw[k] as f64).abs())
-                            .collect();
-                        let mean = dw.iter().sum::<f64>() / dw.len() as f64;
-                        let weighed = (0..cw.len())
-                            .filter(|&k| same[k] && (cw[k] - cv[k]).abs() > 1e-3)
-                            .count();
-                        eprintln!("  weighted: mean |dV_w| {mean:.2e}, {weighed} weighed apart");
                         assert!(mean <= 1e-4, "{lname} {mname}: mean |dV_w| {mean}");
                         assert!(
                             weighed > 10 || lname == "sun",
                             "{lname} {mname}: the weights change nothing"
                         );
                     }
-                    (None, None) => assert!(lname == "sun", "{mname} weighs on neither"),
-                    _ => panic!("{lname} {mname}: one backend weighs, the other not"),
+                    None => assert!(lname == "sun", "{mname} weighs on neither"),
                 }
                 match (&c.output.maps, &g.output.maps) {
                     (Some(a), Some(b)) => {
@@ -1596,6 +1610,16 @@ mod eye {
                     flips * 500 <= dv.len(),
                     "{lname} pcss {taps}: {flips} flips"
                 );
+                // The weighted visibility (the shaded image's) under an
+                // area light: the filter's cells weighed (pcss_weighted.rs).
+                match weighted_apart(&c.output, &g.output, &same) {
+                    Some((mean, weighed)) => {
+                        assert_ne!(lname, "sun");
+                        assert!(mean <= 1e-4, "{lname} pcss {taps}: mean |dV_w| {mean}");
+                        assert!(weighed > 10, "{lname} pcss: the weights change nothing");
+                    }
+                    None => assert_eq!(lname, "sun", "pcss weighs on neither"),
+                }
                 let (a, b) = (c.output.maps.unwrap(), g.output.maps.unwrap());
                 assert_eq!(a.grid, b.grid);
                 assert_eq!((a.layers.len(), b.layers.len()), (1, 1));
@@ -1764,6 +1788,7 @@ mod pcss {
     use crate::geom::light::MapGrid;
     use crate::gpu::context::gpu;
     use crate::gpu::dispatch::upload;
+    use crate::gpu::irradiance_weight::GpuWeighPoint;
     use crate::gpu::pcss::{chunking, PcssShading};
     use crate::gpu::readback::{submit_and_read, visibility, with_error_scopes};
     use crate::gpu::timing::StageTimer;
@@ -1903,10 +1928,22 @@ mod pcss {
         front: &[f32],
         points: &[LightPoint],
     ) -> Vec<f32> {
+        gpu_points_weighed(og, light, taps, front, points, None)
+    }
+
+    /// `gpu_points`, with `weigh` the weighted visibility after the plain.
+    fn gpu_points_weighed(
+        og: &MapGrid,
+        light: LightShape,
+        taps: u32,
+        front: &[f32],
+        points: &[LightPoint],
+        weigh: Option<&[GpuWeighPoint]>,
+    ) -> Vec<f32> {
         let g = gpu().unwrap();
         let out = with_error_scopes(g, || {
             let maps = upload(&g.device, "maps", front);
-            let sh = PcssShading::points(g, og, light, taps, 0, points, &[])?;
+            let sh = PcssShading::points(g, og, light, taps, 0, points, &[], weigh)?;
             let timer = StageTimer::new(g, 1);
             let mut enc = g
                 .device
@@ -1922,6 +1959,59 @@ mod pcss {
         })
         .unwrap();
         visibility(&out.buffers[0]).unwrap()
+    }
+
+    /// The weighted visibility of points mode against the CPU's
+    /// (`Pcss::weighted_on_planes`) on the weighted plate, under the square
+    /// and the disk, every texel read and with strata; the plain
+    /// visibility is unchanged by weighing.
+    #[test]
+    fn weighted_points_mode_is_the_cpus() {
+        if !device_or_skip() {
+            return;
+        }
+        use crate::methods::plate_case::WeightedPlate;
+        use crate::methods::shadow_rays::RayOrigin;
+        for (shape, taps) in [
+            (LightShape::rect([1.0, 1.0]), 64),
+            (LightShape::rect([1.0, 1.0]), 5),
+            (LightShape::disk(0.5), 64),
+            (LightShape::disk(0.5), 5),
+        ] {
+            let plate = WeightedPlate::new(32, glam::Vec3::new(0.5, -0.6, -1.0)).under(shape);
+            let inputs = plate.inputs();
+            let pcss = Pcss { max_taps: taps };
+            let (cv, cw) = pcss.weighted_on_planes(&inputs, &plate.pts, &[], &plate.surfaces);
+            let weigh: Vec<GpuWeighPoint> = plate
+                .surfaces
+                .iter()
+                .map(|s| GpuWeighPoint::from_surface(s.as_ref().and_then(|s| s.surface())))
+                .collect();
+            let both = gpu_points_weighed(
+                &plate.grid,
+                shape,
+                taps,
+                &plate.front,
+                &plate.pts,
+                Some(&weigh),
+            );
+            let n = plate.pts.len();
+            assert_eq!(both.len(), 2 * n);
+            let (gv, gw) = both.split_at(n);
+            let (vmax, _, _) = compare(&cv, gv);
+            let (wmax, wmean, _) = compare(&cw, gw);
+            let weighed = (0..n).filter(|&k| (cw[k] - cv[k]).abs() > 1e-3).count();
+            eprintln!(
+                "{shape:?} {taps}: plain max {vmax:.2e}; weighted max {wmax:.2e}, mean \
+                 {wmean:.2e}; {weighed} weighed apart"
+            );
+            assert!(vmax <= 1e-5, "{shape:?} {taps}: plain {vmax}");
+            assert!(wmax <= 1e-4, "{shape:?} {taps}: weighted {wmax}");
+            assert!(weighed > 50, "{shape:?} {taps}: {weighed} weighed apart");
+            // Unweighed, the same plain visibility.
+            let plain = gpu_points(&plate.grid, shape, taps, &plate.front, &plate.pts);
+            assert_eq!(plain, gv);
+        }
     }
 
     #[test]

@@ -18,7 +18,7 @@ use super::readback::{submit_and_read, visibility, with_error_scopes, words};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::eye::maps::{self, LightTriangles, ShadingPoints};
-use crate::eye::{Bias, EyeMaps, Framed};
+use crate::eye::{Bias, EyeMaps, Framed, MapShading};
 use crate::geom::light::MapGrid;
 use crate::raster::setup_triangles;
 use crate::timing::{Stopwatch, Timings};
@@ -69,7 +69,9 @@ impl FrontLayer {
     /// The device's part: the layer, then the stage `make` builds (inside
     /// the error scopes, so a failed allocation is an error, not a panic),
     /// reading the layer at offset 0; `stages` timed stages in all; the
-    /// visibility per point, the maps and the device's stage times.
+    /// visibility per point (and the weighted visibility, where the stage's
+    /// visibility buffer holds it after the plain one), the maps and the
+    /// device's stage times.
     pub fn shade<S: Stage>(
         self,
         g: &Gpu,
@@ -78,7 +80,7 @@ impl FrontLayer {
         stages: u32,
         make: impl FnOnce() -> Result<S>,
         sw: &mut Stopwatch,
-    ) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+    ) -> Result<(MapShading, Timings)> {
         let bytes = self.grid.len() as u64 * 4;
         let out = with_error_scopes(g, || {
             let maps_buf = storage(&g.device, "maps", bytes, wgpu::BufferUsages::COPY_SRC);
@@ -98,16 +100,24 @@ impl FrontLayer {
             Ok(out)
         })?;
         let mut v = visibility(&out.buffers[1])?;
+        let n = self.points.bound.len();
+        let mut weighted = (v.len() > n).then(|| v.split_off(n));
         maps::finish(&mut v, &self.points.bound);
+        if let Some(w) = &mut weighted {
+            maps::finish_weighted(w, &self.points.bound);
+        }
         let front = words(&out.buffers[0])
             .par_iter()
             .map(|&b| maps::user_depth(&f.space, f.unit, f32::from_bits(b)))
             .collect();
         Ok((
-            v,
-            EyeMaps {
-                grid: self.grid,
-                layers: vec![front],
+            MapShading {
+                visibility: v,
+                weighted,
+                maps: EyeMaps {
+                    grid: self.grid,
+                    layers: vec![front],
+                },
             },
             out.device_timings,
         ))

@@ -24,7 +24,12 @@ use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-pub const GATHER_SOURCE: &str = include_str!("gather.wgsl");
+/// gather.wgsl after the receivers' weights its weighted resolves read.
+pub const GATHER_SOURCE: &str = concat!(
+    include_str!("irradiance_weight.wgsl"),
+    "\n",
+    include_str!("gather.wgsl")
+);
 pub const SSM_SOURCE: &str = concat!(
     include_str!("disk_overlap.wgsl"),
     "\n",
@@ -201,32 +206,6 @@ pub struct GpuPoint {
     pub y: f32,
     pub wr: f32,
     pub live: u32,
-}
-
-/// `WeighPoint` of gather.wgsl: a sorted point's surface point (kernel
-/// space) and tangent plane, for the weighted resolve (`eye::rays::RayStart`:
-/// the midpoint of its starts, its `side`); valid 0 where it has none.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
-pub struct GpuWeighPoint {
-    pub p: [f32; 3],
-    pub valid: u32,
-    pub side: [f32; 3],
-    pub _pad: u32,
-}
-
-impl GpuWeighPoint {
-    pub fn new(r: Option<&crate::eye::rays::RayStart>) -> GpuWeighPoint {
-        r.map_or_else(GpuWeighPoint::default, |r| {
-            let s = r.surface_point();
-            GpuWeighPoint {
-                p: s.p.to_array(),
-                valid: 1,
-                side: s.side,
-                _pad: 0,
-            }
-        })
-    }
 }
 
 /// `GroupBounds` of gather.wgsl: a group's bounds over its active lanes.

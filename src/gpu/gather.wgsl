@@ -314,28 +314,9 @@ const POINTS_GROUP: u32 = 64u;
 // too small): an error, never a silently partial sum.
 @group(0) @binding(12) var<storage, read_write> points_status: array<atomic<u32>>;
 
-// The weighted visibility's receivers (methods/bitmask/weighted.rs,
-// methods/ssm/weighted.rs): per sorted point its surface point p (kernel
-// space, the midpoint of its ray starts) and its tangent plane's
-// side(x, y) = side.x + x side.y + y side.z; valid 0 where it has none.
-// Shared with Rust (`GpuWeighPoint` in gather.rs).
-struct WeighPoint {
-    p: vec3<f32>,
-    valid: u32,
-    side: vec3<f32>,
-    _pad: u32,
-}
-
+// The weighted visibility's receivers (`WeighPoint`, irradiance_weight.wgsl),
+// one per sorted point.
 @group(0) @binding(14) var<storage, read> weigh_points: array<WeighPoint>;
-
-// The light point (x, y, 0)'s share of the irradiance at wp (eye/rays.rs's
-// RayStart::weight): max(side, 0) p_z / r⁴.
-fn irradiance_weight(wp: WeighPoint, x: f32, y: f32) -> f32 {
-    let side = wp.side.x + x * wp.side.y + y * wp.side.z;
-    let q = vec3<f32>(x, y, 0.0) - wp.p;
-    let r2 = dot(q, q);
-    return max(side, 0.0) * wp.p.z / (r2 * r2);
-}
 
 fn point_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
     return gid.x + gid.y * groups.x * POINTS_GROUP;

@@ -19,10 +19,10 @@
 
 use super::context::Gpu;
 use super::dispatch::{storage, upload};
-use super::gather::GpuWeighPoint;
 use super::gather::{
     self, GatherBuffers, GpuGroup, GpuPoint, PointsBuffers, PointsParams, POINT_GROUP,
 };
+use super::irradiance_weight::GpuWeighPoint;
 use super::light;
 use super::method_kernel::{EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage};
 use super::raster::{GpuTri, RasterInput};

@@ -56,6 +56,7 @@ mod from_meshes;
 mod front_layer;
 mod gather;
 mod gather_points;
+mod irradiance_weight;
 mod light;
 pub(crate) mod light_view;
 mod method_kernel;

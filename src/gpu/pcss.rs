@@ -19,12 +19,15 @@
 use super::context::Gpu;
 use super::dispatch::{bind, groups_1d, module, pipeline, storage, upload};
 use super::front_layer::FrontLayer;
+use super::irradiance_weight::GpuWeighPoint;
 use super::method_kernel::{mismatch, EyeInputs, GpuKernel, LightViewInputs, MakeStage, Stage};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::{EyeMaps, MapShading};
+use crate::eye::rays::ray_starts;
+use crate::eye::MapShading;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
+use crate::geom::light_space::LightSpace;
 use crate::geom::plane_gradient::{split, Plane};
 use crate::methods::pcss::{half_per_w, MAX_TAPS};
 use crate::methods::{LightPoint, Method};
@@ -33,9 +36,12 @@ use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
-/// pcss.wgsl after the disk overlap it weighs cells by under a disk.
+/// pcss.wgsl after the disk overlap it weighs cells by under a disk and
+/// the receivers' weights of its weighted resolve.
 pub const SOURCE: &str = concat!(
     include_str!("disk_overlap.wgsl"),
+    "\n",
+    include_str!("irradiance_weight.wgsl"),
     "\n",
     include_str!("pcss.wgsl")
 );
@@ -66,9 +72,11 @@ pub struct PcssParams {
     pub half_per_w_y: f32,
     /// 1 under a disk light: the boxes' inscribed ellipses (`pcf_disk.rs`).
     pub disk: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
+    /// 1: the weighted visibility too (points mode, `pcss_weighted.rs`).
+    pub weigh: u32,
+    /// The light's half-extents (kernel units), for the weights.
+    pub half_lx: f32,
+    pub half_ly: f32,
 }
 
 /// `PcssChunk` of pcss.wgsl.
@@ -171,15 +179,17 @@ pub struct PcssShading {
     chunks: u32,
     coords: wgpu::Buffer,
     points: wgpu::Buffer,
+    weigh_points: wgpu::Buffer,
     near: wgpu::Buffer,
     acc: wgpu::Buffer,
     pub vis: wgpu::Buffer,
     pub vis_bytes: u64,
 }
 
-/// Refuses `n` points whose accumulators (16 bytes each) do not fit one binding.
-fn check_points(g: &Gpu, arg: &str, n: usize) -> Result<()> {
-    let bytes = 16 * n as u64;
+/// Refuses `n` points whose accumulators (16 bytes each, twice where
+/// weighed) do not fit one binding.
+fn check_points(g: &Gpu, arg: &str, n: usize, weigh: bool) -> Result<()> {
+    let bytes = 16 * n as u64 * (1 + weigh as u64);
     if n as u64 >= u32::MAX as u64 || bytes > g.max_storage_binding {
         return Err(Error::too_large(
             arg,
@@ -204,6 +214,7 @@ impl PcssShading {
         mut params: PcssParams,
         coords: &[Coord],
         points: &[GpuPcssPoint],
+        weigh: Option<&[GpuWeighPoint]>,
     ) -> PcssShading {
         let device = &g.device;
         let taps = max_taps.clamp(1, MAX_TAPS);
@@ -218,17 +229,28 @@ impl PcssShading {
         params.half_per_w_x = hx as f32;
         params.half_per_w_y = hy as f32;
         params.disk = u32::from(matches!(light_shape, LightShape::Disk { .. }));
-        let vis_bytes = params.n as u64 * 4;
+        let [lx, ly] = light_shape.half_extent();
+        params.half_lx = lx as f32;
+        params.half_ly = ly as f32;
+        params.weigh = u32::from(weigh.is_some());
+        // Weighing, the weighted accumulators and visibility follow the plain.
+        let copies = 1 + params.weigh as u64;
+        let vis_bytes = params.n as u64 * 4 * copies;
         PcssShading {
             params,
             chunks,
             coords: upload(device, "pcss coords", coords),
             points: upload(device, "pcss points", points),
+            weigh_points: upload(
+                device,
+                "pcss weighed points",
+                weigh.unwrap_or(&[GpuWeighPoint::default()]),
+            ),
             near: storage(device, "pcss z_near", 4, wgpu::BufferUsages::COPY_DST),
             acc: storage(
                 device,
                 "pcss accumulators",
-                params.n as u64 * 16,
+                params.n as u64 * 16 * copies,
                 wgpu::BufferUsages::COPY_DST,
             ),
             vis: storage(
@@ -251,7 +273,7 @@ impl PcssShading {
         max_taps: u32,
         front_offset: u32,
     ) -> Result<PcssShading> {
-        check_points(g, "resolution", grid.len())?;
+        check_points(g, "resolution", grid.len(), false)?;
         // The CPU's receiver tangents (f32), then the occluder grid's pixels.
         let coords: Vec<Coord> = (0..grid.width)
             .map(|i| Coord::new(og.to_pixel(grid.x_of(i) as f32 as f64, 0.0).0))
@@ -276,11 +298,14 @@ impl PcssShading {
             params,
             &coords,
             &[],
+            None,
         ))
     }
 
     /// Points mode: the visibility of each of `points` (kernel light space),
-    /// from the front layer on `og` at `front_offset`.
+    /// from the front layer on `og` at `front_offset`; with `weigh` (a
+    /// receiver per point) the weighted visibility after it.
+    #[allow(clippy::too_many_arguments)]
     pub fn points(
         g: &Gpu,
         og: &MapGrid,
@@ -289,8 +314,10 @@ impl PcssShading {
         front_offset: u32,
         points: &[LightPoint],
         planes: &[Plane],
+        weigh: Option<&[GpuWeighPoint]>,
     ) -> Result<PcssShading> {
-        check_points(g, "resolution", points.len())?;
+        check_points(g, "resolution", points.len(), weigh.is_some())?;
+        debug_assert!(weigh.is_none_or(|w| w.len() == points.len()));
         let pts: Vec<GpuPcssPoint> = points
             .par_iter()
             .enumerate()
@@ -311,6 +338,7 @@ impl PcssShading {
             params,
             &[],
             &pts,
+            weigh,
         ))
     }
 
@@ -330,7 +358,7 @@ impl PcssShading {
         let u = super::dispatch::uniform(device, "pcss params", &self.params);
         let mut pass = enc.begin_compute_pass(&timer.pass("shadow"));
         // Bindings an entry point does not use are not in its layout.
-        let only = |pl: &wgpu::ComputePipeline, used: [bool; 8], c: Option<&wgpu::Buffer>| {
+        let only = |pl: &wgpu::ComputePipeline, used: [bool; 9], c: Option<&wgpu::Buffer>| {
             let all = [
                 Some(maps),
                 Some(&u),
@@ -340,6 +368,7 @@ impl PcssShading {
                 Some(&self.acc),
                 Some(&self.vis),
                 c,
+                Some(&self.weigh_points),
             ];
             let picked: Vec<Option<&wgpu::Buffer>> = all
                 .iter()
@@ -354,15 +383,15 @@ impl PcssShading {
             0,
             &only(
                 &p.near,
-                [true, true, false, false, true, false, false, false],
+                [true, true, false, false, true, false, false, false, false],
                 None,
             ),
             &[],
         );
         pass.dispatch_workgroups(near_groups.0, near_groups.1, 1);
         let groups = groups_1d(self.params.n, GROUP);
-        let used = [true, true, true, true, true, true, false, true];
-        for stage in [&p.search, &p.filter] {
+        for (stage, weighs) in [(&p.search, false), (&p.filter, true)] {
+            let used = [true, true, true, true, true, true, false, true, weighs];
             pass.set_pipeline(stage);
             for chunk in 0..self.chunks {
                 let c = super::dispatch::uniform(
@@ -382,7 +411,7 @@ impl PcssShading {
             0,
             &only(
                 &p.resolve,
-                [true, true, true, true, true, true, true, false],
+                [true, true, true, true, true, true, true, false, true],
                 None,
             ),
             &[],
@@ -392,15 +421,26 @@ impl PcssShading {
 }
 
 /// The eye view's PCSS (`maps::shade` with `Method::Pcss` on the device):
-/// the visibility per visible point of `e.f`, the front layer (user depth),
-/// and the device's stage times.
+/// the visibility per visible point of `e.f` (under an area light its
+/// weighted visibility too), the front layer (user depth), and the
+/// device's stage times.
 fn shade_points(
     g: &Gpu,
     e: &EyeInputs,
     max_taps: u32,
     sw: &mut Stopwatch,
-) -> Result<(Vec<f32>, EyeMaps, Timings)> {
-    let mut front = FrontLayer::new(g, e.f, e.tris, e.grid, e.bias, true)?;
+) -> Result<(MapShading, Timings)> {
+    let f = e.f;
+    let mut front = FrontLayer::new(g, f, e.tris, e.grid, e.bias, true)?;
+    // maps::shade's receivers: the unbiased surface points, under an area
+    // light (the sun's shading has no weights).
+    let weigh: Option<Vec<GpuWeighPoint>> =
+        (matches!(f.space, LightSpace::Area(_)) && !f.light_shape.is_point()).then(|| {
+            ray_starts(&f.space, f.unit, &f.points, &f.normals)
+                .par_iter()
+                .map(|r| GpuWeighPoint::new(r.as_ref()))
+                .collect()
+        });
     sw.lap("setup");
     // The points and planes are the kernel's alone (`shade` reads their
     // bounds only).
@@ -409,10 +449,21 @@ fn shade_points(
     let planes = std::mem::take(&mut front.points.planes);
     front.shade(
         g,
-        e.f,
+        f,
         "softshadow eye pcss",
         2,
-        || PcssShading::points(g, &grid, e.f.light_shape, max_taps, 0, &points, &planes),
+        || {
+            PcssShading::points(
+                g,
+                &grid,
+                f.light_shape,
+                max_taps,
+                0,
+                &points,
+                &planes,
+                weigh.as_deref(),
+            )
+        },
         sw,
     )
 }
@@ -466,7 +517,6 @@ impl GpuKernel for PcssKernel {
         let Method::Pcss { max_taps } = method else {
             return Err(mismatch(method));
         };
-        let (v, maps, t) = shade_points(g, inputs, max_taps, sw)?;
-        Ok((MapShading::unweighted(v, maps), t))
+        shade_points(g, inputs, max_taps, sw)
     }
 }

@@ -49,6 +49,14 @@
 // reads (1 for a texel's part, 1 - t and t for a tap); the ellipse's part
 // outside the map (1 - its overlap with the map) is lit.
 //
+// Weighted (pp.weigh, points mode under an area light; methods/
+// pcss_weighted.rs): the filter also sums, per cell that reads a shadowed
+// texel, its weight times the irradiance weight of the light point the
+// cell stands for (u Lx/2, -v Ly/2), (u, v) the cell centre's offset from
+// the point over the half-widths (irradiance_weight.wgsl); the resolve
+// writes vis[n + idx] = 1 - min(H / mean weight, 1), H that sum over the
+// filter's weights and part off the map, where 0 < V < 1.
+//
 // Two modes, one kernel: map mode (mode 0), one invocation per output texel,
 // its coordinates from per-column and per-row tables and its depth from the
 // receiver map; points mode (mode 1, the eye view), one invocation per
@@ -76,9 +84,11 @@ struct PcssParams {
     half_per_w_y: f32,
     // 1 under a disk light: the boxes' inscribed ellipses.
     disk: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: the weighted visibility too (points mode; `weigh_points`).
+    weigh: u32,
+    // The light's half-extents (kernel units), for the weights.
+    half_lx: f32,
+    half_ly: f32,
 }
 
 // Which chunk of y entries a dispatch reads. Shared with Rust (`PcssChunk`).
@@ -118,10 +128,14 @@ struct PcssPoint {
 @group(0) @binding(3) var<storage, read> points: array<PcssPoint>;
 // INF_BITS - bits(z_near), 0 (cleared) when the map holds no occluder.
 @group(0) @binding(4) var<storage, read_write> near: array<atomic<u32>>;
-// Per point: (sw, Σ w (d - z_near), filter Σ w test, filter Σ w), zeroed.
+// Per point: (sw, Σ w (d - z_near), filter Σ w test, filter Σ w), zeroed;
+// weighing, then per point (filter Σ w (1 - test) irradiance weight, 0, 0, 0).
 @group(0) @binding(5) var<storage, read_write> acc: array<vec4<f32>>;
+// Per point its visibility; weighing, then per point its weighted one.
 @group(0) @binding(6) var<storage, read_write> vis: array<f32>;
 @group(0) @binding(7) var<uniform> chunk: PcssChunk;
+// Weighing: per point its receiver (one unread entry otherwise).
+@group(0) @binding(8) var<storage, read> weigh_points: array<WeighPoint>;
 
 const INF_BITS: u32 = 0x7f800000u;
 // pcf.rs's MAX_HALF: the largest half-width the weights are computed with.
@@ -320,8 +334,11 @@ fn filter_axes(p: Pt, z_near: f32, s: vec4<f32>) -> array<Axis, 2> {
 // sums of up to 2m x 2m terms need: each y entry's terms in `row`, then the
 // row into `sum` (the CPU sums in f64; measured with 256 taps over 640²
 // boxes, a one-level f32 sum was 2e-4 off, the two-level one ~1e-6).
-var<private> sum: vec2<f32>;
-var<private> row: vec2<f32>;
+// (The filter's third component: the weighted shadowed sum.)
+var<private> sum: vec3<f32>;
+var<private> row: vec3<f32>;
+// The filter's weighing receiver, where pp.weigh.
+var<private> weigh_point: WeighPoint;
 
 // pcss.rs's `plane_depth`: the depth of the point's tangent plane at
 // texel (i, j), the same f32 operations; z itself for a plane of (0, 0).
@@ -338,16 +355,28 @@ fn plane_z(p: Pt, i: i32, j: i32) -> f32 {
     return bitcast<f32>(INF_BITS);
 }
 
-fn add(i: i32, j: i32, w: f32, p: Pt, z_near: f32, search: bool) {
+// `lw`: the irradiance weight of the cell's light point (0 unweighed).
+fn add(i: i32, j: i32, w: f32, lw: f32, p: Pt, z_near: f32, search: bool) {
     let d = front(i, j);
     let occludes = d > 0.0 && d < plane_z(p, i, j);
     if search {
         if occludes {
-            row += vec2<f32>(w, w * (d - z_near));
+            row += vec3<f32>(w, w * (d - z_near), 0.0);
         }
     } else {
-        row += vec2<f32>(select(w, 0.0, occludes), w);
+        row += vec3<f32>(select(w, 0.0, occludes), w, select(0.0, w * lw, occludes));
     }
+}
+
+// The irradiance weight of the light point cell (ex, ey) stands for
+// (pcss_weighted.rs): 0 in the search or unweighed.
+fn light_point_weight(ax: Axis, ay: Axis, ex: Entry, ey: Entry, search: bool) -> f32 {
+    if search || pp.weigh == 0u {
+        return 0.0;
+    }
+    let u = (0.5 * (ex.c0 + ex.c1) - ax.frac) / ax.h;
+    let v = (0.5 * (ey.c0 + ey.c1) - ay.frac) / ay.h;
+    return irradiance_weight(weigh_point, u * pp.half_lx, -v * pp.half_ly);
 }
 
 // The cell (ex, ey)'s weight: 1 for the box (its entries' weights are the
@@ -370,27 +399,28 @@ fn visit(ax: Axis, ay: Axis, p: Pt, z_near: f32, search: bool) {
     let k1 = min(k0 + pp.rows_per_chunk, ay.count);
     for (var ky = k0; ky < k1; ky++) {
         let ey = entry(ay, ky);
-        row = vec2<f32>(0.0);
+        row = vec3<f32>(0.0);
         for (var kx = 0u; kx < ax.count; kx++) {
             let ex = entry(ax, kx);
             let c = cell_weight(ax, ay, ex, ey);
             if !(c > 0.0) {
                 continue;
             }
+            let lw = light_point_weight(ax, ay, ex, ey, search);
             if ey.w0 > 0.0 {
                 if ex.w0 > 0.0 {
-                    add(ex.i, ey.i, c * ey.w0 * ex.w0, p, z_near, search);
+                    add(ex.i, ey.i, c * ey.w0 * ex.w0, lw, p, z_near, search);
                 }
                 if ex.w1 > 0.0 {
-                    add(ex.i + 1, ey.i, c * ey.w0 * ex.w1, p, z_near, search);
+                    add(ex.i + 1, ey.i, c * ey.w0 * ex.w1, lw, p, z_near, search);
                 }
             }
             if ey.w1 > 0.0 {
                 if ex.w0 > 0.0 {
-                    add(ex.i, ey.i + 1, c * ey.w1 * ex.w0, p, z_near, search);
+                    add(ex.i, ey.i + 1, c * ey.w1 * ex.w0, lw, p, z_near, search);
                 }
                 if ex.w1 > 0.0 {
-                    add(ex.i + 1, ey.i + 1, c * ey.w1 * ex.w1, p, z_near, search);
+                    add(ex.i + 1, ey.i + 1, c * ey.w1 * ex.w1, lw, p, z_near, search);
                 }
             }
         }
@@ -416,9 +446,9 @@ fn pcss_search(@builtin(global_invocation_id) gid: vec3<u32>,
         return;
     }
     var s = acc[idx];
-    sum = s.xy;
+    sum = vec3<f32>(s.xy, 0.0);
     visit(axes[0], axes[1], p, z_near, true);
-    s = vec4<f32>(sum, s.zw);
+    s = vec4<f32>(sum.xy, s.zw);
     acc[idx] = s;
 }
 
@@ -443,10 +473,18 @@ fn pcss_filter(@builtin(global_invocation_id) gid: vec3<u32>,
     if chunk.chunk * pp.rows_per_chunk >= axes[1].count || axes[0].count == 0u {
         return;
     }
-    sum = s.zw;
+    var hidden = 0.0;
+    if pp.weigh != 0u {
+        weigh_point = weigh_points[idx];
+        hidden = acc[pp.n + idx].x;
+    }
+    sum = vec3<f32>(s.zw, hidden);
     visit(axes[0], axes[1], p, z_near, false);
-    s = vec4<f32>(s.xy, sum);
+    s = vec4<f32>(s.xy, sum.xy);
     acc[idx] = s;
+    if pp.weigh != 0u {
+        acc[pp.n + idx] = vec4<f32>(sum.z, 0.0, 0.0, 0.0);
+    }
 }
 
 // The filter's part outside the map: the box's, from its ends per axis;
@@ -483,17 +521,33 @@ fn pcss_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
     let z_near = nearest();
     let p = point(idx, z_near);
     let s = acc[idx];
-    if !p.ok || !(s.x > 0.0) {
-        vis[idx] = 1.0;
-        return;
+    var v = 1.0;
+    var den = 0.0;
+    if p.ok && s.x > 0.0 {
+        let axes = filter_axes(p, z_near, s);
+        let out = outside(axes[0], axes[1]);
+        den = s.w + out;
+        if den > 0.0 {
+            v = clamp((s.z + out) / den, 0.0, 1.0);
+        }
     }
-    let axes = filter_axes(p, z_near, s);
-    let out = outside(axes[0], axes[1]);
-    let num = s.z + out;
-    let den = s.w + out;
-    if !(den > 0.0) {
-        vis[idx] = 1.0;
-        return;
+    vis[idx] = v;
+    if pp.weigh != 0u {
+        vis[pp.n + idx] = weighted(idx, v, den);
     }
-    vis[idx] = clamp(num / den, 0.0, 1.0);
+}
+
+// pcss_weighted.rs's weighted_visibility from the filter's sums: V where
+// it is 0 or 1 or the point has no receiver; 0 where the whole light is
+// behind its tangent plane.
+fn weighted(idx: u32, v: f32, den: f32) -> f32 {
+    let wp = weigh_points[idx];
+    if !(v > 0.0 && v < 1.0) || wp.valid == 0u {
+        return v;
+    }
+    let mean = 0.25 * light_weight(wp, vec2<f32>(pp.half_lx, pp.half_ly), pp.disk != 0u);
+    if !(mean > 0.0) {
+        return 0.0;
+    }
+    return 1.0 - clamp(acc[pp.n + idx].x / den / mean, 0.0, 1.0);
 }

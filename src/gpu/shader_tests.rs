@@ -5,10 +5,10 @@
 use super::exact::{ExactParams, SOURCE as EXACT_SOURCE};
 use super::eye::{GpuRayStart, HitsParams, HITS_SOURCE, RAYS_SOURCE};
 use super::gather::{
-    module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, GpuWeighPoint, PointsParams,
-    RowSpan, Variant, BITMASK_CLOSED_SOURCE, BITMASK_OPEN_SOURCE, BITMASK_SOURCE, GATHER_SOURCE,
-    SSM_SOURCE,
+    module_source, ChunkParams, GatherParams, GpuGroup, GpuPoint, PointsParams, RowSpan, Variant,
+    BITMASK_CLOSED_SOURCE, BITMASK_OPEN_SOURCE, BITMASK_SOURCE, GATHER_SOURCE, SSM_SOURCE,
 };
+use super::irradiance_weight::GpuWeighPoint;
 use super::pcss::{Coord, GpuPcssPoint, PcssChunk, PcssParams, SOURCE as PCSS_SOURCE};
 use super::raster::{FillParams, GpuTri, RasterParams, RasterTile, SOURCE as RASTER_SOURCE};
 use super::shadow_mapping::{GpuBlurPixel, GpuSmPoint, GpuSmTri, SmParams, SOURCE as SM_SOURCE};
@@ -31,7 +31,7 @@ fn modules() -> Vec<(String, String)> {
         ("smoothies.wgsl".into(), SMOOTHIES_SOURCE.to_string()),
         ("shadow_mapping.wgsl".into(), SM_SOURCE.to_string()),
         (
-            "disk_overlap.wgsl + pcss.wgsl".into(),
+            "disk_overlap.wgsl + irradiance_weight.wgsl + pcss.wgsl".into(),
             PCSS_SOURCE.to_string(),
         ),
     ];
@@ -596,9 +596,9 @@ fn pcss_structs_have_the_same_layout_in_rust_and_wgsl() {
             half_per_w_x,
             half_per_w_y,
             disk,
-            _pad0,
-            _pad1,
-            _pad2
+            weigh,
+            half_lx,
+            half_ly
         }),
     );
     assert_same(
@@ -612,6 +612,16 @@ fn pcss_structs_have_the_same_layout_in_rust_and_wgsl() {
         }),
     );
     assert_same(PCSS_SOURCE, "Coord", rust_layout!(Coord { base, frac }));
+    assert_same(
+        PCSS_SOURCE,
+        "WeighPoint",
+        rust_layout!(GpuWeighPoint {
+            p,
+            valid,
+            side,
+            _pad
+        }),
+    );
     assert_same(
         PCSS_SOURCE,
         "PcssPoint",

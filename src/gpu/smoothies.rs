@@ -35,7 +35,7 @@ use super::raster::NONE;
 use super::readback::{submit_and_read, with_error_scopes};
 use super::timing::StageTimer;
 use crate::error::{Error, Result};
-use crate::eye::{EyeMaps, MapShading};
+use crate::eye::MapShading;
 use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
@@ -624,13 +624,14 @@ fn prepare_light_view(
 /// The eye view's Smoothies on the device (`maps::shade`'s Smoothies arm):
 /// the front layer of every mesh on `e.grid` (raster.wgsl), the smoothies
 /// of the scene's silhouette (CPU), the buffer and the lookup at the biased
-/// points; the visibility per point, the maps, the device's stage times.
+/// points; the visibility per point (unweighted: the smoothies' ramp has
+/// no light point per texel), the maps, the device's stage times.
 fn shade_eye(
     g: &Gpu,
     e: &EyeInputs,
     s: &Smoothies,
     sw: &mut Stopwatch,
-) -> Result<(Vec<f32>, EyeMaps, Timings)> {
+) -> Result<(MapShading, Timings)> {
     let (f, tris, grid) = (e.f, e.tris, e.grid);
     let front = FrontLayer::new(g, f, tris, grid, e.bias, true)?;
     // Every mesh is an occluder: the silhouette straight from the mesh.
@@ -705,8 +706,7 @@ impl GpuKernel for SmoothiesKernel {
         inputs: &EyeInputs,
         sw: &mut Stopwatch,
     ) -> Result<(MapShading, Timings)> {
-        let (v, maps, t) = shade_eye(g, inputs, &options(method)?, sw)?;
-        Ok((MapShading::unweighted(v, maps), t))
+        shade_eye(g, inputs, &options(method)?, sw)
     }
 }
 

@@ -148,9 +148,6 @@ fn ssm_points_resolve(@builtin(global_invocation_id) gid: vec3<u32>,
     vis[idx] = 1.0 - occ;
 }
 
-// ssm/weighted.rs's QUAD: the midpoint rule's side over the whole light.
-const QUAD: u32 = 32u;
-
 // After ssm_points_resolve: vis[n_points + idx], the weighted visibility:
 // the weighted sum of the layer whose plain occlusion is the largest (the
 // back layer first, a later one only where strictly larger, as the CPU
@@ -180,22 +177,7 @@ fn ssm_points_weigh(@builtin(global_invocation_id) gid: vec3<u32>,
             hidden = bitcast<f32>(acc[(gp.n_layers + layer) * pp.n_points + idx]);
         }
     }
-    // weighted.rs's light_weight: 4 times the mean weight at the midpoints
-    // on the light (under a disk, those inside it).
-    let step = 2.0 / f32(QUAD);
-    var all = 0.0;
-    var count = 0u;
-    for (var j = 0u; j < QUAD; j++) {
-        let v = -1.0 + (f32(j) + 0.5) * step;
-        let y = v * gp.half_ly;
-        for (var i = 0u; i < QUAD; i++) {
-            let u = -1.0 + (f32(i) + 0.5) * step;
-            if gp.disk == 0u || u * u + v * v <= 1.0 {
-                all += irradiance_weight(wp, u * gp.half_lx, y);
-                count += 1u;
-            }
-        }
-    }
-    all *= 4.0 / f32(count);
+    // ∫ w over the light (irradiance_weight.wgsl's light_weight).
+    let all = light_weight(wp, vec2<f32>(gp.half_lx, gp.half_ly), gp.disk != 0u);
     vis[out] = select(0.0, 1.0 - clamp(hidden / all, 0.0, 1.0), all > 0.0);
 }

@@ -30,6 +30,7 @@ pub(crate) mod packet;
 pub mod pcf;
 mod pcf_disk;
 pub mod pcss;
+mod pcss_weighted;
 pub mod point_light;
 pub(crate) mod probe;
 mod registry;

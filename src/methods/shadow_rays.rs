@@ -136,6 +136,38 @@ impl SurfacePoint {
     }
 }
 
+/// The midpoint rule's side for the weights over the whole light.
+pub const QUAD: usize = 32;
+
+/// ∫ w over the light [-1, 1]² (half-extents `half` in kernel units) seen
+/// from `s`, in units where the whole light's area is 4 (the SSM's
+/// occlusion sums, `ssm/weighted.rs`; PCSS's weighted filter divides by a
+/// quarter of it, `pcss_weighted.rs`): 4 times the mean of w at the QUAD²
+/// midpoints, a row's in f32 (computed side by side), the rows in f64.
+/// Under a disk (the unit disk in those units) the mean is over the
+/// midpoints inside it (812 of 1024), so that its area counts as the 4 the
+/// disk's clipped sums reach.
+pub fn light_weight(s: &SurfacePoint, half: [f32; 2], disk: bool) -> f64 {
+    let step = 2.0 / QUAD as f32;
+    let us: [f32; QUAD] = std::array::from_fn(|i| -1.0 + (i as f32 + 0.5) * step);
+    let xs: [f32; QUAD] = us.map(|u| u * half[0]);
+    let on = |u: f32, v: f32| !disk || u * u + v * v <= 1.0;
+    let (mut sum, mut count) = (0f64, 0usize);
+    for &v in &us {
+        let y = v * half[1];
+        let row: [f32; QUAD] = std::array::from_fn(|i| {
+            if on(us[i], v) {
+                s.weight(xs[i], y)
+            } else {
+                0.0
+            }
+        });
+        sum += f64::from(row.iter().sum::<f32>());
+        count += us.iter().filter(|&&u| on(u, v)).count();
+    }
+    4.0 * sum / count as f64
+}
+
 /// A receiver point (the light view).
 impl RayOrigin for Vec3 {
     #[inline(always)]

@@ -118,10 +118,11 @@ def test_shaded_is_unshadowed_times_visibility_with_each_mesh_albedo(light, meth
     e = light.irradiance_at(img.position[m], img.normal[m].astype(np.float64))
     albedo = np.array([ALBEDO[0], (ALBEDO[1],) * 3])[img.mesh_id[m]]
     np.testing.assert_allclose(img.unshadowed[m], albedo / np.pi * e, rtol=1e-6, atol=1e-9)
-    if method in ("exact", "ssm", "bitmask") and isinstance(light, ss.RectLight):
-        # Each of exact's rays, the SSM's micro-patches and the bitmask's
-        # light samples weighs what it adds to the irradiance: shaded =
-        # unshadowed * V_w,
+    weighs = method in ("exact", "ssm", "bitmask") or isinstance(method, ss.PCSS)
+    if weighs and isinstance(light, ss.RectLight):
+        # Each of exact's rays, the SSM's micro-patches, the bitmask's
+        # light samples and PCSS's filter cells weighs what it adds to the
+        # irradiance: shaded = unshadowed * V_w,
         # V_w equal to V where V is 0 or 1 and near it in penumbrae (the
         # light's near part weighs more).
         full = m & ((img.visibility == 0.0) | (img.visibility == 1.0))
@@ -160,7 +161,9 @@ def test_default_albedo_is_grey_and_channels_hold_the_shaded_images():
 
 @pytest.mark.gpu
 @pytest.mark.skipif(not ss.gpu_available(), reason="no GPU adapter")
-@pytest.mark.parametrize("method", [ss.Exact(), ss.Ssm(), ss.Bitmask(hierarchy=False)], ids=["exact", "ssm", "bitmask"])
+@pytest.mark.parametrize(
+    "method", [ss.Exact(), ss.Ssm(), ss.Bitmask(hierarchy=False), ss.PCSS()], ids=["exact", "ssm", "bitmask", "pcss"]
+)
 def test_gpu_shades_as_the_cpu_does(method):
     scene, cam = _two_mesh_scene()
     light = LIGHTS["rect"]
@@ -174,8 +177,9 @@ def test_gpu_shades_as_the_cpu_does(method):
     # CPU's in f64): the same shaded image to rounding.
     cpu = ss.render(scene, light, cam, method=method, albedo=ALBEDO)
     both = m & cpu.mask
-    if isinstance(method, ss.Ssm):
-        # The SSM's f32 sums round differently on the device (to 1.2e-7).
+    if isinstance(method, (ss.Ssm, ss.PCSS)):
+        # The SSM's and PCSS's f32 sums round differently on the device
+        # (to 1.2e-7 and 1.8e-7 here).
         np.testing.assert_allclose(img.visibility[both], cpu.visibility[both], rtol=0, atol=1e-6)
     else:
         np.testing.assert_array_equal(img.visibility[both], cpu.visibility[both])
@@ -281,43 +285,53 @@ def test_exact_shading_is_near_mitsuba_direct(name):
     assert _relative_error(img.unshadowed, ref, m) > 5 * MITSUBA_BOUNDS[name]
 
 
-@pytest.mark.parametrize("shape", ["rect", "disk"])
-def test_bitmask_weighs_its_samples_near_mitsuba_direct(shape):
-    """Under ``contact_boxes``' large close light (2.5 wide, 2 above the
-    floor) the light's parts weigh most unevenly. Measured at 80x60 against
-    1024 Mitsuba samples: the bitmask (1024 samples, its samples weighted)
-    0.0132 (rect) and 0.0158 (disk), the rest its visibility's error (0.0067
-    on 512-texel maps); its visibility weighted alike 0.0699 and 0.0756;
-    Mitsuba's noise 0.0021."""
+def _weighted_and_alike_under_contact_boxes(method: object, shape: str) -> tuple[float, float]:
+    """The relative error against Mitsuba's ``direct`` (1024 samples) of
+    ``method``'s shaded image under ``contact_boxes``' large close light
+    (2.5 wide, 2 above the floor, where the light's parts weigh most
+    unevenly; ``disk``: the disk of its area), at 80x60, and of its
+    visibility weighted alike."""
     pytest.importorskip("mitsuba")
     from softshadow.reference import render_direct
 
     scene, light, cam = scenes.eye_view.contact_boxes((80, 60))
     if shape == "disk":
         light = ss.DiskLight(light.center, light.normal, float(np.sqrt(light.size[0] * light.size[1] / np.pi)))
-    img = ss.render(scene, light, cam, method=ss.Bitmask(samples=1024))
+    img = ss.render(scene, light, cam, method=method)
     ref = render_direct(scene, light, cam, samples=1024, seed=0)
     m = img.mask
     weighted = _relative_error(img.shaded, ref, m)
     alike = _relative_error(img.unshadowed * img.visibility[..., None], ref, m)
+    return weighted, alike
+
+
+@pytest.mark.parametrize("shape", ["rect", "disk"])
+def test_bitmask_weighs_its_samples_near_mitsuba_direct(shape):
+    """Measured: the bitmask (1024 samples, its samples weighted) 0.0132
+    (rect) and 0.0158 (disk), the rest its visibility's error (0.0067 on
+    512-texel maps); its visibility weighted alike 0.0699 and 0.0756;
+    Mitsuba's noise 0.0021."""
+    weighted, alike = _weighted_and_alike_under_contact_boxes(ss.Bitmask(samples=1024), shape)
     assert weighted < 0.02 and alike > 0.05
     assert weighted < 0.3 * alike
 
 
+@pytest.mark.parametrize("shape", ["rect", "disk"])
+def test_pcss_weighs_its_filter_cells_near_mitsuba_direct(shape):
+    """PCSS weighs each cell of its filter by the light point it stands for
+    (methods/pcss_weighted.rs). Measured: 0.0220 (rect) and 0.0215 (disk),
+    where its visibility weighted alike errs 0.0771 and 0.0789 (the rest is
+    its visibility's error: one mean blocker depth per pixel)."""
+    weighted, alike = _weighted_and_alike_under_contact_boxes(ss.PCSS(), shape)
+    assert weighted < 0.03 and alike > 0.07
+    assert weighted < 0.35 * alike
+
+
 def test_ssm_weighs_its_micro_patches_near_mitsuba_direct():
     """The SSM weighs each micro-patch's back-projection at its centre.
-    Measured at 80x60 under ``contact_boxes``' rectangle against 1024
-    Mitsuba samples: 0.0250, where its visibility weighted alike errs
-    0.0845 (the rest is its visibility's error: overlapping back-projections
-    counted twice, §3.4)."""
-    pytest.importorskip("mitsuba")
-    from softshadow.reference import render_direct
-
-    scene, light, cam = scenes.eye_view.contact_boxes((80, 60))
-    img = ss.render(scene, light, cam, method="ssm")
-    ref = render_direct(scene, light, cam, samples=1024, seed=0)
-    m = img.mask
-    weighted = _relative_error(img.shaded, ref, m)
-    alike = _relative_error(img.unshadowed * img.visibility[..., None], ref, m)
+    Measured under the rectangle: 0.0250, where its visibility weighted
+    alike errs 0.0845 (the rest is its visibility's error: overlapping
+    back-projections counted twice, §3.4)."""
+    weighted, alike = _weighted_and_alike_under_contact_boxes("ssm", "rect")
     assert weighted < 0.035 and alike > 0.07
     assert weighted < 0.4 * alike

@@ -13,7 +13,7 @@
 //!   O_w = Σ_k A_k w(c_k) / ∫ w dA,   E ≈ E_0 (1 - min(O_w, 1)),
 //!
 //! E_0 the closed-form unshadowed irradiance, ∫ w dA the same weights over
-//! the whole light (a QUAD² midpoint rule): the ratio estimator of Heitz,
+//! the whole light (`shadow_rays::light_weight`, a midpoint rule): the ratio estimator of Heitz,
 //! Hill & McGuire 2018 ("Combining analytic direct illumination and
 //! stochastic shadows", §3) with the SSM's occlusion in place of V. The
 //! layers merge as the plain occlusions do (§3.5): the layer whose plain
@@ -28,39 +28,9 @@ use crate::geom::light_shape::LightShape;
 use crate::methods::gather::{
     self, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES,
 };
-use crate::methods::shadow_rays::{RayOrigin, SurfacePoint};
+use crate::methods::shadow_rays::{light_weight, RayOrigin};
 use crate::methods::{LightPoint, ShadowInputs};
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// The midpoint rule's side for the weights over the whole light.
-pub const QUAD: usize = 32;
-
-/// ∫ w over the light [-1, 1]² (half-extents `half` in kernel units) seen
-/// from `s`, in the units of the SSM's sums (the whole light is 4): 4 times
-/// the mean of w at the QUAD² midpoints, a row's in f32 (computed side by
-/// side), the rows in f64. Under a disk (the unit disk in those units) the
-/// mean is over the midpoints inside it (812 of 1024), so that its area
-/// counts as the 4 the disk's clipped sums reach.
-pub fn light_weight(s: &SurfacePoint, half: [f32; 2], disk: bool) -> f64 {
-    let step = 2.0 / QUAD as f32;
-    let us: [f32; QUAD] = std::array::from_fn(|i| -1.0 + (i as f32 + 0.5) * step);
-    let xs: [f32; QUAD] = us.map(|u| u * half[0]);
-    let on = |u: f32, v: f32| !disk || u * u + v * v <= 1.0;
-    let (mut sum, mut count) = (0f64, 0usize);
-    for &v in &us {
-        let y = v * half[1];
-        let row: [f32; QUAD] = std::array::from_fn(|i| {
-            if on(us[i], v) {
-                s.weight(xs[i], y)
-            } else {
-                0.0
-            }
-        });
-        sum += f64::from(row.iter().sum::<f32>());
-        count += us.iter().filter(|&&u| on(u, v)).count();
-    }
-    4.0 * sum / count as f64
-}
 
 /// The centre of micro-patch [x0, x1] x (row)'s back-projection clipped to
 /// the light, seen from lane l, in half-light units: the clipped interval
