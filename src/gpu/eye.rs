@@ -74,13 +74,15 @@ pub const HITS_SOURCE: &str = concat!(
     include_str!("eye_hits.wgsl")
 );
 /// The shadow-ray module: the light's sampling, exact.wgsl's traversal and
-/// jitter, then eye_rays.wgsl.
+/// jitter, the receivers' weights, then eye_rays.wgsl.
 pub const RAYS_SOURCE: &str = concat!(
     include_str!("u64.wgsl"),
     "\n",
     include_str!("light_shape.wgsl"),
     "\n",
     include_str!("exact.wgsl"),
+    "\n",
+    include_str!("irradiance_weight.wgsl"),
     "\n",
     include_str!("eye_rays.wgsl")
 );

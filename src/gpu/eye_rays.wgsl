@@ -12,13 +12,14 @@
 // t1). A chunk of samples per dispatch counts the clear ones into `seen`,
 // and sums their weights and every sample's into `weights` (the light
 // point's share of the irradiance, cos θ cos θ' / r² up to a factor:
-// rays.rs's `RayStart::weight`); the resolve divides the count by the
+// irradiance_weight.wgsl, rays.rs's `RayStart::weight`); the resolve divides the count by the
 // sample count into vis[k] and the weights into vis[n + k] (the weighted
 // visibility; V where no sample weighs anything), 0 for a start that is
 // not valid (a point at or behind a rectangle's plane).
 //
 // Appended to u64.wgsl + exact.wgsl (hash, unit, occluded and its bindings;
-// ExactParams' rec_w is the number of ray starts here).
+// ExactParams' rec_w is the number of ray starts here) and
+// irradiance_weight.wgsl (the weights).
 
 // Shared with Rust (`GpuRayStart` in eye.rs; a test compares layouts).
 struct RayStart {
@@ -60,7 +61,8 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
     }
     let above = vec3<f32>(s.ax, s.ay, s.az);
     let below = vec3<f32>(s.bx, s.by, s.bz);
-    let p = 0.5 * (above + below);
+    // The surface point (the starts' midpoint) as the weights read it.
+    let wp = WeighPoint(0.5 * (above + below), 1u, vec3<f32>(s.a0, s.au, s.av), 0u);
     var count = 0u;
     var w_seen = 0.0;
     var w_all = 0.0;
@@ -77,9 +79,7 @@ fn eye_exact(@builtin(global_invocation_id) gid: vec3<u32>,
         if side >= 0.0 {
             o = above;
         }
-        let q = vec3<f32>(x, y, 0.0) - p;
-        let r2 = dot(q, q);
-        let w = max(side, 0.0) * p.z / (r2 * r2);
+        let w = irradiance_weight(wp, x, y);
         w_all += w;
         let d = vec3<f32>(x, y, 0.0) - o;
         if !occluded(o, d) {

@@ -179,7 +179,7 @@ def test_gpu_shades_as_the_cpu_does(method):
     both = m & cpu.mask
     if isinstance(method, (ss.Ssm, ss.PCSS)):
         # The SSM's and PCSS's f32 sums round differently on the device
-        # (to 1.2e-7 and 1.8e-7 here).
+        # (measured here on lavapipe: at most 6.0e-8 and 4.2e-7).
         np.testing.assert_allclose(img.visibility[both], cpu.visibility[both], rtol=0, atol=1e-6)
     else:
         np.testing.assert_array_equal(img.visibility[both], cpu.visibility[both])
