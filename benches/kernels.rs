@@ -257,6 +257,15 @@ fn bench_kernels(c: &mut Criterion) {
             Method::Exact {
                 samples: 64,
                 probe: None,
+                engine: softshadow::methods::engine::Engine::Rays,
+            },
+        ),
+        (
+            "masks64",
+            Method::Exact {
+                samples: 64,
+                probe: None,
+                engine: softshadow::methods::engine::Engine::Masks,
             },
         ),
     ];

@@ -613,7 +613,11 @@ fn probed(m: MethodConfig, planned: bool, backend: Backend) -> MethodConfig {
     use crate::methods::auto_config::EYE_PROBE;
     match m {
         MethodConfig::Exact(c)
-            if planned && backend == Backend::Cpu && c.probe.is_none() && c.samples > EYE_PROBE =>
+            if planned
+                && backend == Backend::Cpu
+                && c.probe.is_none()
+                && c.engine.is_none()
+                && c.samples > EYE_PROBE =>
         {
             MethodConfig::Exact(crate::methods::ExactConfig {
                 probe: Some(EYE_PROBE),

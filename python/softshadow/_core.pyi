@@ -9,7 +9,7 @@ module usable.
 """
 
 import inspect
-from typing import Any, ClassVar, final
+from typing import Any, ClassVar, Literal, final
 
 import numpy as np
 import numpy.typing as npt
@@ -115,11 +115,15 @@ class Bitmask(_KeywordConfig):
 class Exact(_KeywordConfig):
     """Ray casting against the occluder triangles."""
 
-    def __new__(cls, *, samples: int | None = None, probe: int | None = None) -> Exact: ...
+    def __new__(
+        cls, *, samples: int | None = None, probe: int | None = None, engine: Literal["rays", "masks"] | None = None
+    ) -> Exact: ...
     @property
     def samples(self) -> int: ...
     @property
     def probe(self) -> int | None: ...
+    @property
+    def engine(self) -> Literal["rays", "masks"] | None: ...
 
 @final
 class ConstantBias:

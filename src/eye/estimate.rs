@@ -35,6 +35,7 @@ use crate::error_estimate::{
     add_batch, finish, strata_order, Draw, ErrorEstimate, Stratum, SHADOW_THRESHOLD,
 };
 use crate::geom::sphere_light::SphereLight;
+use crate::methods::engine::Engine;
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_rays::RayOrigin;
 
@@ -191,9 +192,15 @@ fn estimate_with(
         let key = |j: usize| f.hits[pixels[j]] as u64;
         let identity: Vec<usize> = (0..pixels.len()).collect();
         match given.or(whole.as_ref()) {
-            Some(bvh) => {
-                rays::visibility_in(bvh, f.light_shape, &starts, key, &identity, samples, None)
-            }
+            Some(bvh) => rays::visibility_in(
+                bvh,
+                f.light_shape,
+                &starts,
+                key,
+                &identity,
+                (samples, Engine::Rays),
+                None,
+            ),
             None => {
                 let t = Instant::now();
                 culled += lens.len();
@@ -210,7 +217,15 @@ fn estimate_with(
                     .collect();
                 cull_seconds += t.elapsed().as_secs_f64();
                 let bvh = Bvh::build_fast(kept);
-                rays::visibility_in(&bvh, f.light_shape, &starts, key, &identity, samples, None)
+                rays::visibility_in(
+                    &bvh,
+                    f.light_shape,
+                    &starts,
+                    key,
+                    &identity,
+                    (samples, Engine::Rays),
+                    None,
+                )
             }
         }
     };

@@ -15,6 +15,7 @@ use crate::geom::light_space::{sphere_has_no_space, Light, LightSpace};
 use crate::geom::sun::SunSpace;
 use crate::geom::units::{check_unit, depth_unit};
 use crate::methods::config::CallContext;
+use crate::methods::engine::Engine;
 use crate::methods::MethodConfig;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -125,14 +126,17 @@ pub fn resolve_at_camera(call: &EyeCall, backend: Backend) -> Result<MethodConfi
     })
 }
 
-/// Light samples per pixel of `exact`, and of its probe: a hard light
-/// needs one ray (every sample would be the same) and no probe.
-pub fn exact_samples(call: &EyeCall, method: &MethodConfig) -> (u32, Option<u32>) {
+/// Light samples per pixel of `exact`, and of its probe, and the engine
+/// that decides them: a hard light needs one ray (every sample would be the
+/// same) and no probe.
+pub fn exact_samples(call: &EyeCall, method: &MethodConfig) -> (u32, Option<u32>, Engine) {
     match method.kernel() {
-        crate::methods::Method::Exact { samples, probe } if !call.light.is_hard() => {
-            (samples, probe)
-        }
-        _ => (1, None),
+        crate::methods::Method::Exact {
+            samples,
+            probe,
+            engine,
+        } if !call.light.is_hard() => (samples, probe, engine),
+        _ => (1, None, Engine::Rays),
     }
 }
 

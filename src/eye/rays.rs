@@ -13,11 +13,10 @@
 
 use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
+use crate::methods::engine::{visibilities_weighted, Engine};
 use crate::methods::exact::Bvh;
 use crate::methods::probe::probed_visibilities_weighted;
-use crate::methods::shadow_rays::{
-    tile_order, visibilities_weighted, Jitter, RayOrigin, Sampling, SurfacePoint,
-};
+use crate::methods::shadow_rays::{tile_order, Jitter, Origins, RayOrigin, Sampling, SurfacePoint};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -119,6 +118,14 @@ impl RayOrigin for RayStart {
     fn surface(&self) -> Option<SurfacePoint> {
         Some(self.surface_point())
     }
+    #[inline(always)]
+    fn origins(&self) -> Origins {
+        Origins::Two {
+            above: self.above,
+            below: self.below,
+            side: self.side,
+        }
+    }
 }
 
 /// Visibility at ray starts `starts`, every triangle of `triangles`
@@ -138,7 +145,7 @@ pub fn visibility(
     starts: &[Option<RayStart>],
     key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
-    samples: u32,
+    sampled: (u32, Engine),
     probe: Option<Probe>,
 ) -> Vec<f32> {
     visibility_in(
@@ -147,7 +154,7 @@ pub fn visibility(
         starts,
         key,
         order,
-        samples,
+        sampled,
         probe,
     )
 }
@@ -168,10 +175,10 @@ pub fn visibility_in(
     starts: &[Option<RayStart>],
     key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
-    samples: u32,
+    sampled: (u32, Engine),
     probe: Option<Probe>,
 ) -> Vec<f32> {
-    visibility_weighted(bvh, light_shape, starts, key, order, samples, probe)
+    visibility_weighted(bvh, light_shape, starts, key, order, sampled, probe)
         .into_iter()
         .map(|[v, _]| v)
         .collect()
@@ -180,14 +187,16 @@ pub fn visibility_in(
 /// `visibility_in` with each point's weighted visibility beside it: the
 /// share of the light's irradiance its clear samples carry
 /// (`RayStart::weight`, `shadow_rays::visibilities_weighted`), of a planar
-/// light; a sun's samples (directions) weigh alike.
+/// light; a sun's samples (directions) weigh alike. `sampled`: the
+/// samples and the engine that decides them (`methods/engine.rs`; a probe
+/// traces rays).
 pub fn visibility_weighted(
     bvh: &Bvh,
     light_shape: LightShape,
     starts: &[Option<RayStart>],
     key: impl Fn(usize) -> u64 + Sync,
     order: &[usize],
-    samples: u32,
+    (samples, engine): (u32, Engine),
     probe: Option<Probe>,
 ) -> Vec<[f32; 2]> {
     let sampling = |n, jitter| Sampling {
@@ -201,7 +210,7 @@ pub fn visibility_weighted(
             let coarse = sampling(p.samples, Jitter::PerReceiver);
             probed_visibilities_weighted(bvh, starts, key, order, &fine, &coarse, 0.0, p.size)
         }
-        None => visibilities_weighted(bvh, starts, key, order, &fine, 0.0),
+        None => visibilities_weighted(engine, bvh, starts, key, order, &fine, 0.0),
     }
 }
 

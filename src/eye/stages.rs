@@ -14,6 +14,7 @@ use crate::error::Result;
 use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
 use crate::geom::sphere_light::SphereLight;
+use crate::methods::engine::Engine;
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::MethodConfig;
@@ -49,14 +50,14 @@ pub trait EyeStages {
     /// further runs trace it too); with a `probe` of so many samples, only
     /// at the points a first pass is unsure of (`methods/probe.rs`). Beside
     /// it, where the backend weights its samples (the CPU), each point's
-    /// weighted visibility (`rays::visibility_weighted`).
+    /// weighted visibility (`rays::visibility_weighted`). `sampled`:
+    /// the samples, the probe's and the engine (`exact_samples`).
     fn trace(
         &mut self,
         f: &Framed,
         bvh: &Bvh,
         camera: &Camera,
-        samples: u32,
-        probe: Option<u32>,
+        sampled: (u32, Option<u32>, Engine),
         sw: &mut Stopwatch,
     ) -> Result<(Vec<f32>, Option<Vec<f32>>)>;
 
@@ -124,8 +125,7 @@ impl EyeStages for CpuEye {
         f: &Framed,
         bvh: &Bvh,
         camera: &Camera,
-        samples: u32,
-        probe: Option<u32>,
+        (samples, probe, engine): (u32, Option<u32>, Engine),
         _sw: &mut Stopwatch,
     ) -> Result<(Vec<f32>, Option<Vec<f32>>)> {
         let starts = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals);
@@ -137,7 +137,7 @@ impl EyeStages for CpuEye {
             &starts,
             |k| f.hits[k] as u64,
             &order,
-            samples,
+            (samples, engine),
             probe.map(|samples| rays::Probe {
                 samples,
                 size: (camera.width, camera.height),

@@ -134,6 +134,7 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
         Method::Exact {
             samples: 16,
             probe: None,
+            engine: crate::methods::engine::Engine::Rays,
         },
     ];
     for (passes, method) in [1, 2, 4].into_iter().flat_map(|p| methods.map(|m| (p, m))) {
@@ -482,6 +483,7 @@ fn depth_maps_cannot_be_traced() {
         Method::Exact {
             samples: 4,
             probe: None,
+            engine: crate::methods::engine::Engine::Rays,
         },
         Backend::Gpu,
     )

@@ -53,6 +53,7 @@ use crate::geom::camera::Camera;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::sphere_light::SphereLight;
+use crate::methods::engine::Engine;
 use crate::methods::exact::Bvh;
 use crate::methods::shadow_mapping::config::ShadowMappingConfig;
 use crate::methods::MethodConfig;
@@ -196,14 +197,14 @@ impl EyeStages for GpuEye {
         f: &Framed,
         bvh: &Bvh,
         _camera: &Camera,
-        samples: u32,
-        probe: Option<u32>,
+        (samples, probe, engine): (u32, Option<u32>, Engine),
         sw: &mut Stopwatch,
     ) -> Result<(Vec<f32>, Option<Vec<f32>>)> {
-        // `ExactConfig::resolve` refuses a probe on the GPU.
+        // `ExactConfig::resolve` refuses a probe and the masks on the GPU.
         if probe.is_some() {
             return Err(no_probe());
         }
+        debug_assert_eq!(engine, Engine::Rays);
         let starts: Vec<GpuRayStart> = rays::ray_starts(&f.space, f.unit, &f.points, &f.normals)
             .iter()
             .map(GpuRayStart::new)

@@ -44,6 +44,7 @@ pub fn eye_default(backend: Backend) -> super::ExactConfig {
     super::ExactConfig {
         samples: super::config::DEFAULT_SAMPLES,
         probe: (backend == Backend::Cpu).then_some(EYE_PROBE),
+        engine: None,
     }
 }
 

@@ -255,6 +255,12 @@ impl Bvh {
         deepest
     }
 
+    /// The triangles in BVH order (a leaf's `start..start + count`).
+    #[inline(always)]
+    pub(crate) fn triangles(&self) -> &[[Vec3; 3]] {
+        &self.tris
+    }
+
     pub(crate) fn is_empty(&self) -> bool {
         self.tris.is_empty()
     }

@@ -23,11 +23,12 @@ use super::config::{
     check_passes, CallContext, LooseOptions, MethodSpec, DEFAULT_SAMPLES, MAX_SAMPLES,
     PRECISION_SSM_ONLY,
 };
+use super::engine::{visibilities_weighted, Engine};
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::keywords::{count, KeywordForm, Keywords};
 use super::probe::probed_visibilities;
 pub(crate) use super::shadow_rays::RAY_EPS;
-use super::shadow_rays::{tile_order, visibilities, Jitter, Sampling};
+use super::shadow_rays::{tile_order, Jitter, Sampling};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -36,12 +37,14 @@ use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightSamples;
 use glam::Vec3;
 
-/// The exact method with `samples` light samples per receiver; with a
-/// `probe`, receivers whose first `probe` samples (and their neighbours')
-/// agree keep that answer (`probe.rs`).
+/// The exact method with `samples` light samples per receiver, decided by
+/// `engine` (`engine.rs`); with a `probe` (rays only), receivers whose first
+/// `probe` samples (and their neighbours') agree keep that answer
+/// (`probe.rs`).
 pub struct Exact {
     pub samples: u32,
     pub probe: Option<u32>,
+    pub engine: Engine,
 }
 
 /// The light point (x, y) that `exact`'s ray of stratum (sa, sb) of
@@ -92,7 +95,10 @@ impl Exact {
                 1.0,
                 (g.width, g.height),
             ),
-            _ => visibilities(&bvh, pts, |k| k as u64, order, &fine, 1.0),
+            _ => visibilities_weighted(self.engine, &bvh, pts, |k| k as u64, order, &fine, 1.0)
+                .into_iter()
+                .map(|[v, _]| v)
+                .collect(),
         }
     }
 }
@@ -132,6 +138,16 @@ impl ShadowMethod for Exact {
     }
 }
 
+/// The fewest samples at which an unset `engine` is the masks (on the
+/// CPU, without a probe). Measured with `benchmarks/bench_masks.py` on the
+/// sixteen as-built scenes at 320x240, both sets (docs/benchmarks/
+/// masks_320x240.md): at 1024 samples the masks took 1.0-16.7x less time
+/// than the rays on every scene; at 256 they were slower on five (the slats
+/// of fence_slats and blinds, room_window's frame, table_and_chairs: many
+/// thin boxes whose edges cross the light, 0.37-0.59x) and faster on the
+/// other eleven.
+pub const MASKS_FROM: u32 = 1024;
+
 /// Ray casting through a BVH of the occluder triangles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ExactConfig {
@@ -139,6 +155,9 @@ pub struct ExactConfig {
     /// Light samples of a first pass at every receiver (`probe.rs`); None:
     /// every receiver traces `samples`.
     pub probe: Option<u32>,
+    /// How the samples are decided (`engine.rs`); None: resolved when run
+    /// (`ExactConfig::engine_for`).
+    pub engine: Option<Engine>,
 }
 
 /// Light samples of the option `arg` (`samples`, and a `probe`, which saves
@@ -156,20 +175,57 @@ pub fn check_exact_samples(arg: &str, n: i64) -> Result<u32> {
 }
 
 impl ExactConfig {
-    pub fn new(samples: Option<i64>, probe: Option<i64>) -> Result<Self> {
+    pub fn new(samples: Option<i64>, probe: Option<i64>, engine: Option<&str>) -> Result<Self> {
         let samples = samples
             .map(|n| check_exact_samples("samples", n))
             .transpose()?
             .unwrap_or(DEFAULT_SAMPLES);
         let probe = probe.map(|p| check_exact_samples("probe", p)).transpose()?;
-        Ok(ExactConfig { samples, probe })
+        let engine = engine
+            .map(|e| {
+                Engine::parse(e).ok_or_else(|| {
+                    let names: Vec<&str> = Engine::ALL.iter().map(|e| e.name()).collect();
+                    Error::invalid("engine", format!("must be one of {names:?}, got {e:?}"))
+                })
+            })
+            .transpose()?;
+        if engine == Some(Engine::Masks) && probe.is_some() {
+            return Err(Error::invalid(
+                "probe",
+                "the masks engine decides every sample from the triangles and has no probe; \
+                 leave probe unset or pass engine=\"rays\"",
+            ));
+        }
+        Ok(ExactConfig {
+            samples,
+            probe,
+            engine,
+        })
     }
 
-    /// `samples` light samples at every receiver, no probe.
+    /// `samples` light samples at every receiver, no probe, the engine
+    /// resolved when run.
     pub const fn of(samples: u32) -> Self {
         ExactConfig {
             samples,
             probe: None,
+            engine: None,
+        }
+    }
+
+    /// The engine that runs on `backend`: the one given, else the masks on
+    /// the CPU from `MASKS_FROM` samples without a probe (the probe traces
+    /// rays), the rays otherwise (and on the GPU, whose kernel traces rays).
+    pub fn engine_for(&self, backend: Backend) -> Engine {
+        match self.engine {
+            Some(e) => e,
+            None if backend == Backend::Cpu
+                && self.probe.is_none()
+                && self.samples >= MASKS_FROM =>
+            {
+                Engine::Masks
+            }
+            None => Engine::Rays,
         }
     }
 }
@@ -182,12 +238,17 @@ impl Default for ExactConfig {
 
 impl KeywordForm for ExactConfig {
     fn from_keywords(k: &Keywords) -> Result<Self> {
-        ExactConfig::new(k.int("samples")?, k.int("probe")?)
+        ExactConfig::new(k.int("samples")?, k.int("probe")?, k.str("engine")?)
     }
     fn keywords(&self) -> Vec<(&'static str, Value)> {
         vec![
             ("samples", count(Some(self.samples))),
             ("probe", count(self.probe)),
+            (
+                "engine",
+                self.engine
+                    .map_or(Value::Resolved, |e| Value::Str(e.name())),
+            ),
         ]
     }
 }
@@ -214,7 +275,7 @@ impl MethodSpec for ExactConfig {
         if o.precision.is_some() {
             return Err(refuse("precision", PRECISION_SSM_ONLY));
         }
-        ExactConfig::new(o.samples, None)
+        ExactConfig::new(o.samples, None, None)
     }
     type Resolved = Self;
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
@@ -232,7 +293,17 @@ impl MethodSpec for ExactConfig {
                  use backend=\"cpu\" or leave probe unset",
             ));
         }
-        Ok(self)
+        if self.engine == Some(Engine::Masks) && ctx.backend == Backend::Gpu {
+            return Err(Error::invalid(
+                "engine",
+                "the GPU backend traces rays (engine=\"rays\"); the masks run on the CPU: \
+                 use backend=\"cpu\" or leave engine unset",
+            ));
+        }
+        Ok(ExactConfig {
+            engine: Some(self.engine_for(ctx.backend)),
+            ..self
+        })
     }
 
     fn info() -> MethodInfo {
@@ -269,6 +340,22 @@ impl MethodSpec for ExactConfig {
                           time when fewer than `samples`; points given as arrays have no \
                           neighbours and trace every sample; the CPU only)",
                     restricted_on: vec![(Backend::Gpu, vec![Value::Resolved])],
+                },
+                OptionInfo {
+                    name: "engine",
+                    kind: Kind::Choice(Engine::ALL.iter().map(|e| e.name()).collect()),
+                    default: Value::Resolved,
+                    default_doc: "None: \"masks\" on the CPU from 1024 samples without a probe, \
+                                  else \"rays\"",
+                    doc: "how the samples are decided, with the same answer but for rays that \
+                          graze an edge: \"rays\", a shadow ray a sample through the BVH (the \
+                          reference); \"masks\", each receiver's samples marked by the \
+                          triangles that cross its light, a cell of samples at a time (its cost \
+                          grows with that geometry, not with the samples; the CPU only)",
+                    restricted_on: vec![(
+                        Backend::Gpu,
+                        vec![Value::Resolved, Value::Str(Engine::Rays.name())],
+                    )],
                 },
             ],
         }
@@ -312,26 +399,30 @@ mod tests {
             occluder_triangles: Some(&tris),
         };
         let samples = 1024;
-        let v = Exact {
-            samples,
-            probe: None,
-        }
-        .visibility_map(&inputs);
-        let k = zr * zo / (zr - zo);
-        let ov = |lo: f64, hi: f64, c: f64| {
-            ((k * (hi - c) + 0.5).clamp(0.0, 1.0) - (k * (lo - c) + 0.5).clamp(0.0, 1.0)).max(0.0)
-        };
-        let mut max = 0f64;
-        for j in 0..n {
-            for i in 0..n {
-                let (x, y) = (grid.x_of(i), grid.y_of(j));
-                let exact = 1.0 - ov(-0.1, 0.15, x) * ov(-0.05, 0.2, y);
-                max = max.max((v[j * n + i] as f64 - exact).abs());
+        for engine in Engine::ALL {
+            let v = Exact {
+                samples,
+                probe: None,
+                engine,
             }
+            .visibility_map(&inputs);
+            let k = zr * zo / (zr - zo);
+            let ov = |lo: f64, hi: f64, c: f64| {
+                ((k * (hi - c) + 0.5).clamp(0.0, 1.0) - (k * (lo - c) + 0.5).clamp(0.0, 1.0))
+                    .max(0.0)
+            };
+            let mut max = 0f64;
+            for j in 0..n {
+                for i in 0..n {
+                    let (x, y) = (grid.x_of(i), grid.y_of(j));
+                    let exact = 1.0 - ov(-0.1, 0.15, x) * ov(-0.05, 0.2, y);
+                    max = max.max((v[j * n + i] as f64 - exact).abs());
+                }
+            }
+            // A 32x32 stratification: the shadow's edges cross at most 2 x 32
+            // strata per axis, each wrong by at most 1/1024 -> 4 * 32 / 1024.
+            assert!(max <= 4.0 * 32.0 / 1024.0, "{engine:?}: max error {max}");
         }
-        // A 32x32 stratification: the shadow's edges cross at most 2 x 32
-        // strata per axis, each wrong by at most 1/1024 -> 4 * 32 / 1024.
-        assert!(max <= 4.0 * 32.0 / 1024.0, "max error {max}");
     }
 
     #[test]
@@ -361,23 +452,29 @@ mod tests {
         let a = Exact {
             samples: 64,
             probe: None,
+            engine: Engine::Rays,
         }
         .visibility_points(&mk(Some(&tris)), &pts);
         let b = Exact {
             samples: 64,
             probe: None,
+            engine: Engine::Rays,
         }
         .visibility_points(&mk(Some(&tris)), &pts);
         assert_eq!(a, b);
         assert!(a[0] < 1.0 && a[1] == 1.0);
         let empty: Vec<[Vec3; 3]> = vec![];
-        assert_eq!(
-            Exact {
+        for engine in Engine::ALL {
+            let exact = Exact {
                 samples: 64,
-                probe: None
-            }
-            .visibility_points(&mk(Some(&empty)), &pts),
-            vec![1.0, 1.0]
-        );
+                probe: None,
+                engine,
+            };
+            assert_eq!(exact.visibility_points(&mk(Some(&tris)), &pts), a);
+            assert_eq!(
+                exact.visibility_points(&mk(Some(&empty)), &pts),
+                vec![1.0, 1.0]
+            );
+        }
     }
 }

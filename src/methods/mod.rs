@@ -21,11 +21,13 @@ mod bvh_node;
 pub(crate) mod bvh_wide;
 pub mod capabilities;
 pub mod config;
+pub mod engine;
 pub mod exact;
 pub(crate) mod gather;
 pub mod info;
 pub mod inputs;
 pub mod keywords;
+pub(crate) mod masks;
 pub(crate) mod packet;
 pub mod pcf;
 mod pcf_disk;
@@ -79,7 +81,11 @@ pub enum Method {
     },
     /// Ray casting against the occluder triangles with stratified light
     /// samples; with a probe, only where a first pass is unsure (`probe.rs`).
-    Exact { samples: u32, probe: Option<u32> },
+    Exact {
+        samples: u32,
+        probe: Option<u32>,
+        engine: engine::Engine,
+    },
     /// Micro-patches marking light samples in a bit mask per receiver (OR);
     /// `hierarchy` as for Ssm (on by default); `gaps` how neighbouring
     /// micro-patches meet (closed: connected micro-quads).
@@ -190,7 +196,15 @@ impl Method {
                 hierarchy: hierarchy.then_some(HIERARCHY),
                 precision,
             }),
-            Method::Exact { samples, probe } => Box::new(exact::Exact { samples, probe }),
+            Method::Exact {
+                samples,
+                probe,
+                engine,
+            } => Box::new(exact::Exact {
+                samples,
+                probe,
+                engine,
+            }),
             Method::Bitmask {
                 samples,
                 hierarchy,
@@ -227,6 +241,9 @@ impl MethodConfig {
             MethodConfig::Exact(c) => Method::Exact {
                 samples: c.samples,
                 probe: c.probe,
+                // Resolved configs hold their engine; an unresolved one's is
+                // the CPU's.
+                engine: c.engine_for(crate::backend::Backend::Cpu),
             },
             MethodConfig::Pcss(c) => Method::Pcss {
                 max_taps: c.max_taps,

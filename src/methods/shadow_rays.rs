@@ -113,6 +113,25 @@ pub(crate) trait RayOrigin: Sync {
     fn surface(&self) -> Option<SurfacePoint> {
         None
     }
+    /// Every origin `origin` gives, and which light points each serves
+    /// (`masks/`, which works origin by origin).
+    #[inline(always)]
+    fn origins(&self) -> Origins {
+        Origins::One(self.origin(0.0, 0.0))
+    }
+}
+
+/// A receiver's ray origins: one for every light point, or two, `above`
+/// for the light points (x, y) with side[0] + x side[1] + y side[2] >= 0
+/// (in that order of operations, f32) and `below` for the others.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Origins {
+    One(Vec3),
+    Two {
+        above: Vec3,
+        below: Vec3,
+        side: [f32; 3],
+    },
 }
 
 /// A Lambertian surface point p (kernel space) and its tangent plane,

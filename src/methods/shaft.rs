@@ -28,7 +28,7 @@ const MARGIN: f32 = 1e-5;
 
 /// The rays from the origin box [olo, ohi] to the light rectangle
 /// [x0, x1] x [y0, y1] at z = 0.
-struct Shaft {
+pub(crate) struct Shaft {
     olo: Vec3,
     ohi: Vec3,
     rect: [[f32; 2]; 2],
@@ -39,7 +39,7 @@ struct Shaft {
 impl Shaft {
     /// The shaft, or `None` where an origin lies at or behind the light's
     /// plane (no shaft bounds its rays).
-    fn new(bvh: &Bvh, olo: Vec3, ohi: Vec3, rect: [[f32; 2]; 2]) -> Option<Shaft> {
+    pub(crate) fn new(bvh: &Bvh, olo: Vec3, ohi: Vec3, rect: [[f32; 2]; 2]) -> Option<Shaft> {
         let root = bvh.nodes[0];
         let scale = root
             .min
@@ -56,7 +56,7 @@ impl Shaft {
 
     /// Whether a ray of the shaft could enter `n`'s box.
     #[inline]
-    fn meets(&self, n: &Node) -> bool {
+    pub(crate) fn meets(&self, n: &Node) -> bool {
         self.meets_box(n.min, n.max)
     }
 

@@ -270,7 +270,7 @@ fn render_sphere<S: EyeStages>(
     start: Instant,
 ) -> Result<(EyeImage, MethodConfig)> {
     let method = resolve_at_camera(call, S::BACKEND)?;
-    let (samples, probe) = exact_samples(call, &method);
+    let (samples, probe, _) = exact_samples(call, &method);
     let mut sw = Stopwatch::new();
     let (g, bvh) = match reuse.as_mut().and_then(|r| r.take()) {
         Some(Traced::Sphere { g, bvh }) => (g, bvh),
@@ -378,7 +378,7 @@ fn render_traced<S: EyeStages>(
 ) -> Result<(EyeImage, MethodConfig)> {
     let size = (call.camera.width, call.camera.height);
     let method = resolve_at_camera(call, S::BACKEND)?;
-    let (samples, probe) = exact_samples(call, &method);
+    let (samples, probe, engine) = exact_samples(call, &method);
     let mut sw = Stopwatch::new();
     // Where this call's new tree's shape goes once it has been traced.
     let mut keep_for = None;
@@ -414,7 +414,7 @@ fn render_traced<S: EyeStages>(
             (g, f, bvh)
         }
     };
-    let (v, vw) = stages.trace(&f, &bvh, call.camera, samples, probe, &mut sw)?;
+    let (v, vw) = stages.trace(&f, &bvh, call.camera, (samples, probe, engine), &mut sw)?;
     sw.lap("shadow");
     // `exact` against itself with four times its samples, through the same
     // tree: its own sampling error.

@@ -70,11 +70,13 @@ pub fn from_scene(
         let tris: Vec<[Vec3; 3]> = light_space_triangles(&occ_ls, scene.faces);
         sw.lap("triangles");
         let starts = rays::ray_starts(light, unit, &points, &normals);
-        let (samples, probe) = match s.method {
-            crate::methods::Method::Exact { samples, probe } if !light_shape.is_point() => {
-                (samples, probe)
-            }
-            _ => (1, None),
+        let (samples, probe, engine) = match s.method {
+            crate::methods::Method::Exact {
+                samples,
+                probe,
+                engine,
+            } if !light_shape.is_point() => (samples, probe, engine),
+            _ => (1, None, crate::methods::engine::Engine::Rays),
         };
         // Keys are texel indices, as the light-view exact's.
         let keyed: Vec<Option<rays::RayStart>> = {
@@ -95,7 +97,7 @@ pub fn from_scene(
             &keyed,
             |k| k as u64,
             &order,
-            samples,
+            (samples, engine),
             probe,
         );
         for &k in &texels {

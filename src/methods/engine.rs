@@ -1,0 +1,54 @@
+//! How `exact` finds which of a receiver's light samples are hidden: a
+//! shadow ray a sample through the BVH (`shadow_rays.rs`, the reference),
+//! or each receiver's sample mask from the triangles that cross its light
+//! (`masks/`). Both answer the same question on the same shared pattern and
+//! differ only on rays that graze an edge (`masks/tests.rs`).
+
+use super::bvh::Bvh;
+use super::shadow_rays::{visibilities_weighted as traced, Jitter, RayOrigin, Sampling};
+
+/// The way `exact`'s samples are decided.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Engine {
+    /// One shadow ray a light sample (packets of neighbouring receivers).
+    Rays,
+    /// Each receiver's samples marked by the triangles crossing its light.
+    #[default]
+    Masks,
+}
+
+impl Engine {
+    pub const ALL: [Engine; 2] = [Engine::Rays, Engine::Masks];
+
+    /// The name a user passes as `engine=`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Rays => "rays",
+            Engine::Masks => "masks",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Engine> {
+        Engine::ALL.into_iter().find(|e| e.name() == name)
+    }
+}
+
+/// `[V, V_w]` of each receiver (`shadow_rays::visibilities_weighted`'s
+/// contract), by `engine`; the masks need the shared pattern, so a
+/// per-receiver jitter (the probe's) always traces rays.
+pub(crate) fn visibilities_weighted<R: RayOrigin>(
+    engine: Engine,
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    key: impl Fn(usize) -> u64 + Sync,
+    order: &[usize],
+    s: &Sampling,
+    absent: f32,
+) -> Vec<[f32; 2]> {
+    match engine {
+        Engine::Masks if s.jitter == Jitter::Shared => {
+            super::masks::visibilities_weighted(bvh, receivers, order, s, absent)
+        }
+        _ => traced(bvh, receivers, key, order, s, absent),
+    }
+}

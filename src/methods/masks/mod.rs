@@ -1,0 +1,279 @@
+//! `exact`'s answer without a ray per light sample: each receiver's
+//! blocked samples found from the triangles that cross its light, one bit
+//! mask a receiver (the backprojection of Drettakis & Fiume 1994, on the
+//! fixed sample pattern of `exact`, as the soft irregular shadow maps of
+//! Sintorn, Eisemann & Assarsson 2008 build their masks from triangles).
+//!
+//! Each receiver traverses the BVH with its shaft to the whole light
+//! (`shaft.rs`), nearer children first (the light at depth 0, the receiver
+//! deepest: what lies near it casts the largest shadow on the light). A
+//! node is skipped where its shaft misses it, or where every cell of the
+//! pattern its box's shadow on the light covers is marked already (an
+//! occlusion cull: the triangles behind an umbra cost one box test). Per
+//! triangle, the samples it hides are the ones inside a handful of
+//! half-planes of the light (`cover.rs`), found a cell of the pattern at a
+//! time (`cells.rs`): cells the triangle's shadow covers are marked whole,
+//! cells it misses are skipped, and only the cells its edges cross are
+//! tested sample by sample. A receiver stops when every sample is marked
+//! (an umbra). Its visibility is the unmarked share.
+//!
+//! What it computes is what `exact` computes with the same samples
+//! (`shadow_rays::visibilities_weighted`, the shared pattern): a sample is
+//! marked where its segment crosses a triangle at t in (t0, t1), edges
+//! included; the two decide in different floating-point operations, so a
+//! ray that grazes an edge (within rounding) may be answered differently
+//! (`tests.rs` counts the pixels that differ). Its cost grows with the
+//! triangles crossing the light and the cells their edges cross, not with
+//! the samples: a receiver whose shaft meets no leaf is lit with no test
+//! at all, and four times the samples cost the partial cells' tests only.
+//!
+//! The weighted visibility (the eye view's shaded image) is `exact`'s: the
+//! unmarked samples' weights over all of theirs, summed in the same order.
+
+mod cells;
+mod cover;
+#[cfg(test)]
+mod tests;
+
+use super::bvh::Bvh;
+use super::shadow_rays::{Jitter, Origins, RayOrigin, Sampling, RAY_EPS};
+use super::shaft::Shaft;
+use cells::Cells;
+use cover::{all_marked, box_shadow, cell_range, cover, mark, shadow_box, HalfPlane};
+use rayon::prelude::*;
+
+/// Receivers per parallel task.
+const CHUNK: usize = 64;
+
+/// `shadow_rays::visibilities_weighted` for the shared pattern (`s.jitter`
+/// must be `Jitter::Shared`): `[V, V_w]` of each receiver, `absent` for
+/// `None`, computed from the triangles instead of a ray per sample.
+pub(crate) fn visibilities_weighted<R: RayOrigin>(
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    order: &[usize],
+    s: &Sampling,
+    absent: f32,
+) -> Vec<[f32; 2]> {
+    debug_assert_eq!(s.jitter, Jitter::Shared);
+    debug_assert_eq!(order.len(), receivers.len());
+    let (na, nb) = s.light.grid;
+    let light = s.light.region(0, na, 0, nb);
+    let points: Vec<(f32, f32)> = (0..nb)
+        .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
+        .map(|(sa, sb)| s.sample(0, sa, sb))
+        .collect();
+    let cells = Cells::new(&points, light);
+    let stop = crate::cancel::current();
+    let ctx = Ctx {
+        bvh,
+        cells: &cells,
+        points: &points,
+        t0: s.t0,
+        t1: 1.0 - RAY_EPS,
+        light,
+    };
+    let shaded: Vec<Vec<(usize, [f32; 2])>> = order
+        .par_chunks(CHUNK)
+        .map_init(Scratch::default, |scratch, chunk| {
+            if stop.is_cancelled() {
+                return vec![];
+            }
+            chunk
+                .iter()
+                .filter_map(|&k| receivers[k].as_ref().map(|r| (k, ctx.dispatch(r, scratch))))
+                .collect()
+        })
+        .collect();
+    let mut v = vec![[absent; 2]; receivers.len()];
+    for (k, x) in shaded.into_iter().flatten() {
+        v[k] = x;
+    }
+    v
+}
+
+/// What every receiver reads.
+struct Ctx<'a> {
+    bvh: &'a Bvh,
+    cells: &'a Cells,
+    points: &'a [(f32, f32)],
+    t0: f32,
+    t1: f32,
+    light: [[f32; 2]; 2],
+}
+
+/// A worker's buffers, reused from receiver to receiver.
+#[derive(Default)]
+struct Scratch {
+    mask: Vec<u64>,
+    stack: Vec<u32>,
+}
+
+impl Ctx<'_> {
+    /// `receiver`, compiled for AVX2 where the CPU has it (the cells'
+    /// sample tests run eight lanes wide; the operations are the same, so
+    /// are the bits).
+    #[inline]
+    fn dispatch<R: RayOrigin>(&self, r: &R, scratch: &mut Scratch) -> [f32; 2] {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has the features the function is compiled for.
+                return unsafe { self.receiver_avx2(r, scratch) };
+            }
+        }
+        self.receiver(r, scratch)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn receiver_avx2<R: RayOrigin>(&self, r: &R, scratch: &mut Scratch) -> [f32; 2] {
+        self.receiver(r, scratch)
+    }
+
+    /// One receiver's `[V, V_w]`.
+    #[inline(always)]
+    fn receiver<R: RayOrigin>(&self, r: &R, scratch: &mut Scratch) -> [f32; 2] {
+        if self.bvh.is_empty() {
+            return [1.0; 2];
+        }
+        let cells = self.cells;
+        let (lo, hi) = r.bounds();
+        // None where an origin lies at or behind the light's plane: no
+        // shaft bounds its rays, every node is entered.
+        let shaft = Shaft::new(self.bvh, lo, hi, self.light);
+        scratch.mask.clear();
+        scratch.mask.resize(cells.len(), 0);
+        let mut open = cells.full.iter().filter(|&&f| f != 0).count();
+        let [[x0, x1], [y0, y1]] = cells.rect;
+        let origins: [(glam::Vec3, Option<HalfPlane>); 2];
+        let origins: &[(glam::Vec3, Option<HalfPlane>)] = match r.origins() {
+            Origins::One(o) => {
+                origins = [(o, None); 2];
+                &origins[..1]
+            }
+            Origins::Two { above, below, side } => {
+                let side = HalfPlane {
+                    a: side[0],
+                    b: side[1],
+                    c: side[2],
+                    strict: false,
+                };
+                match side.on_box([x0, y0], [x1, y1]) {
+                    Some(true) => {
+                        origins = [(above, None); 2];
+                        &origins[..1]
+                    }
+                    Some(false) => {
+                        origins = [(below, None); 2];
+                        &origins[..1]
+                    }
+                    None => {
+                        origins = [(above, Some(side)), (below, Some(side.not()))];
+                        &origins[..]
+                    }
+                }
+            }
+        };
+        let mut touched = false;
+        for &(o, side) in origins {
+            touched |= self.mark_from(o, side, shaft.as_ref(), scratch, &mut open);
+            if open == 0 {
+                break;
+            }
+        }
+        let mask = &scratch.mask;
+        let n = self.points.len();
+        if !touched {
+            return [1.0; 2];
+        }
+        let blocked: u32 = mask.iter().map(|w| w.count_ones()).sum();
+        let v = (n as u32 - blocked) as f32 / n as f32;
+        if blocked == 0 {
+            return [1.0; 2];
+        }
+        if !R::WEIGHTED || blocked as usize == n {
+            return [v, v];
+        }
+        // `exact`'s sums: every sample's weight in pattern order, f64.
+        let (mut seen, mut all) = (0f64, 0f64);
+        for (&(x, y), &(k, bit)) in self.points.iter().zip(&cells.slot) {
+            let w = f64::from(r.weight(x, y));
+            all += w;
+            if mask[k as usize] >> bit & 1 == 0 {
+                seen += w;
+            }
+        }
+        let vw = if all > 0.0 { (seen / all) as f32 } else { v };
+        [v, vw]
+    }
+
+    /// Marks the samples the triangles hide from origin `o` (those on
+    /// `side` of the light, where given), traversing the BVH within
+    /// `shaft`; whether a leaf was reached.
+    #[inline(always)]
+    fn mark_from(
+        &self,
+        o: glam::Vec3,
+        side: Option<HalfPlane>,
+        shaft: Option<&Shaft>,
+        scratch: &mut Scratch,
+        open: &mut usize,
+    ) -> bool {
+        let (cells, nodes, tris) = (self.cells, &self.bvh.nodes, self.bvh.triangles());
+        let (mask, stack) = (&mut scratch.mask, &mut scratch.stack);
+        stack.clear();
+        stack.push(0);
+        let mut touched = false;
+        while let Some(k) = stack.pop() {
+            let n = &nodes[k as usize];
+            if shaft.is_some_and(|s| !s.meets(n)) {
+                continue;
+            }
+            let Some(bbox) = box_shadow(n.min, n.max, o) else {
+                continue;
+            };
+            let Some(range) = cell_range(cells, bbox) else {
+                continue;
+            };
+            if all_marked(cells, mask, range) {
+                continue;
+            }
+            if n.count == 0 {
+                // Nearer the receiver (deeper) popped first.
+                let (a, b) = (n.start, n.start + 1);
+                let (near, far) = if nodes[a as usize].max.z >= nodes[b as usize].max.z {
+                    (a, b)
+                } else {
+                    (b, a)
+                };
+                stack.push(far);
+                stack.push(near);
+                continue;
+            }
+            touched = true;
+            for tri in &tris[n.start as usize..(n.start + n.count) as usize] {
+                let Some(bbox) = shadow_box(tri, o) else {
+                    continue;
+                };
+                let Some(range) = cell_range(cells, bbox) else {
+                    continue;
+                };
+                if all_marked(cells, mask, range) {
+                    continue;
+                }
+                let Some(mut c) = cover(tri, o, self.t0, self.t1) else {
+                    continue;
+                };
+                if let Some(p) = side {
+                    c = c.and(p);
+                }
+                mark(&c, cells, range, mask, open);
+                if *open == 0 {
+                    return true;
+                }
+            }
+        }
+        touched
+    }
+}
