@@ -150,7 +150,7 @@ def test_auto_with_light_maps_runs_its_map_rule_and_auto_without_traces(tmp_path
     spec = load_spec(write_spec(tmp_path / "rays", text.replace("light_maps = true\n", "")))
     assert run(spec, tmp_path / "rays" / "out", count=1, progress=False).done == 1
     record = json.loads((tmp_path / "rays" / "out" / "items" / "00000" / "00000000.json").read_text())
-    assert record["method"]["config"] == "Exact(samples=256, probe=16)"
+    assert record["method"]["config"] == "Exact(samples=256, probe=16, engine='rays')"
 
 
 def test_zstd_items_hold_the_zip_items_pixels_and_only_that_spec_hash_changes(tmp_path):

@@ -251,7 +251,7 @@ def test_the_eye_view_refines_until_its_estimate_meets_the_target(name):
     # pilot (16 samples) has none.
     assert img.method.probe == 16, img.method
     # The planned run was the 16-sample pilot (the law asks 144).
-    assert img.plan.planned == ss.Exact(samples=16) and img.plan.method == img.method
+    assert img.plan.planned == ss.Exact(samples=16, engine="rays") and img.plan.method == img.method
     assert "replaced" in img.timings and img.timings["replaced"] > 0
     shadowed = img.mask & (1.0 - ref.visibility > 1e-3)
     assert float(np.abs(img.visibility - ref.visibility)[shadowed].mean()) <= 0.01, img.plan
@@ -277,7 +277,7 @@ def test_the_eye_views_pilot_stands_where_the_penumbrae_are_narrow():
     img = ss.render(scene, light, cam, method=ss.Auto(error=0.01))
     setting = img.plan.decisions[0]
     assert setting.name == "setting" and "exact with 144 samples" in setting.why and "pilot" in setting.why
-    assert img.method == ss.Exact(samples=16) and img.plan.planned is None, img.plan
+    assert img.method == ss.Exact(samples=16, engine="rays") and img.plan.planned is None, img.plan
     assert "refine" not in [d.name for d in img.plan.decisions] and img.plan.decisions[-1].taken
     ref = ss.render(scene, light, cam, method=ss.Exact(samples=1024))
     shadowed = img.mask & (1.0 - ref.visibility > 1e-3)

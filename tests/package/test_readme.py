@@ -30,7 +30,7 @@ def test_usage_example_runs():
         == ss.Bitmask(samples=256, passes=2, occluder_resolution=256, hierarchy=True)
     )
     np.testing.assert_array_equal(accurate.visibility, env["same"].visibility)
-    assert env["reference"].occluder_depth is None and env["reference"].method == ss.Exact(samples=1024)
+    assert env["reference"].occluder_depth is None and env["reference"].method == ss.Exact(samples=1024, engine="masks")
     assert env["one_core"].threads == 1
     np.testing.assert_array_equal(env["one_core"].visibility, sm.visibility)
     np.testing.assert_array_equal(env["sm2"].visibility, ss_one_pass(env))

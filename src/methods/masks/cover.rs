@@ -101,8 +101,9 @@ impl HalfPlane {
     /// The columns [x0, x1] outside which it holds nowhere in the band of
     /// y in [y0, y1], widened by a hair over the rounding (it only skips
     /// cells where it holds at no sample); None where nowhere at all.
+    /// `inv_b` is 1 / b (computed once a triangle, not once a row).
     #[inline(always)]
-    fn x_span(&self, y0: f32, y1: f32) -> Option<[f32; 2]> {
+    fn x_span(&self, inv_b: f32, y0: f32, y1: f32) -> Option<[f32; 2]> {
         // The largest c y over the band.
         let k = self.a
             + if self.c >= 0.0 {
@@ -113,7 +114,7 @@ impl HalfPlane {
         if self.b == 0.0 {
             return (k >= 0.0).then_some([f32::NEG_INFINITY, f32::INFINITY]);
         }
-        let x = -k / self.b;
+        let x = -k * inv_b;
         let pad = 1e-4 * (1.0 + x.abs());
         if !x.is_finite() {
             return Some([f32::NEG_INFINITY, f32::INFINITY]);
@@ -356,13 +357,14 @@ pub(crate) fn mark(
 ) {
     let ([ix0, ix1], [iy0, iy1]) = range;
     let planes = &cover.planes[..cover.n];
+    let inv_b: [f32; PLANES] = std::array::from_fn(|l| 1.0 / cover.planes[l].b);
     for iy in iy0..=iy1 {
         // The columns of this row where every plane may hold: a thin or
         // slanted shadow crosses a few of the row's cells, not its box's.
         let [y0, y1] = cells.row_y[iy];
         let (mut xa, mut xb) = (f32::NEG_INFINITY, f32::INFINITY);
-        for p in planes {
-            match p.x_span(y0, y1) {
+        for (p, &inv) in planes.iter().zip(&inv_b) {
+            match p.x_span(inv, y0, y1) {
                 Some([a, b]) => {
                     xa = xa.max(a);
                     xb = xb.min(b);
