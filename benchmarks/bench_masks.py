@@ -12,7 +12,13 @@ and of its ``shadow`` stage. *Same* is the share of the pixels seeing a
 surface whose visibility the two engines give bit for bit; *max dV* the
 largest difference. *Grain* is the masks' mean |V - box3x3(V)| on the
 penumbra pixels less the 1024-sample rays' own (issue 50's noise bar: at
-most 0.002). No Mitsuba: the rays are the reference here. Writes
+most 0.002). No Mitsuba: the rays are the reference here.
+
+A second table times what an error target plans from 1024 samples
+(``api.rs``'s ``probed``): ``Exact(samples=N, probe=16)`` (the rays behind
+the default call's probe) against ``engine="masks"`` (every pixel, no
+probe), with the share of pixels whose visibility differs (the probe's
+misses, and grazing rays) and the largest difference. Writes
 ``docs/benchmarks/masks_<W>x<H>.md``.
 """
 
@@ -29,6 +35,8 @@ import softshadow as ss
 from softshadow.scenes.as_built import CALIBRATION, SCENES
 
 SAMPLES = (256, 1024)
+#: The planned sample counts of the second table.
+PLANNED = (1024, 2500)
 
 
 def box3(v: np.ndarray) -> np.ndarray:
@@ -83,7 +91,7 @@ def main() -> None:
                 total, shadow, _ = timed(scene, light, camera, m)
                 times[k].append((total, shadow))
 
-        def med(k: str, i: int) -> float:
+        def med(k: str, i: int, times: dict[str, list[tuple[float, float]]] = times) -> float:
             return float(np.median([t[i] for t in times[k]])) * 1e3
 
         seen = np.isfinite(images["rays 256"].depth)
@@ -100,6 +108,25 @@ def main() -> None:
                 f"| {med(f'rays {n}', 0) / med(f'masks {n}', 0):.2f} | {100 * same:.3f}% | {dv:.4f} | {g:+.4f} "
                 f"| {med('default', 0):.0f} | {med('default', 0) / med(f'masks {n}', 0):.2f} |"
             )
+    report.line("")
+    report.line("| scene | set | samples | probe 16 + rays ms | masks ms | probe / masks | pixels differing | max dV |")
+    report.line("|---|---|---|---|---|---|---|---|")
+    for name in args.scenes:
+        scene, light, camera = SCENES[name](resolution=res)
+        for n in PLANNED:
+            pair = {"probe": ss.Exact(samples=n, probe=16), "masks": ss.Exact(samples=n, engine="masks")}
+            imgs = {k: timed(scene, light, camera, m)[2] for k, m in pair.items()}
+            t: dict[str, list[float]] = {k: [] for k in pair}
+            for _ in range(args.repeats):
+                for k, m in pair.items():
+                    t[k].append(timed(scene, light, camera, m)[0])
+            seen = np.isfinite(imgs["masks"].depth)
+            d = np.abs(imgs["masks"].visibility - imgs["probe"].visibility)[seen]
+            tp, tm = (float(np.median(t[k])) * 1e3 for k in ("probe", "masks"))
+            report.line(
+                f"| {name} | {'calibration' if name in CALIBRATION else 'held out'} | {n} | {tp:.0f} | {tm:.0f} "
+                f"| {tp / tm:.2f} | {100 * float((d > 0).mean()):.2f}% | {float(d.max()) if d.size else 0.0:.4f} |"
+            )
     if not args.no_write:
         report.write(
             args.out,
@@ -109,7 +136,8 @@ def main() -> None:
                 "whole calls on a prepared scene (medians of interleaved rounds); the shadow stage in "
                 "brackets. *same*: pixels seeing a surface whose visibility is bit for bit the rays'. "
                 "*grain*: the masks' mean |V - box3x3(V)| over penumbra pixels less the 1024-sample "
-                "rays' own."
+                "rays' own. The second table: what an error target plans from 1024 samples, the rays behind the "
+                "probe against the masks on every pixel."
             ),
         )
 

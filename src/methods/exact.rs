@@ -141,11 +141,11 @@ impl ShadowMethod for Exact {
 /// The fewest samples at which an unset `engine` is the masks (on the
 /// CPU, without a probe). Measured with `benchmarks/bench_masks.py` on the
 /// sixteen as-built scenes at 320x240, both sets (docs/benchmarks/
-/// masks_320x240.md): at 1024 samples the masks took 1.0-16.7x less time
-/// than the rays on every scene; at 256 they were slower on five (the slats
+/// masks_320x240.md): at 1024 samples the masks took 1.0-18x less time
+/// than the rays on every scene; at 256 they were slower on four (the slats
 /// of fence_slats and blinds, room_window's frame, table_and_chairs: many
-/// thin boxes whose edges cross the light, 0.37-0.59x) and faster on the
-/// other eleven.
+/// thin boxes whose edges cross the light, 0.46-0.72x) and faster on the
+/// other twelve (1.4-5.4x).
 pub const MASKS_FROM: u32 = 1024;
 
 /// Ray casting through a BVH of the occluder triangles.

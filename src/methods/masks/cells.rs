@@ -8,11 +8,16 @@
 //! A receiver's blocked samples are one `u64` a cell, bit j the cell's j-th
 //! sample, so a cell is at most 64 samples: C grows until none holds more.
 //!
-//! C is 8 for 256 and 1024 samples (4 and 16 a cell): the cells a
-//! triangle's edges cross are tested sample by sample and cost in
-//! proportion to the samples a cell holds, the cells inside it cost one OR
-//! whatever they hold, so four times the samples cost much less than four
-//! times the time (`docs/methods/masks.md` measures it).
+//! C is about √(samples / 16): 4 for 256 samples, 8 for 1024. The cells a
+//! triangle's edges cross are tested sample by sample, the cells inside it
+//! cost one OR whatever they hold, and every cell its box reaches costs a
+//! test of its box. Chosen on the calibration scenes of the eye view
+//! (room_window, bunny_on_slab, shelf_with_objects at 320x240, 256 and 1024
+//! samples; `benchmarks/bench_masks.py`): 16 a cell took 829 ms in all, 32
+//! a cell 839 and 64 a cell 860; 8 x 8 cells at 256 samples (4 a cell, the
+//! first rule) 895. On held-out scenes 64 a cell did best (fence_slats,
+//! blinds, table_and_chairs, crowd: 1863, 1826 and 1758 ms for 16, 32 and
+//! 64 a cell): the choice is not sharp.
 
 /// Samples evaluated side by side (the partial cells' loop).
 pub(crate) const LANE: usize = 8;
@@ -50,9 +55,8 @@ impl Cells {
     /// than 64 samples.
     pub(crate) fn new(points: &[(f32, f32)], rect: [[f32; 2]; 2]) -> Cells {
         let n = points.len().max(1);
-        // About 16 samples a cell, and at least 8 x 8 cells where there are
-        // 64 samples or more.
-        let mut c = (((n as f64) / 16.0).sqrt().ceil() as usize).max(8);
+        // About 16 samples a cell (module doc).
+        let mut c = (((n as f64) / 16.0).sqrt().ceil() as usize).max(1);
         c = c.min((n as f64).sqrt().floor().max(1.0) as usize);
         loop {
             let cells = Cells::with_side(points, rect, c);
@@ -173,6 +177,7 @@ mod tests {
         }
         let cells = Cells::new(&pts, [[-0.5, 0.5], [-0.5, 0.5]]);
         assert_eq!(cells.c, 8);
+        assert_eq!(Cells::new(&pts[..256], [[-0.5, 0.5], [-0.5, 0.5]]).c, 4);
         let mut seen = std::collections::HashSet::new();
         for (i, &(k, bit)) in cells.slot.iter().enumerate() {
             assert!(seen.insert((k, bit)));
