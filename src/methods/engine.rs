@@ -35,7 +35,8 @@ impl Engine {
 
 /// `[V, V_w]` of each receiver (`shadow_rays::visibilities_weighted`'s
 /// contract), by `engine`; the masks need the shared pattern, so a
-/// per-receiver jitter (the probe's) always traces rays.
+/// per-receiver jitter (the probe's) always traces rays, and distinct
+/// samples, so a point light's (every sample at its centre) does too.
 pub(crate) fn visibilities_weighted<R: RayOrigin>(
     engine: Engine,
     bvh: &Bvh,
@@ -48,6 +49,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
     match engine {
         Engine::Masks if s.jitter == Jitter::Shared => {
             super::masks::visibilities_weighted(bvh, receivers, order, s, absent)
+                .unwrap_or_else(|| traced(bvh, receivers, key, order, s, absent))
         }
         _ => traced(bvh, receivers, key, order, s, absent),
     }

@@ -94,3 +94,14 @@ def test_the_gpu_refuses_the_masks():
     # Refused when the config resolves, before any adapter is asked for.
     with pytest.raises(ValueError, match="^engine: the GPU backend traces rays"):
         ss.soft_shadow_map(scene, light, resolution=16, method=ss.Exact(engine="masks"), backend="gpu")
+
+
+def test_a_point_light_runs_the_rays_under_either_engine():
+    # Every sample of a point light's pattern lies at its centre: the masks
+    # have no cells to sort them into and the rays answer (no endless split).
+    scene, light = scenes.square_plate(side=1.0, height=2.0)
+    point = ss.RectLight(center=light.center, normal=light.normal, up=light.up, size=(0.0, 0.0))
+    a = ss.soft_shadow_map(scene, point, resolution=32, method=ss.Exact(samples=1024, engine="masks"))
+    b = ss.soft_shadow_map(scene, point, resolution=32, method=ss.Exact(samples=1024, engine="rays"))
+    np.testing.assert_array_equal(a.visibility, b.visibility)
+    assert set(np.unique(a.visibility)) <= {0.0, 1.0} and (a.visibility == 0).any()

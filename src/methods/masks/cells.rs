@@ -22,6 +22,11 @@
 /// Samples evaluated side by side (the partial cells' loop).
 pub(crate) const LANE: usize = 8;
 
+/// The most cells a side: 256² cells hold `MAX_SAMPLES` (65 536) samples
+/// one a cell, so a pattern that still crowds one past 64 at that size has
+/// samples that coincide.
+const MAX_SIDE: usize = 256;
+
 /// The pattern in cells.
 pub(crate) struct Cells {
     /// Cells per side.
@@ -51,20 +56,22 @@ pub(crate) struct Cells {
 
 impl Cells {
     /// The cells of `points` (the pattern, row-major by stratum) inside the
-    /// box `rect`; C at least `min_side`, doubled while a cell holds more
-    /// than 64 samples.
-    pub(crate) fn new(points: &[(f32, f32)], rect: [[f32; 2]; 2]) -> Cells {
+    /// box `rect`, C doubled while a cell holds more than 64 samples; None
+    /// where one still does at `MAX_SIDE` (samples that coincide: a point
+    /// light's), which the caller traces instead.
+    pub(crate) fn new(points: &[(f32, f32)], rect: [[f32; 2]; 2]) -> Option<Cells> {
         let n = points.len().max(1);
         // About 16 samples a cell (module doc).
         let mut c = (((n as f64) / 16.0).sqrt().ceil() as usize).max(1);
         c = c.min((n as f64).sqrt().floor().max(1.0) as usize);
-        loop {
+        while c <= MAX_SIDE {
             let cells = Cells::with_side(points, rect, c);
             if cells.count.iter().all(|&k| k <= 64) {
-                return cells;
+                return Some(cells);
             }
             c *= 2;
         }
+        None
     }
 
     /// The cell (ix, iy) of the coordinate (x, y), clamped into the grid.
@@ -175,9 +182,14 @@ mod tests {
                 pts.push((x, y));
             }
         }
-        let cells = Cells::new(&pts, [[-0.5, 0.5], [-0.5, 0.5]]);
+        let cells = Cells::new(&pts, [[-0.5, 0.5], [-0.5, 0.5]]).unwrap();
         assert_eq!(cells.c, 8);
-        assert_eq!(Cells::new(&pts[..256], [[-0.5, 0.5], [-0.5, 0.5]]).c, 4);
+        assert_eq!(
+            Cells::new(&pts[..256], [[-0.5, 0.5], [-0.5, 0.5]])
+                .unwrap()
+                .c,
+            4
+        );
         let mut seen = std::collections::HashSet::new();
         for (i, &(k, bit)) in cells.slot.iter().enumerate() {
             assert!(seen.insert((k, bit)));
@@ -203,8 +215,15 @@ mod tests {
                 )
             })
             .collect();
-        let cells = Cells::new(&pts, [[-0.5, 0.5], [-0.5, 0.5]]);
+        let cells = Cells::new(&pts, [[-0.5, 0.5], [-0.5, 0.5]]).unwrap();
         assert!(cells.count.iter().all(|&k| k <= 64));
         assert_eq!(cells.count.iter().sum::<u32>(), 4096);
+    }
+
+    #[test]
+    fn coinciding_samples_have_no_cells() {
+        // A point light's pattern: every sample at its centre.
+        assert!(Cells::new(&[(0.0, 0.0); 1024], [[0.0, 0.0], [0.0, 0.0]]).is_none());
+        assert!(Cells::new(&[(0.0, 0.0); 64], [[0.0, 0.0], [0.0, 0.0]]).is_some());
     }
 }

@@ -47,14 +47,16 @@ const CHUNK: usize = 64;
 
 /// `shadow_rays::visibilities_weighted` for the shared pattern (`s.jitter`
 /// must be `Jitter::Shared`): `[V, V_w]` of each receiver, `absent` for
-/// `None`, computed from the triangles instead of a ray per sample.
+/// `None`, computed from the triangles instead of a ray per sample; None
+/// where the pattern has no cells (its samples coincide: a point light's),
+/// for the caller to trace.
 pub(crate) fn visibilities_weighted<R: RayOrigin>(
     bvh: &Bvh,
     receivers: &[Option<R>],
     order: &[usize],
     s: &Sampling,
     absent: f32,
-) -> Vec<[f32; 2]> {
+) -> Option<Vec<[f32; 2]>> {
     debug_assert_eq!(s.jitter, Jitter::Shared);
     debug_assert_eq!(order.len(), receivers.len());
     let (na, nb) = s.light.grid;
@@ -63,7 +65,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
         .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
         .map(|(sa, sb)| s.sample(0, sa, sb))
         .collect();
-    let cells = Cells::new(&points, light);
+    let cells = Cells::new(&points, light)?;
     let stop = crate::cancel::current();
     let ctx = Ctx {
         bvh,
@@ -89,7 +91,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
     for (k, x) in shaded.into_iter().flatten() {
         v[k] = x;
     }
-    v
+    Some(v)
 }
 
 /// What every receiver reads.
