@@ -8,12 +8,12 @@ use super::bvh::Bvh;
 use super::shadow_rays::{visibilities_weighted as traced, Jitter, RayOrigin, Sampling};
 
 /// The way `exact`'s samples are decided.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+/// An unset `engine` is resolved by `ExactConfig::engine_for`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Engine {
     /// One shadow ray a light sample (packets of neighbouring receivers).
     Rays,
     /// Each receiver's samples marked by the triangles crossing its light.
-    #[default]
     Masks,
 }
 

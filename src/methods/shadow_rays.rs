@@ -258,6 +258,16 @@ impl Sampling {
         self.point(key, hash(((sb * na + sa) as u64) << 1), sa, sb)
     }
 
+    /// The shared pattern's light points (every receiver's), row-major by
+    /// stratum: sample (sa, sb) at sb * a + sa.
+    pub(crate) fn shared_points(&self) -> Vec<(f32, f32)> {
+        let (na, nb) = self.light.grid;
+        (0..nb)
+            .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
+            .map(|(sa, sb)| self.sample(0, sa, sb))
+            .collect()
+    }
+
     /// `sample`, with `hs` = `hash(((sb * na + sa) as u64) << 1)`, which
     /// every receiver shares.
     #[inline(always)]
@@ -331,13 +341,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
     // not once a packet (its two permutations' walks and four hashes ran 8
     // times a sample in `trace_packet` once, 16% of a profile of Exact(64)
     // on bench_scale's mesh_125k).
-    let (na, nb) = s.light.grid;
-    let shared: Option<Vec<(f32, f32)>> = (s.jitter == Jitter::Shared).then(|| {
-        (0..nb)
-            .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
-            .map(|(sa, sb)| s.sample(0, sa, sb))
-            .collect()
-    });
+    let shared: Option<Vec<(f32, f32)>> = (s.jitter == Jitter::Shared).then(|| s.shared_points());
     // A cancelled call's remaining packets are skipped (`crate::cancel`).
     let stop = crate::cancel::current();
     let traced: Vec<Vec<(usize, [f32; 2])>> = order

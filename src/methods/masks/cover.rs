@@ -115,7 +115,11 @@ impl HalfPlane {
             return (k >= 0.0).then_some([f32::NEG_INFINITY, f32::INFINITY]);
         }
         let x = -k * inv_b;
-        let pad = 1e-4 * (1.0 + x.abs());
+        // A hair over the rounding of x itself and of k (whose terms may
+        // cancel): what is skipped lies outside the plane by more than
+        // its own evaluation's rounding.
+        let terms = self.a.abs() + (y0 * self.c).abs().max((y1 * self.c).abs());
+        let pad = 1e-4 * (1.0 + x.abs()) + 1e-5 * terms * inv_b.abs();
         if !x.is_finite() {
             return Some([f32::NEG_INFINITY, f32::INFINITY]);
         }

@@ -61,10 +61,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
     debug_assert_eq!(order.len(), receivers.len());
     let (na, nb) = s.light.grid;
     let light = s.light.region(0, na, 0, nb);
-    let points: Vec<(f32, f32)> = (0..nb)
-        .flat_map(|sb| (0..na).map(move |sa| (sa, sb)))
-        .map(|(sa, sb)| s.sample(0, sa, sb))
-        .collect();
+    let points = s.shared_points();
     let cells = Cells::new(&points, light)?;
     let stop = crate::cancel::current();
     let ctx = Ctx {
