@@ -194,7 +194,6 @@ impl Bvh {
 
     /// The input index of the triangle in each BVH slot (what `nearest`
     /// reports), for the GPU twin's closest hits (`gpu/eye_hits.wgsl`).
-    #[cfg(feature = "gpu")]
     pub(crate) fn order(&self) -> &[u32] {
         &self.order
     }

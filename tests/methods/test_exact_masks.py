@@ -36,6 +36,48 @@ def test_the_eye_view_gives_the_rays_bits(name, samples):
     assert masks.method.engine == "masks" and rays.method.engine == "rays"
 
 
+def turned_boxes() -> ss.Scene:
+    """Closed boxes as users stack them (the masks mark each by its outline):
+    thin turned slats and panels crossing each other, one box wound inside
+    out, two stacked on shared corners, a floor slab; and an open box and a
+    merged multi-box mesh beside them, which are not pieces."""
+    from softshadow.scenes.primitives import box, rotated
+
+    rng = np.random.default_rng(5)
+    meshes = [as_built.slab()]
+    for k in range(18):
+        c = (float(rng.uniform(-1, 1)), float(rng.uniform(0.4, 1.4)), float(rng.uniform(-1, 1)))
+        size = [(1.2, 0.02, 0.1), (0.5, 0.4, 0.03), (0.2, 0.25, 0.2)][k % 3]
+        m = rotated(rotated(box(c, size), float(rng.uniform(0, 180)), "x"), float(rng.uniform(0, 180)), "y")
+        if k == 4:
+            m = (m[0], m[1][:, ::-1].copy())
+        meshes.append(m)
+    meshes += [box((0.6, 0.1, 0.6), (0.2, 0.2, 0.2)), box((0.6, 0.3, 0.6), (0.2, 0.2, 0.2))]
+    v, f = box((-0.6, 0.3, 0.6), (0.4, 0.3, 0.2))
+    meshes.append((v, f[:10]))
+    (va, fa), (vb, fb) = box((0.0, 0.2, -0.6), (0.3, 0.1, 0.3)), box((0.0, 0.35, -0.6), (0.1, 0.2, 0.1))
+    meshes.append((np.vstack([va, vb]), np.vstack([fa, fb + len(va)])))
+    return ss.Scene(meshes=meshes)
+
+
+@pytest.mark.parametrize("samples", [256, 1024])
+def test_closed_boxes_marked_by_their_outline_give_the_rays_bits(samples):
+    scene = turned_boxes()
+    light = as_built.rect_light((0.3, 2.4, 0.2), (0.0, 0.0, 0.0), (1.2, 0.9))
+    cam = ss.Camera.look_at(eye=(2.2, 1.8, 2.4), target=(0.0, 0.4, 0.0), up=(0, 1, 0), fov_y=45.0, resolution=(64, 48))
+    rays = ss.render(scene, light, cam, method=ss.Exact(samples=samples, engine="rays"))
+    masks = ss.render(scene, light, cam, method=ss.Exact(samples=samples, engine="masks"))
+    seen = np.isfinite(rays.depth)
+    assert ((rays.visibility > 0) & (rays.visibility < 1)).sum() > 200
+    assert same_share(rays.visibility, masks.visibility, seen) >= SAME
+    assert np.abs(rays.visibility - masks.visibility).max() <= 2 / samples
+    # The light view: receivers on the boxes themselves, one origin each.
+    a = ss.soft_shadow_map(scene, light, resolution=48, method=ss.Exact(samples=samples, engine="rays"))
+    b = ss.soft_shadow_map(scene, light, resolution=48, method=ss.Exact(samples=samples, engine="masks"))
+    on = np.isfinite(a.receiver_depth)
+    assert same_share(a.visibility, b.visibility, on) >= SAME
+
+
 def test_the_light_view_and_points_give_the_rays_bits():
     scene, light = scenes.bunny_floating()
     rays = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Exact(samples=256, engine="rays"))

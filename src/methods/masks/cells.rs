@@ -33,6 +33,10 @@ pub(crate) struct Cells {
     pub c: usize,
     /// The light's box [[x0, x1], [y0, y1]] the grid covers.
     pub rect: [[f32; 2]; 2],
+    /// Cells per unit of x and of y (a product where `cell_of` would
+    /// divide; the samples are placed by the same function, so a box
+    /// holding a sample still reaches its cell).
+    per: [f32; 2],
     /// Per cell: the tight box of its samples (empty cells: inverted).
     pub lo: Vec<[f32; 2]>,
     pub hi: Vec<[f32; 2]>,
@@ -42,6 +46,8 @@ pub(crate) struct Cells {
     pub count: Vec<u32>,
     /// Per cell: the bits of its samples (`count` low bits).
     pub full: Vec<u64>,
+    /// The cells holding a sample.
+    pub open: usize,
     /// Per row of cells: the span of its samples' y (inverted where it has
     /// none).
     pub row_y: Vec<[f32; 2]>,
@@ -77,26 +83,31 @@ impl Cells {
     /// The cell (ix, iy) of the coordinate (x, y), clamped into the grid.
     #[inline(always)]
     pub(crate) fn cell_of(&self, x: f32, y: f32) -> (usize, usize) {
-        let f = |v: f32, [a, b]: [f32; 2]| {
-            let t = (v - a) / (b - a) * self.c as f32;
+        let f = |v: f32, [a, _]: [f32; 2], per: f32| {
+            let t = (v - a) * per;
             if t.is_nan() {
                 0
             } else {
                 (t.max(0.0) as usize).min(self.c - 1)
             }
         };
-        (f(x, self.rect[0]), f(y, self.rect[1]))
+        (
+            f(x, self.rect[0], self.per[0]),
+            f(y, self.rect[1], self.per[1]),
+        )
     }
 
     fn with_side(points: &[(f32, f32)], rect: [[f32; 2]; 2], c: usize) -> Cells {
         let mut probe = Cells {
             c,
             rect,
+            per: rect.map(|[a, b]| c as f32 / (b - a)),
             lo: vec![],
             hi: vec![],
             start: vec![],
             count: vec![],
             full: vec![],
+            open: 0,
             row_y: vec![],
             xs: vec![],
             ys: vec![],
@@ -155,6 +166,7 @@ impl Cells {
         probe.hi = hi;
         probe.start = start;
         probe.count = count;
+        probe.open = full.iter().filter(|&&f| f != 0).count();
         probe.full = full;
         probe.xs = xs;
         probe.ys = ys;

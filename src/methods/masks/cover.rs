@@ -141,10 +141,10 @@ pub(crate) struct Cover {
 
 /// The most half-planes of a `Cover`: three edges, the segments' two
 /// ends, the side of an eye-view point's tangent plane.
-pub(crate) const PLANES: usize = 6;
+pub(crate) const PLANES: usize = 8;
 
 impl Cover {
-    fn new() -> Cover {
+    pub fn new() -> Cover {
         let none = HalfPlane {
             a: 1.0,
             b: 0.0,
@@ -226,6 +226,39 @@ pub(crate) fn shadow_box(tri: &[Vec3; 3], o: Vec3) -> Option<Option<[[f32; 2]; 2
     } else {
         Some(None)
     }
+}
+
+/// Whether the origin `o` and the whole light `rect` (z = 0) lie on one
+/// side of `tri`'s plane, each farther from it than rounding reaches: then
+/// no segment between them meets the plane, and the triangle hides
+/// nothing (Möller-Trumbore's t lies outside (0, 1) by more than its
+/// error). f64, from the f32 corners.
+#[inline]
+pub(crate) fn beside(tri: &[Vec3; 3], o: Vec3, rect: [[f32; 2]; 2]) -> bool {
+    let t = tri.map(|v| v.as_dvec3());
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    let at = |p: DVec3| n.dot(p - t[0]);
+    let od = o.as_dvec3();
+    let scale = t
+        .iter()
+        .chain(std::iter::once(&od))
+        .fold(1.0f64, |m, p| m.max(p.abs().max_element()))
+        .max(f64::from(
+            rect[0][0]
+                .abs()
+                .max(rect[0][1].abs())
+                .max(rect[1][0].abs())
+                .max(rect[1][1].abs()),
+        ));
+    let margin = 1e-6 * n.length() * scale;
+    let side = at(od);
+    if !(side.abs() > margin) {
+        return false;
+    }
+    let [[x0, x1], [y0, y1]] = rect.map(|r| r.map(f64::from));
+    [(x0, y0), (x1, y0), (x0, y1), (x1, y1)]
+        .iter()
+        .all(|&(x, y)| at(DVec3::new(x, y, 0.0)) * side.signum() > margin)
 }
 
 /// `shadow_box` of the box [lo, hi]: its shadow from `o` on the light's

@@ -17,6 +17,17 @@
 //! tested sample by sample. A receiver stops when every sample is marked
 //! (an umbra). Its visibility is the unmarked share.
 //!
+//! Two shortcuts keep whole groups of triangles from that per-triangle
+//! work. A closed convex piece (a box, a slat, a wall: `pieces.rs`, found
+//! once a call in the triangles' input order) is marked by its outline
+//! seen from the origin, one convex polygon, where it lies between the
+//! light and the origin; its triangles are then skipped (thin boxes whose
+//! twelve triangles' shadows shared one outline cost 2-2.4x less). And a
+//! triangle reaching behind the origin or past the light whose plane has
+//! the origin and the whole light on one side hides nothing (`beside`):
+//! the floor a receiver lies on, or the wall a light is set in, no longer
+//! sends every cell of the light to the row loop.
+//!
 //! What it computes is what `exact` computes with the same samples
 //! (`shadow_rays::visibilities_weighted`, the shared pattern): a sample is
 //! marked where its segment crosses a triangle at t in (t0, t1), edges
@@ -32,6 +43,7 @@
 
 mod cells;
 mod cover;
+mod pieces;
 #[cfg(test)]
 mod tests;
 
@@ -39,7 +51,8 @@ use super::bvh::Bvh;
 use super::shadow_rays::{Jitter, Origins, RayOrigin, Sampling, RAY_EPS};
 use super::shaft::Shaft;
 use cells::Cells;
-use cover::{all_marked, box_shadow, cell_range, cover, mark, shadow_box, HalfPlane};
+use cover::{all_marked, beside, box_shadow, cell_range, cover, mark, shadow_box, HalfPlane};
+use pieces::Pieces;
 use rayon::prelude::*;
 
 /// Receivers per parallel task.
@@ -64,8 +77,10 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
     let points = s.shared_points();
     let cells = Cells::new(&points, light)?;
     let stop = crate::cancel::current();
+    let pieces = Pieces::find(bvh);
     let ctx = Ctx {
         bvh,
+        pieces: &pieces,
         cells: &cells,
         points: &points,
         t0: s.t0,
@@ -94,6 +109,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
 /// What every receiver reads.
 struct Ctx<'a> {
     bvh: &'a Bvh,
+    pieces: &'a Pieces,
     cells: &'a Cells,
     points: &'a [(f32, f32)],
     t0: f32,
@@ -106,6 +122,10 @@ struct Ctx<'a> {
 struct Scratch {
     mask: Vec<u64>,
     stack: Vec<u32>,
+    /// Per piece: the origin (`round`) that last met it, and whether its
+    /// outline was marked then (its triangles skipped).
+    met: Vec<(u32, bool)>,
+    round: u32,
 }
 
 impl Ctx<'_> {
@@ -143,7 +163,7 @@ impl Ctx<'_> {
         let shaft = Shaft::new(self.bvh, lo, hi, self.light);
         scratch.mask.clear();
         scratch.mask.resize(cells.len(), 0);
-        let mut open = cells.full.iter().filter(|&&f| f != 0).count();
+        let mut open = cells.open;
         let [[x0, x1], [y0, y1]] = cells.rect;
         let origins: [(glam::Vec3, Option<HalfPlane>); 2];
         let origins: &[(glam::Vec3, Option<HalfPlane>)] = match r.origins() {
@@ -220,7 +240,18 @@ impl Ctx<'_> {
         open: &mut usize,
     ) -> bool {
         let (cells, nodes, tris) = (self.cells, &self.bvh.nodes, self.bvh.triangles());
-        let (mask, stack) = (&mut scratch.mask, &mut scratch.stack);
+        let pieces = self.pieces;
+        if scratch.met.len() != pieces.len() {
+            scratch.met = vec![(0, false); pieces.len()];
+            scratch.round = 0;
+        }
+        scratch.round = scratch.round.wrapping_add(1);
+        if scratch.round == 0 {
+            scratch.met.fill((0, false));
+            scratch.round = 1;
+        }
+        let round = scratch.round;
+        let (mask, stack, met) = (&mut scratch.mask, &mut scratch.stack, &mut scratch.met);
         stack.clear();
         stack.push(0);
         let mut touched = false;
@@ -229,14 +260,21 @@ impl Ctx<'_> {
             if shaft.is_some_and(|s| !s.meets(n)) {
                 continue;
             }
-            let Some(bbox) = box_shadow(n.min, n.max, o) else {
+            if n.min.z >= o.z {
                 continue;
-            };
-            let Some(range) = cell_range(cells, bbox) else {
-                continue;
-            };
-            if all_marked(cells, mask, range) {
-                continue;
+            }
+            // The occlusion cull, once a cell is marked whole (before, no
+            // node's shadow can fall on marked cells only).
+            if *open < cells.open {
+                let Some(bbox) = box_shadow(n.min, n.max, o) else {
+                    continue;
+                };
+                let Some(range) = cell_range(cells, bbox) else {
+                    continue;
+                };
+                if all_marked(cells, mask, range) {
+                    continue;
+                }
             }
             if n.count == 0 {
                 // Nearer the receiver (deeper) popped first.
@@ -251,10 +289,31 @@ impl Ctx<'_> {
                 continue;
             }
             touched = true;
-            for tri in &tris[n.start as usize..(n.start + n.count) as usize] {
+            let leaf = n.start as usize..(n.start + n.count) as usize;
+            for (tri, &piece) in tris[leaf.clone()].iter().zip(&pieces.of[leaf]) {
+                if piece != pieces::NONE {
+                    let m = &mut met[piece as usize];
+                    if m.0 != round {
+                        *m = (round, self.outline(piece, o, side, mask, open));
+                        if *open == 0 {
+                            return true;
+                        }
+                    }
+                    if m.1 {
+                        continue;
+                    }
+                }
                 let Some(bbox) = shadow_box(tri, o) else {
                     continue;
                 };
+                // A triangle reaching behind the origin (no box bounds its
+                // shadow) or past the light: most such (the floor or the
+                // wall a receiver lies on, a wall the light is set in) have
+                // the origin and the light on one side of their plane.
+                if (bbox.is_none() || tri.iter().any(|v| v.z <= 0.0)) && beside(tri, o, self.light)
+                {
+                    continue;
+                }
                 let Some(range) = cell_range(cells, bbox) else {
                     continue;
                 };
@@ -274,5 +333,37 @@ impl Ctx<'_> {
             }
         }
         touched
+    }
+
+    /// Marks the samples piece `k` hides from `o` (on `side`), by its
+    /// outline; false where its triangles must be marked instead.
+    #[inline(always)]
+    fn outline(
+        &self,
+        k: u32,
+        o: glam::Vec3,
+        side: Option<HalfPlane>,
+        mask: &mut [u64],
+        open: &mut usize,
+    ) -> bool {
+        let [lo, hi] = self.pieces.bounds[k as usize];
+        let Some(Some(bbox)) = box_shadow(lo, hi, o) else {
+            return false;
+        };
+        // Its triangles' shadows lie inside its box's: where that misses
+        // the light or falls on marked cells only, so do theirs.
+        let Some(range) = cell_range(self.cells, Some(bbox)) else {
+            return true;
+        };
+        if all_marked(self.cells, mask, range) {
+            return true;
+        }
+        match pieces::outline(self.pieces.corners(k), o, self.t0, self.t1, side) {
+            Some(c) => {
+                mark(&c, self.cells, range, mask, open);
+                true
+            }
+            None => false,
+        }
     }
 }

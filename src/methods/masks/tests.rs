@@ -99,6 +99,50 @@ fn scene(kind: u32, seed: u64) -> Vec<[Vec3; 3]> {
                 }
             }
         }
+        // Closed convex pieces (`pieces.rs`): turned boxes, thin slats and
+        // plates, tetrahedra, a box wound inside out, boxes stacked on
+        // shared corners, and what is not a piece beside them (an open
+        // box, a closed L-shaped prism).
+        3 => {
+            for k in 0..14 {
+                let c = v(2.5) + Vec3::Z * (0.6 + z() * 0.8);
+                let h = match k % 3 {
+                    0 => Vec3::new(0.6 * r() + 0.1, 0.01, 0.08),
+                    1 => Vec3::new(0.4 * r() + 0.1, 0.3 * r() + 0.1, 0.01 + 0.02 * r()),
+                    _ => Vec3::new(0.1 + 0.3 * r(), 0.1 + 0.3 * r(), 0.1 + 0.3 * r()),
+                };
+                let q =
+                    glam::Quat::from_euler(glam::EulerRot::XYZ, 3.0 * r(), 3.0 * r(), 3.0 * r());
+                let mut b: Vec<[Vec3; 3]> = cube(Vec3::ZERO, h)
+                    .iter()
+                    .map(|t| t.map(|p| c + q * p))
+                    .collect();
+                if k == 4 {
+                    b.iter_mut().for_each(|t| t.swap(1, 2));
+                }
+                tris.extend(b);
+            }
+            for _ in 0..6 {
+                let c = v(2.5) + Vec3::Z * (0.6 + z() * 0.8);
+                let p = [v(0.6), v(0.6), v(0.6)].map(|d| c + d + Vec3::Z * (r() - 0.5) * 0.4);
+                let t = [c, p[0], p[1], p[2]];
+                tris.extend([
+                    [t[0], t[1], t[2]],
+                    [t[0], t[2], t[3]],
+                    [t[0], t[3], t[1]],
+                    [t[1], t[3], t[2]],
+                ]);
+            }
+            // Two boxes stacked: the upper one's bottom corners are the
+            // lower one's top corners, bit for bit.
+            let (lo, hi) = (Vec3::new(0.3, -0.4, 2.6), Vec3::new(0.6, -0.1, 2.9));
+            tris.extend(cube(0.5 * (lo + hi), 0.5 * (hi - lo)));
+            tris.extend(cube(0.5 * (lo + hi) - Vec3::Z * 0.3, 0.5 * (hi - lo)));
+            let mut open = cube(Vec3::new(-0.7, 0.6, 2.2), Vec3::new(0.3, 0.2, 0.05));
+            open.truncate(10);
+            tris.extend(open);
+            tris.extend(l_prism(Vec3::new(0.5, 0.8, 1.8)));
+        }
         // Closed boxes touching and intersecting, and a T-junction strip.
         _ => {
             for _ in 0..12 {
@@ -128,7 +172,7 @@ fn scene(kind: u32, seed: u64) -> Vec<[Vec3; 3]> {
 }
 
 /// The 12 triangles of the box centred at `c` with half-sides `h`.
-fn cube(c: Vec3, h: Vec3) -> Vec<[Vec3; 3]> {
+pub(super) fn cube(c: Vec3, h: Vec3) -> Vec<[Vec3; 3]> {
     let p = |i: u32| {
         c + Vec3::new(
             if i & 1 == 0 { -h.x } else { h.x },
@@ -148,6 +192,34 @@ fn cube(c: Vec3, h: Vec3) -> Vec<[Vec3; 3]> {
         .iter()
         .flat_map(|q| [[p(q[0]), p(q[1]), p(q[2])], [p(q[0]), p(q[2]), p(q[3])]])
         .collect()
+}
+
+/// A closed L-shaped prism (not convex) with its corner at `c`.
+pub(super) fn l_prism(c: Vec3) -> Vec<[Vec3; 3]> {
+    let outline = [
+        (0.0, 0.0),
+        (0.4, 0.0),
+        (0.4, 0.1),
+        (0.1, 0.1),
+        (0.1, 0.4),
+        (0.0, 0.4),
+    ];
+    let p = |k: usize, top: bool| {
+        c + Vec3::new(outline[k].0, outline[k].1, if top { 0.1 } else { 0.0 })
+    };
+    // The L as four triangles (fanned from the inner corner), twice.
+    let fan = [(3, 0, 1), (3, 1, 2), (3, 4, 5), (3, 5, 0)];
+    let mut t = vec![];
+    for (a, b, d) in fan {
+        t.push([p(a, false), p(d, false), p(b, false)]);
+        t.push([p(a, true), p(b, true), p(d, true)]);
+    }
+    for k in 0..6 {
+        let j = (k + 1) % 6;
+        t.push([p(k, false), p(j, false), p(j, true)]);
+        t.push([p(k, false), p(j, true), p(k, true)]);
+    }
+    t
 }
 
 /// A w x w grid of receivers on the floor (depth 4, a hair above it toward
@@ -220,9 +292,13 @@ fn the_same_bits_as_the_rays_on_random_scenes() {
     let w = 40;
     let order = tile_order(w, w);
     let (mut total, mut differ, mut penumbra) = (0usize, 0usize, 0usize);
-    for kind in 0..3 {
+    for kind in 0..4 {
         for seed in 0..2u64 {
             let bvh = Bvh::build(scene(kind, 11 + seed * 7 + u64::from(kind)));
+            if kind == 3 {
+                // 14 boxes (one inside out), 6 tetrahedra, 2 stacked.
+                assert_eq!(super::pieces::Pieces::find(&bvh).len(), 22);
+            }
             for (shape, n) in [
                 (LightShape::rect([1.0, 0.7]), 64),
                 (LightShape::rect([1.2, 1.2]), 256),
@@ -287,4 +363,80 @@ fn a_plate_over_the_whole_light_is_an_umbra() {
     let s = sampling(LightShape::rect([1.0, 1.0]), 1024, RAY_EPS);
     let pts = vec![Some(Vec3::new(0.1, -0.2, 3.0))];
     assert_eq!(masked(&bvh, &pts, &[0], &s, 1.0), Some(vec![[0.0, 0.0]]));
+}
+
+#[test]
+fn closed_convex_pieces_are_found_and_nothing_else() {
+    use super::pieces::{Pieces, NONE};
+    let b = |x: f32| cube(Vec3::new(x, 0.0, 2.0), Vec3::new(0.2, 0.1, 0.05));
+    let mut flipped = b(1.0);
+    flipped.iter_mut().for_each(|t| t.swap(1, 2));
+    let mut open = b(2.0);
+    open.truncate(10);
+    let tetra = {
+        let t = [
+            Vec3::new(3.0, 0.0, 2.0),
+            Vec3::new(3.3, 0.0, 2.0),
+            Vec3::new(3.0, 0.3, 2.0),
+            Vec3::new(3.0, 0.0, 2.3),
+        ];
+        vec![
+            [t[0], t[2], t[1]],
+            [t[0], t[1], t[3]],
+            [t[0], t[3], t[2]],
+            [t[1], t[2], t[3]],
+        ]
+    };
+    // What each group is: a piece or not.
+    let groups: Vec<(Vec<[Vec3; 3]>, bool)> = vec![
+        (b(0.0), true),
+        (flipped, true),
+        (open, false),
+        (tetra, true),
+        (l_prism(Vec3::new(4.0, 0.0, 2.0)), false),
+        // Stacked on shared corners: two pieces.
+        (cube(Vec3::new(5.0, 0.0, 2.0), Vec3::splat(0.1)), true),
+        (cube(Vec3::new(5.0, 0.0, 2.2), Vec3::splat(0.1)), true),
+    ];
+    let tris: Vec<[Vec3; 3]> = groups.iter().flat_map(|(g, _)| g.clone()).collect();
+    let bvh = Bvh::build(tris);
+    let pieces = Pieces::find(&bvh);
+    assert_eq!(pieces.len(), groups.iter().filter(|g| g.1).count());
+    // Each input triangle's piece, through the tree's order.
+    let mut of_input = vec![NONE; bvh.triangles().len()];
+    for (slot, &i) in bvh.order().iter().enumerate() {
+        of_input[i as usize] = pieces.of[slot];
+    }
+    let mut at = 0;
+    for (g, is) in &groups {
+        let ids = &of_input[at..at + g.len()];
+        if *is {
+            assert!(
+                ids[0] != NONE && ids.iter().all(|&k| k == ids[0]),
+                "{ids:?}"
+            );
+        } else {
+            assert!(ids.iter().all(|&k| k == NONE), "{ids:?}");
+        }
+        at += g.len();
+    }
+}
+
+#[test]
+fn a_piece_is_outlined_only_between_the_light_and_the_origin() {
+    use super::pieces::{outline, Pieces};
+    let bvh = Bvh::build(cube(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.3, 0.2, 0.1)));
+    let pieces = Pieces::find(&bvh);
+    let corners = pieces.corners(0);
+    assert_eq!(corners.len(), 8);
+    // Seen from above its middle: the outline is the top face's 4 edges
+    // (its near face's corners hide the far ones inside).
+    let c = outline(corners, Vec3::new(0.0, 0.0, 3.0), 0.0, 1.0 - RAY_EPS, None).unwrap();
+    assert_eq!(c.n, 4);
+    // Seen from the side: six.
+    let c = outline(corners, Vec3::new(2.0, 1.5, 3.0), 0.0, 1.0 - RAY_EPS, None).unwrap();
+    assert_eq!(c.n, 6);
+    // An origin inside its depths, or one whose segments start past it: none.
+    assert!(outline(corners, Vec3::new(0.0, 0.0, 1.05), 0.0, 1.0 - RAY_EPS, None).is_none());
+    assert!(outline(corners, Vec3::new(0.0, 0.0, 3.0), 0.7, 1.0 - RAY_EPS, None).is_none());
 }

@@ -1,0 +1,318 @@
+//! Closed convex pieces (a box, a slat, a wall, a tetrahedron): each one's
+//! shadow on the light is one convex polygon, the outline of its corners
+//! seen from the origin, instead of the union of its triangles' shadows.
+//!
+//! A piece P is a run of consecutive input triangles (a mesh of its own,
+//! or one part of a multi-part mesh) that is closed (every edge, corners
+//! matched bit for bit, is shared by exactly two of its triangles) and
+//! convex (every corner lies on one side of each triangle's plane, within
+//! a relative 1e-6). Its surface is then the boundary of the convex hull
+//! of its corners, so a segment from an origin o outside it crosses one of
+//! its triangles iff its direction lies in the cone from o over the hull.
+//! Where every corner lies deeper than the light and shallower than o by
+//! the same margins `cover::cover` uses to drop its end planes, every such
+//! crossing has t in (t0, t1) and o is outside P (a point inside the hull
+//! of corners would have one as deep as itself), so the samples P hides
+//! are exactly those inside the 2D convex hull of its corners projected
+//! from o onto the light (z = 0): one half-plane per hull edge (v_i, v_j),
+//! the plane through o, v_i and v_j.
+//!
+//! Those half-planes are computed as `cover::cover` computes a triangle's
+//! edge planes (m = a_i x a_j, a = v - o in f64, an exact negation when
+//! the order flips), so where the hull edge is a triangle's edge, its bits
+//! are that triangle's: a sample on the outline is decided as the
+//! triangle decides it. A hull edge that is no mesh edge (corners in a
+//! line) bounds the same cone within rounding. Where the conditions fail
+//! (a corner behind the origin or beyond the light, a hull of more edges
+//! than a cover holds, a degenerate outline), the piece's triangles are
+//! marked one by one instead, as every other triangle is.
+//!
+//! Why: a thin closed box seen across the light (a slat, a shelf, a wall)
+//! is twelve triangles whose shadows overlap along the same outline, and
+//! each one's edges cross the same cells of the pattern: the outline costs
+//! the cells its six edges cross, once.
+
+use super::cover::{Cover, HalfPlane, PLANES};
+use crate::methods::bvh::Bvh;
+use glam::{DVec2, DVec3, Vec3};
+use rayon::prelude::*;
+
+/// Corners a piece holds at most (a box has 8).
+const MAX_CORNERS: usize = 16;
+/// Triangles a piece holds at most: a closed surface of V corners has
+/// 2V - 4 triangles.
+const MAX_TRIANGLES: usize = 2 * MAX_CORNERS - 4;
+/// No piece: a triangle marked on its own.
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// The closed convex pieces of a tree's triangles.
+pub(crate) struct Pieces {
+    /// The piece of each triangle, in the tree's order (`NONE`: none).
+    pub of: Vec<u32>,
+    /// Piece k's corners are `corners[start[k]..start[k + 1]]`.
+    start: Vec<u32>,
+    corners: Vec<Vec3>,
+    /// Each piece's box.
+    pub bounds: Vec<[Vec3; 2]>,
+}
+
+impl Pieces {
+    /// The pieces of `bvh`'s triangles, found in their input order.
+    pub(crate) fn find(bvh: &Bvh) -> Pieces {
+        let tris = bvh.triangles();
+        let order = bvh.order();
+        let mut slot = vec![0u32; tris.len()];
+        for (s, &i) in order.iter().enumerate() {
+            slot[i as usize] = s as u32;
+        }
+        let mut p = Pieces {
+            of: vec![NONE; tris.len()],
+            start: vec![0],
+            corners: vec![],
+            bounds: vec![],
+        };
+        // A closed run has every edge twice, so its edges' hashes XOR to
+        // zero: the runs i..j worth the exact test have equal prefix XORs
+        // at i and j (one pass of hashes; a big mesh has almost none).
+        let xor: Vec<u64> = slot
+            .par_iter()
+            .map(|&s| edge_xor(&tris[s as usize]))
+            .collect();
+        let mut prefix = Vec::with_capacity(xor.len() + 1);
+        prefix.push(0u64);
+        for (k, x) in xor.iter().enumerate() {
+            prefix.push(prefix[k] ^ x);
+        }
+        let n = tris.len();
+        let starts: Vec<usize> = (0..n)
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter(|&i| {
+                i + 4 <= n && prefix[i + 4..=(i + MAX_TRIANGLES).min(n)].contains(&prefix[i])
+            })
+            .collect();
+        let mut next = 0;
+        for i in starts {
+            if i < next {
+                continue;
+            }
+            match closed_run(tris, &slot, i) {
+                Some((end, corners)) if convex(tris, &slot[i..end], &corners) => {
+                    let k = p.bounds.len() as u32;
+                    for &s in &slot[i..end] {
+                        p.of[s as usize] = k;
+                    }
+                    p.bounds.push(bounds(&corners));
+                    p.corners.extend_from_slice(&corners);
+                    p.start.push(p.corners.len() as u32);
+                    next = end;
+                }
+                _ => {}
+            }
+        }
+        p
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.bounds.len()
+    }
+
+    /// Piece k's corners.
+    #[inline(always)]
+    pub(crate) fn corners(&self, k: u32) -> &[Vec3] {
+        &self.corners[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
+    }
+}
+
+/// The box of `corners`.
+fn bounds(corners: &[Vec3]) -> [Vec3; 2] {
+    corners
+        .iter()
+        .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &v| {
+            [lo.min(v), hi.max(v)]
+        })
+}
+
+/// A corner's hash, from its bits (a multiply and a shift: enough to
+/// make unrelated edges' XOR vanish rarely; a false candidate only costs
+/// the exact test).
+#[inline(always)]
+fn corner_hash(v: Vec3) -> u64 {
+    let xy = u64::from(v.x.to_bits()) | u64::from(v.y.to_bits()) << 32;
+    let h = xy.wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ u64::from(v.z.to_bits()).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+    h ^ h >> 29
+}
+
+/// The XOR of a triangle's three undirected edges' hashes (an edge's is
+/// the product of its corners': symmetric, and not linear in XOR).
+#[inline(always)]
+fn edge_xor(t: &[Vec3; 3]) -> u64 {
+    let h = t.map(corner_hash);
+    h[0].wrapping_mul(h[1]) ^ h[1].wrapping_mul(h[2]) ^ h[2].wrapping_mul(h[0])
+}
+
+/// The triangles i..end (input order) where they close a surface of at
+/// most `MAX_CORNERS` corners first, and its corners; None where they do
+/// not (a corner too many, an edge shared by three).
+fn closed_run(tris: &[[Vec3; 3]], slot: &[u32], i: usize) -> Option<(usize, Vec<Vec3>)> {
+    let mut corners: Vec<[u32; 3]> = Vec::with_capacity(MAX_CORNERS);
+    let mut at: Vec<Vec3> = Vec::with_capacity(MAX_CORNERS);
+    // Undirected edges (corner ids, low first) and how many triangles use each.
+    let mut edges: Vec<([u8; 2], u8)> = Vec::with_capacity(3 * MAX_CORNERS);
+    let mut open = 0usize;
+    for j in i..(i + MAX_TRIANGLES).min(tris.len()) {
+        let t = &tris[slot[j] as usize];
+        let mut id = [0u8; 3];
+        for (c, v) in t.iter().enumerate() {
+            let key = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+            id[c] = match corners.iter().position(|k| *k == key) {
+                Some(k) => k as u8,
+                None if corners.len() < MAX_CORNERS => {
+                    corners.push(key);
+                    at.push(*v);
+                    (corners.len() - 1) as u8
+                }
+                None => return None,
+            };
+        }
+        if id[0] == id[1] || id[1] == id[2] || id[2] == id[0] {
+            return None;
+        }
+        for (a, b) in [(id[0], id[1]), (id[1], id[2]), (id[2], id[0])] {
+            let e = [a.min(b), a.max(b)];
+            match edges.iter_mut().find(|(k, _)| *k == e) {
+                Some((_, n)) if *n == 1 => {
+                    *n = 2;
+                    open -= 1;
+                }
+                Some(_) => return None,
+                None => {
+                    edges.push((e, 1));
+                    open += 1;
+                }
+            }
+        }
+        if open == 0 {
+            return (j + 1 - i >= 4).then_some((j + 1, at));
+        }
+    }
+    None
+}
+
+/// Whether every corner lies on one side of every triangle's plane (the
+/// same side for all, within a relative 1e-6 of the piece's size and
+/// its coordinates'): a closed surface of supporting planes bounds its
+/// corners' convex hull.
+fn convex(tris: &[[Vec3; 3]], slots: &[u32], corners: &[Vec3]) -> bool {
+    let [lo, hi] = bounds(corners);
+    // A relative 1e-6 of the piece's size, and of its coordinates' size
+    // (the f32 corners of a turned box are coplanar within their rounding,
+    // about 1e-7 of the coordinates).
+    let size = f64::from((hi - lo).max_element()) + f64::from(lo.abs().max(hi.abs()).max_element());
+    let mut sign = 0.0f64;
+    for &s in slots {
+        let t = tris[s as usize].map(|v| v.as_dvec3());
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        let len = n.length();
+        if !(len > 0.0) {
+            return false;
+        }
+        let tol = 1e-6 * len * size;
+        for v in corners {
+            let d = n.dot(v.as_dvec3() - t[0]);
+            if d.abs() <= tol {
+                continue;
+            }
+            if sign == 0.0 {
+                sign = d.signum();
+            } else if d.signum() != sign {
+                return false;
+            }
+        }
+    }
+    sign != 0.0
+}
+
+/// The samples piece `corners` hides from `o` (segments t in (t0, t1)),
+/// as the half-planes of its outline on the light, with `side` added;
+/// None where its triangles must be marked one by one instead.
+pub(crate) fn outline(
+    corners: &[Vec3],
+    o: Vec3,
+    t0: f32,
+    t1: f32,
+    side: Option<HalfPlane>,
+) -> Option<Cover> {
+    // The depths `cover::cover` drops its end planes for, every corner.
+    let margin = 1.0 + 1e-3;
+    let near = (1.0 - t1) * o.z * margin;
+    let far = (1.0 - t0) * o.z;
+    if !corners.iter().all(|v| v.z > near && v.z * margin < far) {
+        return None;
+    }
+    let od = o.as_dvec3();
+    let a: Vec<DVec3> = corners.iter().map(|v| v.as_dvec3() - od).collect();
+    // The corners seen from o on z = 0: o + a (o.z / (o.z - v.z)) = o - a o.z / a.z.
+    let p: Vec<DVec2> = a
+        .iter()
+        .map(|a| od.truncate() - a.truncate() * (od.z / a.z))
+        .collect();
+    let hull = hull(&p);
+    let n = hull.len();
+    if n < 3 || n + usize::from(side.is_some()) > PLANES {
+        return None;
+    }
+    let mid = hull.iter().map(|&k| p[k]).sum::<DVec2>() / n as f64;
+    let mut c = Cover::new();
+    for e in 0..n {
+        let (i, j) = (hull[e], hull[(e + 1) % n]);
+        let m = a[i].cross(a[j]);
+        // m · d at the outline's centre (d = s - o), its sign the inside's.
+        let inside = m.x * (mid.x - od.x) + m.y * (mid.y - od.y) - m.z * od.z;
+        if !(inside.abs() > 0.0) || !inside.is_finite() {
+            return None;
+        }
+        let k = inside.signum();
+        c = c.and(HalfPlane {
+            a: (k * (-m.dot(od))) as f32,
+            b: (k * m.x) as f32,
+            c: (k * m.y) as f32,
+            strict: false,
+        });
+    }
+    if let Some(s) = side {
+        c = c.and(s);
+    }
+    Some(c)
+}
+
+/// The convex hull of `p` (Andrew's monotone chain), counter-clockwise,
+/// as indices; corners on a hull edge are left out.
+fn hull(p: &[DVec2]) -> Vec<usize> {
+    let mut k: Vec<usize> = (0..p.len()).collect();
+    k.sort_unstable_by(|&i, &j| p[i].x.total_cmp(&p[j].x).then(p[i].y.total_cmp(&p[j].y)));
+    let turns_left = |h: &[usize], i: usize| {
+        let (o, a) = (p[h[h.len() - 2]], p[h[h.len() - 1]]);
+        (a - o).perp_dot(p[i] - o) > 0.0
+    };
+    // The lower chain left to right, then the upper one right to left
+    // (starting at the lower one's last corner, which it never pops).
+    let mut h: Vec<usize> = Vec::with_capacity(2 * p.len());
+    for &i in &k {
+        while h.len() >= 2 && !turns_left(&h, i) {
+            h.pop();
+        }
+        h.push(i);
+    }
+    let floor = h.len() + 1;
+    for &i in k.iter().rev().skip(1) {
+        while h.len() >= floor && !turns_left(&h, i) {
+            h.pop();
+        }
+        h.push(i);
+    }
+    // The upper chain ends where the lower began.
+    h.pop();
+    h
+}
