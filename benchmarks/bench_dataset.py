@@ -17,8 +17,12 @@ worker processes, every item's render capped at cores / workers threads
 start included.
 
 Equal error: on the first ``--error-items`` items, every setting's error is
-the mean |V - V_ref| over the pixels both renderers see alike
-(:func:`softshadow.metrics.compare_images`), against the reference with
+the mean |V - V_ref| over the pixels the reference shadows (umbra and
+penumbra) among those both renderers see alike
+(:func:`softshadow.metrics.compare_images`'s ``shadow_error``; an average
+over every pixel would hide the errors behind the lit ones), with the acne
+(reference lit, darker by > 0.05) and leaks (reference umbra, lighter by
+> 0.05) beside it, against the reference with
 ``--reference-samples`` samples a pixel (another jitter seed than the
 teacher's). The teacher's time per item at a method's error is interpolated
 log-log between the two sample counts around it (``*``: extrapolated beyond
@@ -73,13 +77,23 @@ def spec_for(text: str, folder: Path, name: str) -> Spec:
     return load_spec(path)
 
 
-def errors(specs: dict[str, Spec], teacher: Spec, items: int, reference_samples: int, threads: int) -> dict[str, float]:
-    """Mean error over the first ``items`` items of every method and of the teacher at each sample count."""
+def errors(
+    specs: dict[str, Spec], teacher: Spec, items: int, reference_samples: int, threads: int
+) -> dict[str, tuple[float, float, float]]:
+    """Over the first ``items`` items, every method's and the teacher's (at
+    each sample count): the mean error over the pixels the reference shadows
+    (``ImageComparison.shadow_error``, umbra and penumbra), and the acne and
+    leaks (shares of the reference's lit and umbra pixels off by > 0.05)."""
     from softshadow.reference import render_visibility
     from softshadow.reference._mitsuba import _mitsuba
 
     _mitsuba()[1].set_thread_count(threads)
-    sums: dict[str, list[float]] = {}
+    sums: dict[str, list[tuple[float, float, float]]] = {}
+
+    def add(name: str, img: object, ref: object) -> None:
+        c = compare_images(img, ref)
+        sums.setdefault(name, []).append((c.shadow_error, c.acne, c.leak))
+
     for k in range(items):
         params = sample_item(teacher, k)
         scene, _ = build_scene(params, teacher.folder)
@@ -90,11 +104,11 @@ def errors(specs: dict[str, Spec], teacher: Spec, items: int, reference_samples:
             m = spec.method
             config, loose = method_call(spec)
             img = render(scene, light, camera, config, map_resolution=m.map_resolution, threads=threads, **loose)
-            sums.setdefault(name, []).append(compare_images(img, ref).mean_abs)
+            add(name, img, ref)
         for s in TEACHER_SAMPLES:
-            img = render_visibility(scene, light, camera, s, seed=item_seed(teacher.seed, k))
-            sums.setdefault(f"reference {s}", []).append(compare_images(img, ref).mean_abs)
-    return {name: float(np.mean(v)) for name, v in sums.items()}
+            add(f"reference {s}", render_visibility(scene, light, camera, s, seed=item_seed(teacher.seed, k)), ref)
+    means = {name: np.mean(v, axis=0) for name, v in sums.items()}
+    return {name: (float(m[0]), float(m[1]), float(m[2])) for name, m in means.items()}
 
 
 def throughput(spec: Spec, count: int, workers: int, executor: str) -> float:
@@ -179,14 +193,15 @@ def main() -> None:
             s: spec_for(variant(text, f'name = "reference"\noptions = {{ samples = {s} }}', res), folder, f"ref{s}")
             for s in TEACHER_SAMPLES
         }
-        err = errors(specs, teachers[1], args.error_items, args.reference_samples, threads)
+        measured = errors(specs, teachers[1], args.error_items, args.reference_samples, threads)
         report.line(f"## Error on the first {args.error_items} items (reference: {args.reference_samples} samples)")
         report.line()
-        report.line("| renderer | mean error |")
-        report.line("|---|---|")
-        for name, e in err.items():
-            report.line(f"| {name} | {e:.4f} |")
+        report.line("| renderer | error over shadowed pixels | acne | leaks |")
+        report.line("|---|---|---|---|")
+        for name, (e, acne, leak) in measured.items():
+            report.line(f"| {name} | {e:.4f} | {acne:.2%} | {leak:.2%} |")
         report.line()
+        err = {name: e for name, (e, _, _) in measured.items()}
 
         # The teacher's sample counts around each method's error.
         needed = set().union(*(bracket(err[name], err) for name in specs))
