@@ -38,8 +38,11 @@ def test_demo_renders_the_eye_view_beside_mitsuba(tmp_path, capsys):
     # Both see the bunny and the floor, and Mitsuba's V is a multiple of 1/16.
     np.testing.assert_array_equal(ref["mask"], img["mask"])
     np.testing.assert_array_equal(ref["V"] * 16, np.round(ref["V"] * 16))
-    err = float(out.split("matched pixels")[1].split("mean ")[1].split(";")[0])
+    # The error is over the pixels Mitsuba shadows, acne and leaks beside it.
+    line = out.split("error over shadowed pixels")[1].split("\n")[0]
+    err = float(line.split("mean ")[1].split(";")[0])
     assert 0.0 < err < 0.05
+    assert "acne" in line and "leaks" in line
     w, h = png_size(tmp_path / "demo.png")
     assert w > 1000 and h > 800  # the 2 x 2 figure
 
@@ -55,3 +58,18 @@ def test_demo_without_mitsuba_still_draws_its_figure(tmp_path, capsys):
     assert w > h  # one row of two panels
     with pytest.raises(SystemExit):
         main(["--out", str(tmp_path), "--resolution", "0", "48"])
+
+
+def test_the_figure_shows_the_shaded_image_where_no_map_was_read():
+    pytest.importorskip("matplotlib")
+    import softshadow as ss
+    from softshadow.experiments.demo import figure
+    from softshadow.scenes import eye_view
+
+    scene, light, camera = eye_view.bunny_on_floor((48, 36))
+    img = ss.render(scene, light, camera, ss.Exact(samples=64))
+    assert not img.shadow_maps
+    panel = figure(img, 0.1).axes[-1]
+    assert len(panel.images) == 1 and "shaded" in panel.get_title()
+    shown = np.asarray(panel.images[0].get_array())
+    assert shown.shape == (36, 48, 3) and 0.0 <= shown.min() and shown.max() <= 1.0 and shown.max() > 0.5
