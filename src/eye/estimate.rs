@@ -191,16 +191,10 @@ fn estimate_with(
         // image's.
         let key = |j: usize| f.hits[pixels[j]] as u64;
         let identity: Vec<usize> = (0..pixels.len()).collect();
-        match given.or(whole.as_ref()) {
-            Some(bvh) => rays::visibility_in(
-                bvh,
-                f.light_shape,
-                &starts,
-                key,
-                &identity,
-                (samples, Engine::Rays),
-                None,
-            ),
+        // The tree culled to this draw's shafts, where no tree is given.
+        let culled_tree;
+        let bvh = match given.or(whole.as_ref()) {
+            Some(bvh) => bvh,
             None => {
                 let t = Instant::now();
                 culled += lens.len();
@@ -216,18 +210,19 @@ fn estimate_with(
                     .map(|(t, _)| *t)
                     .collect();
                 cull_seconds += t.elapsed().as_secs_f64();
-                let bvh = Bvh::build_fast(kept);
-                rays::visibility_in(
-                    &bvh,
-                    f.light_shape,
-                    &starts,
-                    key,
-                    &identity,
-                    (samples, Engine::Rays),
-                    None,
-                )
+                culled_tree = Bvh::build_fast(kept);
+                &culled_tree
             }
-        }
+        };
+        rays::visibility_in(
+            bvh,
+            f.light_shape,
+            &starts,
+            key,
+            &identity,
+            (samples, Engine::Rays),
+            None,
+        )
     };
     drawn(
         (&f.hits, size),
