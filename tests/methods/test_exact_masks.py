@@ -78,6 +78,55 @@ def test_closed_boxes_marked_by_their_outline_give_the_rays_bits(samples):
     assert same_share(a.visibility, b.visibility, on) >= SAME
 
 
+def rounded_solids() -> ss.Scene:
+    """Closed convex meshes of many triangles as trimesh makes them (the masks
+    mark each by its silhouette): icospheres, a UV sphere, a cylinder and a
+    capsule, one sphere wound inside out, one sunk into the floor and one
+    through another; and closed meshes that are not convex beside them (a
+    torus, a dented sphere), which are marked triangle by triangle."""
+    import trimesh
+
+    def m(t: trimesh.Trimesh, at: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
+        return np.asarray(t.vertices) + np.asarray(at), np.asarray(t.faces)
+
+    flipped = trimesh.creation.icosphere(subdivisions=2, radius=0.2)
+    flipped.invert()
+    dented = trimesh.creation.icosphere(subdivisions=2, radius=0.25)
+    v = np.asarray(dented.vertices).copy()
+    v[7] *= 0.6
+    meshes = [
+        as_built.slab(),
+        m(trimesh.creation.icosphere(subdivisions=3, radius=0.3), (-0.5, 0.6, 0.0)),
+        m(trimesh.creation.uv_sphere(radius=0.25, count=[24, 24]), (0.4, 0.9, -0.2)),
+        m(trimesh.creation.cylinder(radius=0.12, height=0.8, sections=40), (0.1, 0.5, 0.5)),
+        m(trimesh.creation.capsule(height=0.5, radius=0.1, count=[16, 16]), (-0.2, 1.2, -0.5)),
+        m(flipped, (0.7, 0.4, 0.5)),
+        m(trimesh.creation.icosphere(subdivisions=2, radius=0.3), (-0.8, 0.1, -0.6)),
+        m(trimesh.creation.icosphere(subdivisions=2, radius=0.2), (-0.35, 0.75, 0.2)),
+        m(trimesh.creation.torus(major_radius=0.25, minor_radius=0.07), (0.6, 1.3, 0.0)),
+        (v + np.array([0.0, 1.0, -0.9]), np.asarray(dented.faces)),
+    ]
+    return ss.Scene(meshes=meshes)
+
+
+@pytest.mark.parametrize("samples", [256, 1024])
+def test_solids_marked_by_their_silhouette_give_the_rays_bits(samples):
+    scene = rounded_solids()
+    light = as_built.rect_light((0.3, 2.4, 0.2), (0.0, 0.0, 0.0), (1.2, 0.9))
+    cam = ss.Camera.look_at(eye=(2.2, 1.8, 2.4), target=(0.0, 0.5, 0.0), up=(0, 1, 0), fov_y=45.0, resolution=(64, 48))
+    rays = ss.render(scene, light, cam, method=ss.Exact(samples=samples, engine="rays"))
+    masks = ss.render(scene, light, cam, method=ss.Exact(samples=samples, engine="masks"))
+    seen = np.isfinite(rays.depth)
+    assert ((rays.visibility > 0) & (rays.visibility < 1)).sum() > 200
+    assert same_share(rays.visibility, masks.visibility, seen) >= SAME
+    assert np.abs(rays.visibility - masks.visibility).max() <= 2 / samples
+    # The light view: receivers on the solids themselves, one origin each.
+    a = ss.soft_shadow_map(scene, light, resolution=48, method=ss.Exact(samples=samples, engine="rays"))
+    b = ss.soft_shadow_map(scene, light, resolution=48, method=ss.Exact(samples=samples, engine="masks"))
+    on = np.isfinite(a.receiver_depth)
+    assert same_share(a.visibility, b.visibility, on) >= SAME
+
+
 def test_the_light_view_and_points_give_the_rays_bits():
     scene, light = scenes.bunny_floating()
     rays = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Exact(samples=256, engine="rays"))

@@ -44,6 +44,8 @@
 mod cells;
 mod cover;
 mod pieces;
+mod polygon;
+mod solids;
 #[cfg(test)]
 mod tests;
 
@@ -126,6 +128,8 @@ struct Scratch {
     /// outline was marked then (its triangles skipped).
     met: Vec<(u32, bool)>,
     round: u32,
+    /// The solids' silhouettes (`solids.rs`).
+    solids: solids::Scratch,
 }
 
 impl Ctx<'_> {
@@ -251,7 +255,12 @@ impl Ctx<'_> {
             scratch.round = 1;
         }
         let round = scratch.round;
-        let (mask, stack, met) = (&mut scratch.mask, &mut scratch.stack, &mut scratch.met);
+        let (mask, stack, met, sil) = (
+            &mut scratch.mask,
+            &mut scratch.stack,
+            &mut scratch.met,
+            &mut scratch.solids,
+        );
         stack.clear();
         stack.push(0);
         let mut touched = false;
@@ -276,6 +285,22 @@ impl Ctx<'_> {
                     continue;
                 }
             }
+            // A node of one piece: its outline once, the node skipped
+            // where it is marked.
+            let whole = pieces.node[k as usize];
+            if whole != pieces::NONE {
+                let m = &mut met[whole as usize];
+                if m.0 != round {
+                    *m = (round, self.outline(whole, o, side, mask, open, sil));
+                    if *open == 0 {
+                        return true;
+                    }
+                }
+                if m.1 {
+                    touched = true;
+                    continue;
+                }
+            }
             if n.count == 0 {
                 // Nearer the receiver (deeper) popped first.
                 let (a, b) = (n.start, n.start + 1);
@@ -294,7 +319,7 @@ impl Ctx<'_> {
                 if piece != pieces::NONE {
                     let m = &mut met[piece as usize];
                     if m.0 != round {
-                        *m = (round, self.outline(piece, o, side, mask, open));
+                        *m = (round, self.outline(piece, o, side, mask, open, sil));
                         if *open == 0 {
                             return true;
                         }
@@ -345,6 +370,7 @@ impl Ctx<'_> {
         side: Option<HalfPlane>,
         mask: &mut [u64],
         open: &mut usize,
+        sil: &mut solids::Scratch,
     ) -> bool {
         let [lo, hi] = self.pieces.bounds[k as usize];
         let Some(Some(bbox)) = box_shadow(lo, hi, o) else {
@@ -358,7 +384,15 @@ impl Ctx<'_> {
         if all_marked(self.cells, mask, range) {
             return true;
         }
-        match pieces::outline(self.pieces.corners(k), o, self.t0, self.t1, side) {
+        let corners = self.pieces.corners(k);
+        if let Some(solid) = self.pieces.solid(k) {
+            let ok = solids::outline(solid, corners, [lo, hi], o, self.t0, self.t1, side, sil);
+            if ok {
+                polygon::mark_polygon(&sil.planes, &sil.ys, self.cells, range, mask, open, &mut sil.active);
+            }
+            return ok;
+        }
+        match pieces::outline(corners, o, self.t0, self.t1, side) {
             Some(c) => {
                 mark(&c, self.cells, range, mask, open);
                 true

@@ -33,6 +33,7 @@
 //! the cells its six edges cross, once.
 
 use super::cover::{Cover, HalfPlane, PLANES};
+use super::solids::Solid;
 use crate::methods::bvh::Bvh;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
@@ -44,6 +45,9 @@ const MAX_CORNERS: usize = 16;
 const MAX_TRIANGLES: usize = 2 * MAX_CORNERS - 4;
 /// No piece: a triangle marked on its own.
 pub(crate) const NONE: u32 = u32::MAX;
+/// Triangles a solid (`solids.rs`) holds at most: its silhouette is found
+/// by a pass over its triangles and edges, once per origin that meets it.
+const MAX_SOLID: usize = 1 << 16;
 
 /// The closed convex pieces of a tree's triangles.
 pub(crate) struct Pieces {
@@ -54,6 +58,14 @@ pub(crate) struct Pieces {
     corners: Vec<Vec3>,
     /// Each piece's box.
     pub bounds: Vec<[Vec3; 2]>,
+    /// Each piece's topology where it is a solid (`solids.rs`: more
+    /// triangles than a hull of its corners is worth), None where it is
+    /// outlined by that hull.
+    pub solids: Vec<Option<Solid>>,
+    /// Per node of the tree: the piece every triangle under it belongs
+    /// to, else `NONE` (a traversal meeting an outlined piece's node skips
+    /// it whole: a solid's thousands of triangles cost one box test).
+    pub node: Vec<u32>,
 }
 
 impl Pieces {
@@ -70,6 +82,8 @@ impl Pieces {
             start: vec![0],
             corners: vec![],
             bounds: vec![],
+            solids: vec![],
+            node: vec![],
         };
         // A closed run has every edge twice, so its edges' hashes XOR to
         // zero: the runs i..j worth the exact test have equal prefix XORs
@@ -102,15 +116,78 @@ impl Pieces {
                     for &s in &slot[i..end] {
                         p.of[s as usize] = k;
                     }
-                    p.bounds.push(bounds(&corners));
-                    p.corners.extend_from_slice(&corners);
-                    p.start.push(p.corners.len() as u32);
+                    p.push(&corners, None);
                     next = end;
                 }
                 _ => {}
             }
         }
+        p.find_solids(tris, &slot, &prefix);
+        p.node = node_pieces(bvh, &p.of);
         p
+    }
+
+    fn push(&mut self, corners: &[Vec3], solid: Option<Solid>) {
+        self.bounds.push(bounds(corners));
+        self.corners.extend_from_slice(corners);
+        self.start.push(self.corners.len() as u32);
+        self.solids.push(solid);
+    }
+
+    /// The solids: runs i..j longer than a piece, no triangle of them in
+    /// one, with equal prefix XORs at i and j (j the next index holding
+    /// i's), each tested as `Solid::new` says after a sample of its
+    /// corners and planes (`likely_convex`: a bunny or a person fails it
+    /// in a few hundred products, before the sort). The tests run in
+    /// parallel; overlapping runs keep the first.
+    fn find_solids(&mut self, tris: &[[Vec3; 3]], slot: &[u32], prefix: &[u64]) {
+        let n = tris.len();
+        let next = next_equal(prefix);
+        let free = |i: usize, j: usize| slot[i..j].iter().all(|&s| self.of[s as usize] == NONE);
+        let candidates: Vec<(usize, usize)> = (0..n)
+            .filter_map(|i| {
+                let j = next[i] as usize;
+                (next[i] != NONE && j - i > MAX_TRIANGLES && j - i <= MAX_SOLID).then_some((i, j))
+            })
+            .filter(|&(i, j)| free(i, j))
+            .collect();
+        // A bound on the work: a scene's triangles, four times over.
+        let mut work = 0usize;
+        let candidates: Vec<(usize, usize)> = candidates
+            .into_iter()
+            .take_while(|&(i, j)| {
+                work += j - i;
+                work <= 4 * n
+            })
+            .collect();
+        let found: Vec<Option<(Vec<Vec3>, Solid)>> = candidates
+            .par_iter()
+            .map(|&(i, j)| {
+                let run = &slot[i..j];
+                likely_convex(tris, run)
+                    .then(|| solid_run(tris, run))
+                    .flatten()
+            })
+            .collect();
+        let mut end = 0;
+        for (&(i, j), f) in candidates.iter().zip(found) {
+            let Some((corners, solid)) = f else { continue };
+            if i < end {
+                continue;
+            }
+            let k = self.bounds.len() as u32;
+            for &s in &slot[i..j] {
+                self.of[s as usize] = k;
+            }
+            self.push(&corners, Some(solid));
+            end = j;
+        }
+    }
+
+    /// Piece k's topology, where it is a solid.
+    #[inline(always)]
+    pub(crate) fn solid(&self, k: u32) -> Option<&Solid> {
+        self.solids[k as usize].as_ref()
     }
 
     pub(crate) fn len(&self) -> usize {
@@ -122,6 +199,102 @@ impl Pieces {
     pub(crate) fn corners(&self, k: u32) -> &[Vec3] {
         &self.corners[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
     }
+}
+
+/// Per node of `bvh`: the piece of every triangle under it (`of`), else
+/// `NONE`. Children follow their parent in the list (`bvh.rs`), so one
+/// pass from the end sees them first.
+fn node_pieces(bvh: &Bvh, of: &[u32]) -> Vec<u32> {
+    let nodes = &bvh.nodes;
+    let mut node = vec![NONE; nodes.len()];
+    if bvh.is_empty() {
+        return node;
+    }
+    for k in (0..nodes.len()).rev() {
+        let n = &nodes[k];
+        node[k] = if n.count > 0 {
+            let leaf = &of[n.start as usize..(n.start + n.count) as usize];
+            if leaf.iter().all(|&p| p == leaf[0]) {
+                leaf[0]
+            } else {
+                NONE
+            }
+        } else {
+            let (a, b) = (node[n.start as usize], node[n.start as usize + 1]);
+            if a == b {
+                a
+            } else {
+                NONE
+            }
+        };
+    }
+    node
+}
+
+/// For each i, the least j > i with `prefix[j] == prefix[i]` (`NONE`:
+/// none): a table keyed by the values (already hashes), filled from the
+/// end.
+fn next_equal(prefix: &[u64]) -> Vec<u32> {
+    let size = (2 * prefix.len()).next_power_of_two().max(16);
+    let mask = size - 1;
+    let (mut keys, mut at) = (vec![0u64; size], vec![NONE; size]);
+    let mut next = vec![NONE; prefix.len()];
+    for j in (0..prefix.len()).rev() {
+        let key = prefix[j];
+        let mut h = ((key ^ key >> 31).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 20) as usize & mask;
+        loop {
+            if at[h] == NONE {
+                keys[h] = key;
+                at[h] = j as u32;
+                break;
+            }
+            if keys[h] == key {
+                next[j] = at[h];
+                at[h] = j as u32;
+                break;
+            }
+            h = (h + 1) & mask;
+        }
+    }
+    next
+}
+
+/// Whether 64 corners of the triangles `slots`, spread over them, lie on
+/// one side of 16 of their planes (within `convex`'s tolerance): what a
+/// convex surface passes and most others fail.
+fn likely_convex(tris: &[[Vec3; 3]], slots: &[u32]) -> bool {
+    let n = slots.len();
+    let corners: Vec<Vec3> = (0..64)
+        .map(|k| tris[slots[k * n / 64] as usize][k % 3])
+        .collect();
+    let faces: Vec<u32> = (0..16).map(|k| slots[(k * n / 16 + n / 32) % n]).collect();
+    convex(tris, &faces, &corners)
+}
+
+/// The solid of the triangles `slots` (input order), with its corners.
+fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<Vec3>, Solid)> {
+    // Corners matched bit for bit: their keys sorted, one id a key.
+    let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(3 * slots.len());
+    for (f, &s) in slots.iter().enumerate() {
+        for (c, v) in tris[s as usize].iter().enumerate() {
+            keys.push(([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()], (3 * f + c) as u32));
+        }
+    }
+    keys.sort_unstable();
+    let mut faces = vec![[0u32; 3]; slots.len()];
+    let mut corners = Vec::new();
+    for (k, &(key, r)) in keys.iter().enumerate() {
+        if k == 0 || keys[k - 1].0 != key {
+            corners.push(Vec3::new(
+                f32::from_bits(key[0]),
+                f32::from_bits(key[1]),
+                f32::from_bits(key[2]),
+            ));
+        }
+        faces[r as usize / 3][r as usize % 3] = (corners.len() - 1) as u32;
+    }
+    let solid = Solid::new(&corners, &faces)?;
+    Some((corners, solid))
 }
 
 /// The box of `corners`.

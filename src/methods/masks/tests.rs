@@ -143,6 +143,36 @@ fn scene(kind: u32, seed: u64) -> Vec<[Vec3; 3]> {
             tris.extend(open);
             tris.extend(l_prism(Vec3::new(0.5, 0.8, 1.8)));
         }
+        // Solids (`solids.rs`): tessellated spheres, one inside out, one
+        // through the wall the receivers lie on, one crossing the floor's
+        // depth, a capped cylinder; and closed surfaces that are none: a
+        // torus, a dented sphere, an open hemisphere.
+        4 => {
+            for k in 0..5 {
+                let c = v(2.4) + Vec3::Z * (1.0 + z() * 0.6);
+                let mut t = uv_sphere(c, 0.15 + 0.25 * r(), 5 + k, 8 + 3 * k);
+                if k == 2 {
+                    t.iter_mut().for_each(|t| t.swap(1, 2));
+                }
+                tris.extend(t);
+            }
+            tris.extend(uv_sphere(Vec3::new(0.9, 0.3, 2.0), 0.3, 8, 12));
+            tris.extend(uv_sphere(Vec3::new(-1.2, -1.1, 3.85), 0.3, 6, 10));
+            tris.extend(cylinder(Vec3::new(-0.6, 0.9, 2.4), 0.2, 0.5, 16));
+            tris.extend(torus(Vec3::new(0.4, -0.7, 2.2), 0.35, 0.1, 16, 8));
+            let mut dented = uv_sphere(Vec3::new(-0.3, -0.2, 1.4), 0.3, 6, 10);
+            let dent = dented[20][1];
+            for t in dented.iter_mut() {
+                for p in t.iter_mut() {
+                    if *p == dent {
+                        *p = Vec3::new(-0.3, -0.2, 1.4) + (dent - Vec3::new(-0.3, -0.2, 1.4)) * 0.6;
+                    }
+                }
+            }
+            tris.extend(dented);
+            let open = uv_sphere(Vec3::new(1.4, 1.2, 2.6), 0.25, 6, 10);
+            tris.extend(open[..open.len() / 2].iter().copied());
+        }
         // Closed boxes touching and intersecting, and a T-junction strip.
         _ => {
             for _ in 0..12 {
@@ -192,6 +222,72 @@ pub(super) fn cube(c: Vec3, h: Vec3) -> Vec<[Vec3; 3]> {
         .iter()
         .flat_map(|q| [[p(q[0]), p(q[1]), p(q[2])], [p(q[0]), p(q[2]), p(q[3])]])
         .collect()
+}
+
+/// A closed sphere of `rings` bands of `segs` quads (triangles at the
+/// poles), wound outward.
+pub(super) fn uv_sphere(c: Vec3, r: f32, rings: usize, segs: usize) -> Vec<[Vec3; 3]> {
+    use std::f32::consts::{PI, TAU};
+    let p = |i: usize, j: usize| {
+        let (th, ph) = (PI * i as f32 / rings as f32, TAU * (j % segs) as f32 / segs as f32);
+        if i == 0 {
+            return c + Vec3::Z * r;
+        }
+        if i == rings {
+            return c - Vec3::Z * r;
+        }
+        c + r * Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos())
+    };
+    let mut t = vec![];
+    for i in 0..rings {
+        for j in 0..segs {
+            let (a, b, d, e) = (p(i, j), p(i, j + 1), p(i + 1, j), p(i + 1, j + 1));
+            if i > 0 {
+                t.push([a, d, b]);
+            }
+            if i + 1 < rings {
+                t.push([b, d, e]);
+            }
+        }
+    }
+    t
+}
+
+/// A closed cylinder along z of radius `r` and height `h`, `segs` sides,
+/// its caps fanned from their centres.
+pub(super) fn cylinder(c: Vec3, r: f32, h: f32, segs: usize) -> Vec<[Vec3; 3]> {
+    use std::f32::consts::TAU;
+    let p = |j: usize, top: bool| {
+        let ph = TAU * (j % segs) as f32 / segs as f32;
+        c + Vec3::new(r * ph.cos(), r * ph.sin(), if top { h } else { 0.0 })
+    };
+    let (bottom, top) = (c, c + Vec3::Z * h);
+    let mut t = vec![];
+    for j in 0..segs {
+        t.push([p(j, false), p(j + 1, false), p(j + 1, true)]);
+        t.push([p(j, false), p(j + 1, true), p(j, true)]);
+        t.push([top, p(j, true), p(j + 1, true)]);
+        t.push([bottom, p(j + 1, false), p(j, false)]);
+    }
+    t
+}
+
+/// A closed torus around z (not convex).
+pub(super) fn torus(c: Vec3, big: f32, small: f32, segs: usize, sides: usize) -> Vec<[Vec3; 3]> {
+    use std::f32::consts::TAU;
+    let p = |i: usize, j: usize| {
+        let (u, w) = (TAU * (i % segs) as f32 / segs as f32, TAU * (j % sides) as f32 / sides as f32);
+        let rr = big + small * w.cos();
+        c + Vec3::new(rr * u.cos(), rr * u.sin(), small * w.sin())
+    };
+    let mut t = vec![];
+    for i in 0..segs {
+        for j in 0..sides {
+            t.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+            t.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    t
 }
 
 /// A closed L-shaped prism (not convex) with its corner at `c`.
@@ -292,12 +388,17 @@ fn the_same_bits_as_the_rays_on_random_scenes() {
     let w = 40;
     let order = tile_order(w, w);
     let (mut total, mut differ, mut penumbra) = (0usize, 0usize, 0usize);
-    for kind in 0..4 {
+    for kind in 0..5 {
         for seed in 0..2u64 {
             let bvh = Bvh::build(scene(kind, 11 + seed * 7 + u64::from(kind)));
             if kind == 3 {
                 // 14 boxes (one inside out), 6 tetrahedra, 2 stacked.
                 assert_eq!(super::pieces::Pieces::find(&bvh).len(), 22);
+            }
+            if kind == 4 {
+                // 7 spheres and the cylinder (no torus, dent or hemisphere).
+                let p = super::pieces::Pieces::find(&bvh);
+                assert_eq!(p.solids.iter().filter(|s| s.is_some()).count(), 8);
             }
             for (shape, n) in [
                 (LightShape::rect([1.0, 0.7]), 64),
@@ -439,4 +540,54 @@ fn a_piece_is_outlined_only_between_the_light_and_the_origin() {
     // An origin inside its depths, or one whose segments start past it: none.
     assert!(outline(corners, Vec3::new(0.0, 0.0, 1.05), 0.0, 1.0 - RAY_EPS, None).is_none());
     assert!(outline(corners, Vec3::new(0.0, 0.0, 3.0), 0.7, 1.0 - RAY_EPS, None).is_none());
+}
+
+#[test]
+fn a_solid_is_outlined_by_its_silhouette_from_outside_only() {
+    use super::pieces::Pieces;
+    use super::solids::{outline, Scratch};
+    let c = Vec3::new(0.0, 0.0, 1.0);
+    let bvh = Bvh::build(uv_sphere(c, 0.3, 8, 12));
+    let pieces = Pieces::find(&bvh);
+    assert_eq!(pieces.len(), 1);
+    let solid = pieces.solid(0).expect("a solid");
+    let (corners, bounds) = (pieces.corners(0), pieces.bounds[0]);
+    assert_eq!(corners.len(), 2 + 7 * 12);
+    let mut s = Scratch::default();
+    let t1 = 1.0 - RAY_EPS;
+    // Seen from above its pole: the silhouette is one ring of 12 edges.
+    assert!(outline(solid, corners, bounds, Vec3::new(0.0, 0.0, 3.0), 0.0, t1, None, &mut s));
+    assert_eq!(s.planes.len(), 12);
+    // Its polygon holds the projected centre and not a point past its rim
+    // (from (0, 0, 3), the sphere spans about 0.3 * 3 / 2 of the light).
+    let holds = |s: &Scratch, x: f32, y: f32| s.planes.iter().all(|p| p.at(x, y) >= 0.0);
+    assert!(holds(&s, 0.0, 0.0));
+    assert!(!holds(&s, 0.6, 0.0) && holds(&s, 0.35, 0.0));
+    // From aside, with the eye view's side plane: one more plane.
+    let side = super::cover::HalfPlane { a: 1.0, b: 0.1, c: 0.0, strict: false };
+    assert!(outline(solid, corners, bounds, Vec3::new(1.0, 0.5, 3.0), 0.0, t1, Some(side), &mut s));
+    assert_eq!(s.planes.last(), Some(&side));
+    // An origin within its depths, or segments starting past it: none.
+    assert!(!outline(solid, corners, bounds, Vec3::new(0.0, 0.0, 1.1), 0.0, t1, None, &mut s));
+    assert!(!outline(solid, corners, bounds, Vec3::new(0.0, 0.0, 3.0), 0.7, t1, None, &mut s));
+    // A torus, a dented sphere, an open one, two spheres in one mesh
+    // whose second is inside out half way: closed or not, no solids.
+    let mut dented = uv_sphere(c, 0.3, 8, 12);
+    let dent = dented[30][1];
+    for t in dented.iter_mut() {
+        for p in t.iter_mut() {
+            if *p == dent {
+                *p = c + (dent - c) * 0.7;
+            }
+        }
+    }
+    let mut mixed = uv_sphere(c + Vec3::X, 0.3, 8, 12);
+    let half = mixed.len() / 2;
+    mixed[..half].iter_mut().for_each(|t| t.swap(1, 2));
+    let open = uv_sphere(c, 0.3, 8, 12)[1..].to_vec();
+    for tris in [torus(c, 0.4, 0.1, 16, 8), dented, mixed, open] {
+        let bvh = Bvh::build(tris);
+        let p = Pieces::find(&bvh);
+        assert!(p.solids.iter().all(|s| s.is_none()));
+    }
 }
