@@ -277,7 +277,10 @@ fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<Vec3>, Solid)> {
     let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(3 * slots.len());
     for (f, &s) in slots.iter().enumerate() {
         for (c, v) in tris[s as usize].iter().enumerate() {
-            keys.push(([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()], (3 * f + c) as u32));
+            keys.push((
+                [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()],
+                (3 * f + c) as u32,
+            ));
         }
     }
     keys.sort_unstable();

@@ -81,7 +81,10 @@ impl Solid {
     /// triangle, another topology than the sphere's, no volume, or an
     /// edge where the surface turns inward by more than a relative 1e-6.
     pub(crate) fn new(corners: &[Vec3], faces: &[[u32; 3]]) -> Option<Solid> {
-        if faces.iter().any(|f| f[0] == f[1] || f[1] == f[2] || f[2] == f[0]) {
+        if faces
+            .iter()
+            .any(|f| f[0] == f[1] || f[1] == f[2] || f[2] == f[0])
+        {
             return None;
         }
         // Directed edges, sorted by their undirected key: each key twice,
@@ -94,7 +97,7 @@ impl Solid {
             }
         }
         dir.sort_unstable();
-        if dir.len() % 2 != 0 {
+        if !dir.len().is_multiple_of(2) {
             return None;
         }
         let mut edges = Vec::with_capacity(dir.len() / 2);
@@ -110,7 +113,10 @@ impl Solid {
         }
         let used = {
             let mut seen = vec![false; corners.len()];
-            faces.iter().flatten().for_each(|&c| seen[c as usize] = true);
+            faces
+                .iter()
+                .flatten()
+                .for_each(|&c| seen[c as usize] = true);
             seen.iter().filter(|&&s| s).count()
         };
         if used as i64 - edges.len() as i64 + faces.len() as i64 != 2 {
@@ -119,20 +125,23 @@ impl Solid {
         let v = |c: u32| corners[c as usize].as_dvec3();
         let normal = |f: &[u32; 3]| (v(f[1]) - v(f[0])).cross(v(f[2]) - v(f[0]));
         // Outward: the signed volume's sign.
-        let volume: f64 = faces.iter().map(|f| v(f[0]).dot(v(f[1]).cross(v(f[2])))).sum();
+        let volume: f64 = faces
+            .iter()
+            .map(|f| v(f[0]).dot(v(f[1]).cross(v(f[2]))))
+            .sum();
         if !(volume.abs() > 0.0) || !volume.is_finite() {
             return None;
         }
         let out = volume.signum();
-        let [lo, hi] = corners.iter().fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[l, h], &c| {
-            [l.min(c), h.max(c)]
-        });
-        let size = f64::from((hi - lo).max_element()) + f64::from(lo.abs().max(hi.abs()).max_element());
+        let [lo, hi] = corners
+            .iter()
+            .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[l, h], &c| {
+                [l.min(c), h.max(c)]
+            });
+        let size =
+            f64::from((hi - lo).max_element()) + f64::from(lo.abs().max(hi.abs()).max_element());
         let far = |f: &[u32; 3], a: u32, b: u32| {
-            f.iter()
-                .copied()
-                .find(|&c| c != a && c != b)
-                .unwrap_or(a)
+            f.iter().copied().find(|&c| c != a && c != b).unwrap_or(a)
         };
         for e in &edges {
             let [a, b, f, g] = *e;
@@ -186,9 +195,9 @@ pub(crate) fn outline(
     // Front: o on the outer side of the plane.
     let n = solid.d.len();
     s.front.clear();
-    s.front.extend((0..n).map(|k| {
-        solid.nx[k] * o.x + solid.ny[k] * o.y + solid.nz[k] * o.z > solid.d[k]
-    }));
+    s.front.extend(
+        (0..n).map(|k| solid.nx[k] * o.x + solid.ny[k] * o.y + solid.nz[k] * o.z > solid.d[k]),
+    );
     if s.next.len() != corners.len() {
         s.next = vec![NONE; corners.len()];
     }
@@ -243,7 +252,10 @@ fn polygon(corners: &[Vec3], o: Vec3, side: Option<HalfPlane>, s: &mut Scratch) 
     s.a.extend(s.ring.iter().map(|&c| corners[c as usize].as_dvec3() - od));
     s.p.clear();
     // The corners seen from o on z = 0: o - a o.z / a.z.
-    s.p.extend(s.a.iter().map(|a| od.truncate() - a.truncate() * (od.z / a.z)));
+    s.p.extend(
+        s.a.iter()
+            .map(|a| od.truncate() - a.truncate() * (od.z / a.z)),
+    );
     let (p, a) = (&s.p, &s.a);
     let m = p.len();
     // Convex: every turn one way (within a relative hair: corners along

@@ -229,7 +229,10 @@ pub(super) fn cube(c: Vec3, h: Vec3) -> Vec<[Vec3; 3]> {
 pub(super) fn uv_sphere(c: Vec3, r: f32, rings: usize, segs: usize) -> Vec<[Vec3; 3]> {
     use std::f32::consts::{PI, TAU};
     let p = |i: usize, j: usize| {
-        let (th, ph) = (PI * i as f32 / rings as f32, TAU * (j % segs) as f32 / segs as f32);
+        let (th, ph) = (
+            PI * i as f32 / rings as f32,
+            TAU * (j % segs) as f32 / segs as f32,
+        );
         if i == 0 {
             return c + Vec3::Z * r;
         }
@@ -276,7 +279,10 @@ pub(super) fn cylinder(c: Vec3, r: f32, h: f32, segs: usize) -> Vec<[Vec3; 3]> {
 pub(super) fn torus(c: Vec3, big: f32, small: f32, segs: usize, sides: usize) -> Vec<[Vec3; 3]> {
     use std::f32::consts::TAU;
     let p = |i: usize, j: usize| {
-        let (u, w) = (TAU * (i % segs) as f32 / segs as f32, TAU * (j % sides) as f32 / sides as f32);
+        let (u, w) = (
+            TAU * (i % segs) as f32 / segs as f32,
+            TAU * (j % sides) as f32 / sides as f32,
+        );
         let rr = big + small * w.cos();
         c + Vec3::new(rr * u.cos(), rr * u.sin(), small * w.sin())
     };
@@ -556,7 +562,16 @@ fn a_solid_is_outlined_by_its_silhouette_from_outside_only() {
     let mut s = Scratch::default();
     let t1 = 1.0 - RAY_EPS;
     // Seen from above its pole: the silhouette is one ring of 12 edges.
-    assert!(outline(solid, corners, bounds, Vec3::new(0.0, 0.0, 3.0), 0.0, t1, None, &mut s));
+    assert!(outline(
+        solid,
+        corners,
+        bounds,
+        Vec3::new(0.0, 0.0, 3.0),
+        0.0,
+        t1,
+        None,
+        &mut s
+    ));
     assert_eq!(s.planes.len(), 12);
     // Its polygon holds the projected centre and not a point past its rim
     // (from (0, 0, 3), the sphere spans about 0.3 * 3 / 2 of the light).
@@ -564,12 +579,44 @@ fn a_solid_is_outlined_by_its_silhouette_from_outside_only() {
     assert!(holds(&s, 0.0, 0.0));
     assert!(!holds(&s, 0.6, 0.0) && holds(&s, 0.35, 0.0));
     // From aside, with the eye view's side plane: one more plane.
-    let side = super::cover::HalfPlane { a: 1.0, b: 0.1, c: 0.0, strict: false };
-    assert!(outline(solid, corners, bounds, Vec3::new(1.0, 0.5, 3.0), 0.0, t1, Some(side), &mut s));
+    let side = super::cover::HalfPlane {
+        a: 1.0,
+        b: 0.1,
+        c: 0.0,
+        strict: false,
+    };
+    assert!(outline(
+        solid,
+        corners,
+        bounds,
+        Vec3::new(1.0, 0.5, 3.0),
+        0.0,
+        t1,
+        Some(side),
+        &mut s
+    ));
     assert_eq!(s.planes.last(), Some(&side));
     // An origin within its depths, or segments starting past it: none.
-    assert!(!outline(solid, corners, bounds, Vec3::new(0.0, 0.0, 1.1), 0.0, t1, None, &mut s));
-    assert!(!outline(solid, corners, bounds, Vec3::new(0.0, 0.0, 3.0), 0.7, t1, None, &mut s));
+    assert!(!outline(
+        solid,
+        corners,
+        bounds,
+        Vec3::new(0.0, 0.0, 1.1),
+        0.0,
+        t1,
+        None,
+        &mut s
+    ));
+    assert!(!outline(
+        solid,
+        corners,
+        bounds,
+        Vec3::new(0.0, 0.0, 3.0),
+        0.7,
+        t1,
+        None,
+        &mut s
+    ));
     // A torus, a dented sphere, an open one, two spheres in one mesh
     // whose second is inside out half way: closed or not, no solids.
     let mut dented = uv_sphere(c, 0.3, 8, 12);
