@@ -56,7 +56,7 @@ mod solids;
 mod tests;
 
 use super::bvh::Bvh;
-use super::shadow_rays::{Jitter, Origins, RayOrigin, Sampling, RAY_EPS};
+use super::shadow_rays::{Jitter, Origins, RayOrigin, Sampling, SurfacePoint, RAY_EPS};
 use super::shaft::Shaft;
 use cells::Cells;
 use cover::{all_marked, beside, box_shadow, cell_range, cover, mark, shadow_box, HalfPlane};
@@ -65,6 +65,8 @@ use rayon::prelude::*;
 
 /// Receivers per parallel task.
 const CHUNK: usize = 64;
+/// Receivers whose weights are summed side by side.
+const WEIGH: usize = 8;
 
 /// `shadow_rays::visibilities_weighted` for the shared pattern (`s.jitter`
 /// must be `Jitter::Shared`): `[V, V_w]` of each receiver, `absent` for
@@ -101,10 +103,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
             if stop.is_cancelled() {
                 return vec![];
             }
-            chunk
-                .iter()
-                .filter_map(|&k| receivers[k].as_ref().map(|r| (k, ctx.dispatch(r, scratch))))
-                .collect()
+            ctx.dispatch(receivers, chunk, scratch)
         })
         .collect();
     let mut v = vec![[absent; 2]; receivers.len()];
@@ -112,6 +111,19 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
         v[k] = x;
     }
     Some(v)
+}
+
+/// `SurfacePoint::weight` of `WEIGH` points at the light point (x, y),
+/// the same operations in the same order (so the same bits), a lane each.
+#[inline(always)]
+fn weights(sp: &[SurfacePoint; WEIGH], x: f32, y: f32) -> [f32; WEIGH] {
+    std::array::from_fn(|j| {
+        let s = &sp[j];
+        let side = s.side[0] + x * s.side[1] + y * s.side[2];
+        let (dx, dy, dz) = (x - s.p.x, y - s.p.y, 0.0 - s.p.z);
+        let r2 = dx * dx + dy * dy + dz * dz;
+        side.max(0.0) * s.p.z / (r2 * r2)
+    })
 }
 
 /// What every receiver reads.
@@ -136,31 +148,121 @@ struct Scratch {
     round: u32,
     /// The solids' silhouettes (`solids.rs`).
     solids: solids::Scratch,
+    /// A chunk's receivers whose weights are to be summed (their place in
+    /// its output, their index) and their masks, one after the other.
+    pending: Vec<(usize, usize)>,
+    masks: Vec<u64>,
 }
 
 impl Ctx<'_> {
-    /// `receiver`, compiled for AVX2 where the CPU has it (the cells'
-    /// sample tests run eight lanes wide; the operations are the same, so
-    /// are the bits).
+    /// `chunk`, compiled for AVX2 where the CPU has it (the cells' sample
+    /// tests and the weights run eight lanes wide; the operations are the
+    /// same, so are the bits).
     #[inline]
-    fn dispatch<R: RayOrigin>(&self, r: &R, scratch: &mut Scratch) -> [f32; 2] {
+    fn dispatch<R: RayOrigin>(
+        &self,
+        receivers: &[Option<R>],
+        chunk: &[usize],
+        scratch: &mut Scratch,
+    ) -> Vec<(usize, [f32; 2])> {
         #[cfg(target_arch = "x86_64")]
         {
             if is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU has the features the function is compiled for.
-                return unsafe { self.receiver_avx2(r, scratch) };
+                return unsafe { self.chunk_avx2(receivers, chunk, scratch) };
             }
         }
-        self.receiver(r, scratch)
+        self.chunk(receivers, chunk, scratch)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn receiver_avx2<R: RayOrigin>(&self, r: &R, scratch: &mut Scratch) -> [f32; 2] {
-        self.receiver(r, scratch)
+    fn chunk_avx2<R: RayOrigin>(
+        &self,
+        receivers: &[Option<R>],
+        chunk: &[usize],
+        scratch: &mut Scratch,
+    ) -> Vec<(usize, [f32; 2])> {
+        self.chunk(receivers, chunk, scratch)
     }
 
-    /// One receiver's `[V, V_w]`.
+    /// `[V, V_w]` of the receivers `chunk`: each one's mask, then the
+    /// weights of those in a penumbra, eight receivers side by side.
+    #[inline(always)]
+    fn chunk<R: RayOrigin>(
+        &self,
+        receivers: &[Option<R>],
+        chunk: &[usize],
+        scratch: &mut Scratch,
+    ) -> Vec<(usize, [f32; 2])> {
+        let mut out = Vec::with_capacity(chunk.len());
+        scratch.pending.clear();
+        scratch.masks.clear();
+        for &k in chunk {
+            let Some(r) = receivers[k].as_ref() else {
+                continue;
+            };
+            let v = self.receiver(r, scratch);
+            if R::WEIGHTED && v[1].is_nan() {
+                scratch.pending.push((out.len(), k));
+                scratch.masks.extend_from_slice(&scratch.mask);
+            }
+            out.push((k, v));
+        }
+        let words = self.cells.len();
+        for (group, masks) in scratch
+            .pending
+            .chunks(WEIGH)
+            .zip(scratch.masks.chunks(WEIGH * words))
+        {
+            let lane = |j: usize| {
+                let (at, k) = group[j.min(group.len() - 1)];
+                (at, receivers[k].as_ref().expect("a receiver"))
+            };
+            let rs: [&R; WEIGH] = std::array::from_fn(|j| lane(j).1);
+            let ms: [&[u64]; WEIGH] = std::array::from_fn(|j| {
+                let j = j.min(group.len() - 1);
+                &masks[j * words..(j + 1) * words]
+            });
+            let vw = self.weigh(rs, ms);
+            for (j, &(at, _)) in group.iter().enumerate() {
+                let v = out[at].1[0];
+                out[at].1[1] = vw[j].unwrap_or(v);
+            }
+        }
+        out
+    }
+
+    /// `exact`'s weighted sums for `WEIGH` receivers and their masks:
+    /// every sample's weight in pattern order, f64, each receiver's sums
+    /// on their own (side by side, so that the adds of one do not wait on
+    /// the one before); None where all the weights are 0.
+    #[inline(always)]
+    fn weigh<R: RayOrigin>(&self, rs: [&R; WEIGH], ms: [&[u64]; WEIGH]) -> [Option<f32>; WEIGH] {
+        let (mut seen, mut all) = ([0f64; WEIGH], [0f64; WEIGH]);
+        let surfaces: Option<Vec<SurfacePoint>> = rs.iter().map(|r| r.surface()).collect();
+        let lanes = surfaces
+            .as_deref()
+            .and_then(|s| <&[SurfacePoint; WEIGH]>::try_from(s).ok());
+        for (&(x, y), &(k, bit)) in self.points.iter().zip(&self.cells.slot) {
+            let w: [f32; WEIGH] = match lanes {
+                Some(sp) => weights(sp, x, y),
+                None => std::array::from_fn(|j| rs[j].weight(x, y)),
+            };
+            for j in 0..WEIGH {
+                let w = f64::from(w[j]);
+                all[j] += w;
+                // Adding 0 to a sum that starts at +0 leaves it as is.
+                let clear = ms[j][k as usize] >> bit & 1 == 0;
+                seen[j] += if clear { w } else { 0.0 };
+            }
+        }
+        std::array::from_fn(|j| (all[j] > 0.0).then(|| (seen[j] / all[j]) as f32))
+    }
+
+    /// One receiver's `[V, V_w]`, V_w NaN where its weights are to be
+    /// summed (a penumbra of a weighted receiver: its mask is left in
+    /// `scratch.mask`).
     #[inline(always)]
     fn receiver<R: RayOrigin>(&self, r: &R, scratch: &mut Scratch) -> [f32; 2] {
         if self.bvh.is_empty() {
@@ -224,17 +326,8 @@ impl Ctx<'_> {
         if !R::WEIGHTED || blocked as usize == n {
             return [v, v];
         }
-        // `exact`'s sums: every sample's weight in pattern order, f64.
-        let (mut seen, mut all) = (0f64, 0f64);
-        for (&(x, y), &(k, bit)) in self.points.iter().zip(&cells.slot) {
-            let w = f64::from(r.weight(x, y));
-            all += w;
-            if mask[k as usize] >> bit & 1 == 0 {
-                seen += w;
-            }
-        }
-        let vw = if all > 0.0 { (seen / all) as f32 } else { v };
-        [v, vw]
+        // The weights are summed by `chunk`, eight receivers at a time.
+        [v, f32::NAN]
     }
 
     /// Marks the samples the triangles hide from origin `o` (those on
