@@ -44,7 +44,17 @@ pub struct Bvh {
     wide_parent: Vec<u32>,
     /// The binary node each wide node was made from (`refit.rs`).
     wide_source: Vec<u32>,
+    /// What a method derives from the tree's shape and the triangles'
+    /// input order alone (the masks' closed pieces: `masks/pieces.rs`),
+    /// made on first use and shared by the trees refitted from this one's
+    /// shape (`refit.rs`), so that a prepared scene derives it once.
+    derived: Derived,
 }
+
+/// `Bvh::derived`'s cell, shared between a tree, its shape and the trees
+/// refitted from it.
+pub(crate) type Derived =
+    std::sync::Arc<std::sync::OnceLock<std::sync::Arc<dyn std::any::Any + Send + Sync>>>;
 
 /// Each triangle as `hit_t` reads it (`Bvh::edges`).
 fn edges_of(tris: &[[Vec3; 3]]) -> Vec<[f32; 9]> {
@@ -235,7 +245,23 @@ impl Bvh {
             wide,
             wide_parent,
             wide_source,
+            derived: Derived::default(),
         }
+    }
+
+    /// The `T` derived from this tree's shape, `make` run on first use (a
+    /// cell holding another type is not replaced: `make`'s is returned
+    /// uncached).
+    pub(crate) fn derived<T: std::any::Any + Send + Sync>(
+        &self,
+        make: impl Fn() -> T,
+    ) -> std::sync::Arc<T> {
+        let any = self
+            .derived
+            .get_or_init(|| std::sync::Arc::new(make()))
+            .clone();
+        any.downcast::<T>()
+            .unwrap_or_else(|_| std::sync::Arc::new(make()))
     }
 
     /// Levels from the root to the deepest leaf (1 for a single leaf).
@@ -700,6 +726,7 @@ pub(crate) mod tests {
                 wide: vec![],
                 wide_parent: vec![],
                 wide_source: vec![],
+                derived: Derived::default(),
             };
             assert_eq!(par.order, one.order);
             assert_eq!(canonical(&par), canonical(&one));

@@ -48,6 +48,7 @@ impl Bvh {
             wide: self.wide.clone(),
             wide_parent: self.wide_parent.clone(),
             wide_source: self.wide_source.clone(),
+            derived: self.derived.clone(),
         })
     }
 }
@@ -101,6 +102,7 @@ impl Topology {
             wide,
             wide_parent: t.wide_parent.clone(),
             wide_source: t.wide_source.clone(),
+            derived: t.derived.clone(),
         })
     }
 }

@@ -386,7 +386,7 @@ impl Ctx<'_> {
             }
             // A node of one piece: its outline once, the node skipped
             // where it is marked.
-            let whole = pieces.node[k as usize];
+            let whole = pieces.node()[k as usize];
             if whole != pieces::NONE {
                 let m = &mut met[whole as usize];
                 if m.0 != round {
@@ -414,7 +414,7 @@ impl Ctx<'_> {
             }
             touched = true;
             let leaf = n.start as usize..(n.start + n.count) as usize;
-            for (tri, &piece) in tris[leaf.clone()].iter().zip(&pieces.of[leaf]) {
+            for (tri, &piece) in tris[leaf.clone()].iter().zip(&pieces.of()[leaf]) {
                 if piece != pieces::NONE {
                     let m = &mut met[piece as usize];
                     if m.0 != round {
@@ -471,6 +471,9 @@ impl Ctx<'_> {
         open: &mut usize,
         sil: &mut solids::Scratch,
     ) -> bool {
+        if !self.pieces.live(k) {
+            return false;
+        }
         let [lo, hi] = self.pieces.bounds[k as usize];
         let Some(Some(bbox)) = box_shadow(lo, hi, o) else {
             return false;

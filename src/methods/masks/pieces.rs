@@ -33,10 +33,11 @@
 //! the cells its six edges cross, once.
 
 use super::cover::{Cover, HalfPlane, PLANES};
-use super::solids::Solid;
+use super::solids::{Planes, Solid};
 use crate::methods::bvh::Bvh;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Corners a piece holds at most (a box has 8).
 const MAX_CORNERS: usize = 16;
@@ -49,41 +50,143 @@ pub(crate) const NONE: u32 = u32::MAX;
 /// by a pass over its triangles and edges, once per origin that meets it.
 const MAX_SOLID: usize = 1 << 16;
 
-/// The closed convex pieces of a tree's triangles.
-pub(crate) struct Pieces {
+/// Which runs of a tree's triangles are pieces and solids: what their
+/// input order and corners' bits decide, found once a tree's shape
+/// (`Bvh::derived`: a prepared scene's calls, refitted, reuse it).
+pub(crate) struct Shapes {
     /// The piece of each triangle, in the tree's order (`NONE`: none).
-    pub of: Vec<u32>,
+    of: Vec<u32>,
+    /// Per node of the tree: the piece every triangle under it belongs
+    /// to, else `NONE` (a traversal meeting an outlined piece's node skips
+    /// it whole: a solid's thousands of triangles cost one box test).
+    node: Vec<u32>,
+    /// Piece k's corners, as (triangle slot, corner) of their first use:
+    /// `refs[refs_start[k]..refs_start[k + 1]]`.
+    refs_start: Vec<u32>,
+    refs: Vec<(u32, u8)>,
+    /// Piece k's triangles (slots), for the convexity a small piece is
+    /// tested for again at each call's coordinates.
+    slots_start: Vec<u32>,
+    slots: Vec<u32>,
+    /// Each piece's topology where it is a solid (`solids.rs`: more
+    /// triangles than a hull of its corners is worth), None where it is
+    /// outlined by that hull.
+    solids: Vec<Option<Solid>>,
+}
+
+/// The pieces at one call's coordinates.
+pub(crate) struct Pieces {
+    shapes: Arc<Shapes>,
     /// Piece k's corners are `corners[start[k]..start[k + 1]]`.
     start: Vec<u32>,
     corners: Vec<Vec3>,
     /// Each piece's box.
     pub bounds: Vec<[Vec3; 2]>,
-    /// Each piece's topology where it is a solid (`solids.rs`: more
-    /// triangles than a hull of its corners is worth), None where it is
-    /// outlined by that hull.
-    pub solids: Vec<Option<Solid>>,
-    /// Per node of the tree: the piece every triangle under it belongs
-    /// to, else `NONE` (a traversal meeting an outlined piece's node skips
-    /// it whole: a solid's thousands of triangles cost one box test).
-    pub node: Vec<u32>,
+    /// Whether piece k is outlined at these coordinates (a small piece
+    /// still convex, a solid with a volume; else its triangles are
+    /// marked), and a solid's planes.
+    live: Vec<bool>,
+    planes: Vec<Option<Planes>>,
 }
 
 impl Pieces {
-    /// The pieces of `bvh`'s triangles, found in their input order.
+    /// The pieces of `bvh`'s triangles: their shapes (found once a tree's
+    /// shape), at the tree's coordinates.
     pub(crate) fn find(bvh: &Bvh) -> Pieces {
+        let shapes = bvh.derived(|| Shapes::find(bvh));
+        let tris = bvh.triangles();
+        let n = shapes.solids.len();
+        let at = |&(s, c): &(u32, u8)| tris[s as usize][c as usize];
+        let corners: Vec<Vec3> = shapes.refs.iter().map(at).collect();
+        let start = shapes.refs_start.clone();
+        let of_piece = |k: usize| &corners[start[k] as usize..start[k + 1] as usize];
+        let bounds: Vec<[Vec3; 2]> = (0..n).map(|k| bounds(of_piece(k))).collect();
+        let per: Vec<(bool, Option<Planes>)> = (0..n)
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|k| match &shapes.solids[k] {
+                Some(solid) => {
+                    let p = solid.planes(of_piece(k));
+                    (p.is_some(), p)
+                }
+                None => {
+                    let slots = &shapes.slots
+                        [shapes.slots_start[k] as usize..shapes.slots_start[k + 1] as usize];
+                    (convex(tris, slots, of_piece(k)), None)
+                }
+            })
+            .collect();
+        let (live, planes) = per.into_iter().unzip();
+        Pieces {
+            shapes,
+            start,
+            corners,
+            bounds,
+            live,
+            planes,
+        }
+    }
+
+    /// The piece of each triangle, in the tree's order (`NONE`: none).
+    #[inline(always)]
+    pub(crate) fn of(&self) -> &[u32] {
+        &self.shapes.of
+    }
+
+    /// Per node: the piece every triangle under it belongs to, or `NONE`.
+    #[inline(always)]
+    pub(crate) fn node(&self) -> &[u32] {
+        &self.shapes.node
+    }
+
+    /// Whether piece k is outlined at these coordinates.
+    #[inline(always)]
+    pub(crate) fn live(&self, k: u32) -> bool {
+        self.live[k as usize]
+    }
+
+    /// Piece k's topology and planes, where it is a solid.
+    #[inline(always)]
+    pub(crate) fn solid(&self, k: u32) -> Option<(&Solid, &Planes)> {
+        let k = k as usize;
+        self.shapes.solids[k].as_ref().zip(self.planes[k].as_ref())
+    }
+
+    /// How many of the pieces are solids.
+    #[cfg(test)]
+    pub(crate) fn solids(&self) -> usize {
+        self.shapes.solids.iter().filter(|s| s.is_some()).count()
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.bounds.len()
+    }
+
+    /// Piece k's corners.
+    #[inline(always)]
+    pub(crate) fn corners(&self, k: u32) -> &[Vec3] {
+        &self.corners[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
+    }
+}
+
+impl Shapes {
+    /// The pieces and solids of `bvh`'s triangles, found in their input
+    /// order.
+    fn find(bvh: &Bvh) -> Shapes {
         let tris = bvh.triangles();
         let order = bvh.order();
         let mut slot = vec![0u32; tris.len()];
         for (s, &i) in order.iter().enumerate() {
             slot[i as usize] = s as u32;
         }
-        let mut p = Pieces {
+        let mut p = Shapes {
             of: vec![NONE; tris.len()],
-            start: vec![0],
-            corners: vec![],
-            bounds: vec![],
-            solids: vec![],
             node: vec![],
+            refs_start: vec![0],
+            refs: vec![],
+            slots_start: vec![0],
+            slots: vec![],
+            solids: vec![],
         };
         // A closed run has every edge twice, so its edges' hashes XOR to
         // zero: the runs i..j worth the exact test have equal prefix XORs
@@ -111,12 +214,8 @@ impl Pieces {
                 continue;
             }
             match closed_run(tris, &slot, i) {
-                Some((end, corners)) if convex(tris, &slot[i..end], &corners) => {
-                    let k = p.bounds.len() as u32;
-                    for &s in &slot[i..end] {
-                        p.of[s as usize] = k;
-                    }
-                    p.push(&corners, None);
+                Some((end, corners, refs)) if convex(tris, &slot[i..end], &corners) => {
+                    p.push(&slot[i..end], &refs, None);
                     next = end;
                 }
                 _ => {}
@@ -127,10 +226,18 @@ impl Pieces {
         p
     }
 
-    fn push(&mut self, corners: &[Vec3], solid: Option<Solid>) {
-        self.bounds.push(bounds(corners));
-        self.corners.extend_from_slice(corners);
-        self.start.push(self.corners.len() as u32);
+    /// Adds the piece of the triangles `slots`, its corners `refs`.
+    fn push(&mut self, slots: &[u32], refs: &[(u32, u8)], solid: Option<Solid>) {
+        let k = self.solids.len() as u32;
+        for &s in slots {
+            self.of[s as usize] = k;
+        }
+        self.refs.extend_from_slice(refs);
+        self.refs_start.push(self.refs.len() as u32);
+        if solid.is_none() {
+            self.slots.extend_from_slice(slots);
+        }
+        self.slots_start.push(self.slots.len() as u32);
         self.solids.push(solid);
     }
 
@@ -160,7 +267,7 @@ impl Pieces {
                 work <= 4 * n
             })
             .collect();
-        let found: Vec<Option<(Vec<Vec3>, Solid)>> = candidates
+        let found: Vec<Option<(Vec<(u32, u8)>, Solid)>> = candidates
             .par_iter()
             .map(|&(i, j)| {
                 let run = &slot[i..j];
@@ -171,33 +278,13 @@ impl Pieces {
             .collect();
         let mut end = 0;
         for (&(i, j), f) in candidates.iter().zip(found) {
-            let Some((corners, solid)) = f else { continue };
+            let Some((refs, solid)) = f else { continue };
             if i < end {
                 continue;
             }
-            let k = self.bounds.len() as u32;
-            for &s in &slot[i..j] {
-                self.of[s as usize] = k;
-            }
-            self.push(&corners, Some(solid));
+            self.push(&slot[i..j], &refs, Some(solid));
             end = j;
         }
-    }
-
-    /// Piece k's topology, where it is a solid.
-    #[inline(always)]
-    pub(crate) fn solid(&self, k: u32) -> Option<&Solid> {
-        self.solids[k as usize].as_ref()
-    }
-
-    pub(crate) fn len(&self) -> usize {
-        self.bounds.len()
-    }
-
-    /// Piece k's corners.
-    #[inline(always)]
-    pub(crate) fn corners(&self, k: u32) -> &[Vec3] {
-        &self.corners[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
     }
 }
 
@@ -271,8 +358,9 @@ fn likely_convex(tris: &[[Vec3; 3]], slots: &[u32]) -> bool {
     convex(tris, &faces, &corners)
 }
 
-/// The solid of the triangles `slots` (input order), with its corners.
-fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<Vec3>, Solid)> {
+/// The solid of the triangles `slots` (input order), with its corners as
+/// (slot, corner) of their first use.
+fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<(u32, u8)>, Solid)> {
     // Corners matched bit for bit: their keys sorted, one id a key.
     let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(3 * slots.len());
     for (f, &s) in slots.iter().enumerate() {
@@ -286,6 +374,7 @@ fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<Vec3>, Solid)> {
     keys.sort_unstable();
     let mut faces = vec![[0u32; 3]; slots.len()];
     let mut corners = Vec::new();
+    let mut refs = Vec::new();
     for (k, &(key, r)) in keys.iter().enumerate() {
         if k == 0 || keys[k - 1].0 != key {
             corners.push(Vec3::new(
@@ -293,11 +382,12 @@ fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<Vec3>, Solid)> {
                 f32::from_bits(key[1]),
                 f32::from_bits(key[2]),
             ));
+            refs.push((slots[r as usize / 3], (r % 3) as u8));
         }
         faces[r as usize / 3][r as usize % 3] = (corners.len() - 1) as u32;
     }
     let solid = Solid::new(&corners, &faces)?;
-    Some((corners, solid))
+    Some((refs, solid))
 }
 
 /// The box of `corners`.
@@ -331,9 +421,15 @@ fn edge_xor(t: &[Vec3; 3]) -> u64 {
 /// The triangles i..end (input order) where they close a surface of at
 /// most `MAX_CORNERS` corners first, and its corners; None where they do
 /// not (a corner too many, an edge shared by three).
-fn closed_run(tris: &[[Vec3; 3]], slot: &[u32], i: usize) -> Option<(usize, Vec<Vec3>)> {
+#[allow(clippy::type_complexity)]
+fn closed_run(
+    tris: &[[Vec3; 3]],
+    slot: &[u32],
+    i: usize,
+) -> Option<(usize, Vec<Vec3>, Vec<(u32, u8)>)> {
     let mut corners: Vec<[u32; 3]> = Vec::with_capacity(MAX_CORNERS);
     let mut at: Vec<Vec3> = Vec::with_capacity(MAX_CORNERS);
+    let mut refs: Vec<(u32, u8)> = Vec::with_capacity(MAX_CORNERS);
     // Undirected edges (corner ids, low first) and how many triangles use each.
     let mut edges: Vec<([u8; 2], u8)> = Vec::with_capacity(3 * MAX_CORNERS);
     let mut open = 0usize;
@@ -347,6 +443,7 @@ fn closed_run(tris: &[[Vec3; 3]], slot: &[u32], i: usize) -> Option<(usize, Vec<
                 None if corners.len() < MAX_CORNERS => {
                     corners.push(key);
                     at.push(*v);
+                    refs.push((slot[j], c as u8));
                     (corners.len() - 1) as u8
                 }
                 None => return None,
@@ -370,7 +467,7 @@ fn closed_run(tris: &[[Vec3; 3]], slot: &[u32], i: usize) -> Option<(usize, Vec<
             }
         }
         if open == 0 {
-            return (j + 1 - i >= 4).then_some((j + 1, at));
+            return (j + 1 - i >= 4).then_some((j + 1, at, refs));
         }
     }
     None

@@ -41,18 +41,24 @@
 use super::cover::HalfPlane;
 use glam::{DVec2, DVec3, Vec3};
 
-/// A solid's topology: what its silhouette from an origin is found from.
+/// A solid's topology: what its silhouette from an origin is found from
+/// (corner ids; kept with the tree's shape, `pieces.rs`).
 pub(crate) struct Solid {
-    /// Each triangle's outward plane n · x = d (f32: it only sorts the
-    /// triangles into front and back; a near tie is a sliver, see above),
-    /// one array a coordinate.
+    /// Each triangle's corners, as input.
+    faces: Vec<[u32; 3]>,
+    /// Each edge: its corners a -> b as triangle f winds them, and the
+    /// triangle g that winds them b -> a.
+    edges: Vec<[u32; 4]>,
+}
+
+/// A solid's triangles' outward planes n · x = d at one call's
+/// coordinates (f32: they only sort the triangles into front and back; a
+/// near tie is a sliver, see above), one array a coordinate.
+pub(crate) struct Planes {
     nx: Vec<f32>,
     ny: Vec<f32>,
     nz: Vec<f32>,
     d: Vec<f32>,
-    /// Each edge: its corners a -> b as triangle f winds them outward, and
-    /// the triangle g that winds them b -> a.
-    edges: Vec<[u32; 4]>,
 }
 
 /// A worker's buffers for `outline`.
@@ -124,15 +130,7 @@ impl Solid {
         }
         let v = |c: u32| corners[c as usize].as_dvec3();
         let normal = |f: &[u32; 3]| (v(f[1]) - v(f[0])).cross(v(f[2]) - v(f[0]));
-        // Outward: the signed volume's sign.
-        let volume: f64 = faces
-            .iter()
-            .map(|f| v(f[0]).dot(v(f[1]).cross(v(f[2]))))
-            .sum();
-        if !(volume.abs() > 0.0) || !volume.is_finite() {
-            return None;
-        }
-        let out = volume.signum();
+        let out = orientation(corners, faces)?;
         let [lo, hi] = corners
             .iter()
             .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[l, h], &c| {
@@ -154,21 +152,43 @@ impl Solid {
                 }
             }
         }
-        let planes: Vec<[f32; 4]> = faces
-            .iter()
-            .map(|f| {
-                let n = normal(f) * out;
-                [n.x as f32, n.y as f32, n.z as f32, n.dot(v(f[0])) as f32]
-            })
-            .collect();
         Some(Solid {
-            nx: planes.iter().map(|p| p[0]).collect(),
-            ny: planes.iter().map(|p| p[1]).collect(),
-            nz: planes.iter().map(|p| p[2]).collect(),
-            d: planes.iter().map(|p| p[3]).collect(),
+            faces: faces.to_vec(),
             edges,
         })
     }
+
+    /// Its triangles' outward planes at `corners` (this call's
+    /// coordinates of its corners); None where it has no volume there.
+    pub(crate) fn planes(&self, corners: &[Vec3]) -> Option<Planes> {
+        let out = orientation(corners, &self.faces)?;
+        let v = |c: u32| corners[c as usize].as_dvec3();
+        let mut p = Planes {
+            nx: Vec::with_capacity(self.faces.len()),
+            ny: Vec::with_capacity(self.faces.len()),
+            nz: Vec::with_capacity(self.faces.len()),
+            d: Vec::with_capacity(self.faces.len()),
+        };
+        for f in &self.faces {
+            let n = (v(f[1]) - v(f[0])).cross(v(f[2]) - v(f[0])) * out;
+            p.nx.push(n.x as f32);
+            p.ny.push(n.y as f32);
+            p.nz.push(n.z as f32);
+            p.d.push(n.dot(v(f[0])) as f32);
+        }
+        Some(p)
+    }
+}
+
+/// The sign that turns the triangles `faces` outward: their signed
+/// volume's; None where it is 0 or not finite.
+fn orientation(corners: &[Vec3], faces: &[[u32; 3]]) -> Option<f64> {
+    let v = |c: u32| corners[c as usize].as_dvec3();
+    let volume: f64 = faces
+        .iter()
+        .map(|f| v(f[0]).dot(v(f[1]).cross(v(f[2]))))
+        .sum();
+    (volume.abs() > 0.0 && volume.is_finite()).then(|| volume.signum())
 }
 
 /// The samples the solid of `corners` hides from `o` (on `side`), as
@@ -177,7 +197,7 @@ impl Solid {
 /// more than one loop or not convex, a degenerate outline).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn outline(
-    solid: &Solid,
+    (solid, planes): (&Solid, &Planes),
     corners: &[Vec3],
     bounds: [Vec3; 2],
     o: Vec3,
@@ -193,10 +213,10 @@ pub(crate) fn outline(
         return false;
     }
     // Front: o on the outer side of the plane.
-    let n = solid.d.len();
+    let n = planes.d.len();
     s.front.clear();
     s.front.extend(
-        (0..n).map(|k| solid.nx[k] * o.x + solid.ny[k] * o.y + solid.nz[k] * o.z > solid.d[k]),
+        (0..n).map(|k| planes.nx[k] * o.x + planes.ny[k] * o.y + planes.nz[k] * o.z > planes.d[k]),
     );
     if s.next.len() != corners.len() {
         s.next = vec![NONE; corners.len()];

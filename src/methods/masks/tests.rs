@@ -404,7 +404,7 @@ fn the_same_bits_as_the_rays_on_random_scenes() {
             if kind == 4 {
                 // 7 spheres and the cylinder (no torus, dent or hemisphere).
                 let p = super::pieces::Pieces::find(&bvh);
-                assert_eq!(p.solids.iter().filter(|s| s.is_some()).count(), 8);
+                assert_eq!(p.solids(), 8);
             }
             for (shape, n) in [
                 (LightShape::rect([1.0, 0.7]), 64),
@@ -512,7 +512,7 @@ fn closed_convex_pieces_are_found_and_nothing_else() {
     // Each input triangle's piece, through the tree's order.
     let mut of_input = vec![NONE; bvh.triangles().len()];
     for (slot, &i) in bvh.order().iter().enumerate() {
-        of_input[i as usize] = pieces.of[slot];
+        of_input[i as usize] = pieces.of()[slot];
     }
     let mut at = 0;
     for (g, is) in &groups {
@@ -557,6 +557,7 @@ fn a_solid_is_outlined_by_its_silhouette_from_outside_only() {
     let pieces = Pieces::find(&bvh);
     assert_eq!(pieces.len(), 1);
     let solid = pieces.solid(0).expect("a solid");
+    assert!(pieces.live(0));
     let (corners, bounds) = (pieces.corners(0), pieces.bounds[0]);
     assert_eq!(corners.len(), 2 + 7 * 12);
     let mut s = Scratch::default();
@@ -635,6 +636,38 @@ fn a_solid_is_outlined_by_its_silhouette_from_outside_only() {
     for tris in [torus(c, 0.4, 0.1, 16, 8), dented, mixed, open] {
         let bvh = Bvh::build(tris);
         let p = Pieces::find(&bvh);
-        assert!(p.solids.iter().all(|s| s.is_none()));
+        assert_eq!(p.solids(), 0);
     }
+}
+
+#[test]
+fn the_shapes_are_found_once_a_tree_shape_and_tested_again_where_they_move() {
+    use super::pieces::Pieces;
+    let mut tris = cube(Vec3::new(0.0, 0.0, 2.0), Vec3::new(0.3, 0.2, 0.1));
+    tris.extend(uv_sphere(Vec3::new(1.0, 0.0, 2.0), 0.3, 6, 10));
+    let bvh = Bvh::build(tris.clone());
+    let first = Pieces::find(&bvh);
+    assert_eq!((first.len(), first.solids()), (2, 1));
+    // The same triangles moved (another light space): the tree refitted
+    // from the first one's shape reuses its shapes, at the new corners.
+    let moved: Vec<[Vec3; 3]> = tris
+        .iter()
+        .map(|t| t.map(|v| 1.5 * v + Vec3::new(0.2, -0.1, 0.5)))
+        .collect();
+    let refit = bvh.topology().refit(&moved).unwrap();
+    let again = Pieces::find(&refit);
+    assert!(std::ptr::eq(first.of(), again.of()), "found again");
+    assert!(again.live(0) && again.live(1));
+    assert_eq!(again.bounds[0][0], first.bounds[0][0] * 1.5 + Vec3::new(0.2, -0.1, 0.5));
+    // A box pressed in at one corner is no longer convex: its triangles
+    // are marked one by one.
+    let dent = tris[0][0];
+    let pressed: Vec<[Vec3; 3]> = tris
+        .iter()
+        .map(|t| t.map(|v| if v == dent { Vec3::new(0.0, 0.0, 2.0) } else { v }))
+        .collect();
+    let refit = bvh.topology().refit(&pressed).unwrap();
+    let pressed = Pieces::find(&refit);
+    let box_piece = pressed.of()[bvh.order().iter().position(|&i| i == 0).unwrap()];
+    assert!(!pressed.live(box_piece));
 }
