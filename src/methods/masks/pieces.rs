@@ -44,6 +44,8 @@ const MAX_CORNERS: usize = 16;
 /// Triangles a piece holds at most: a closed surface of V corners has
 /// 2V - 4 triangles.
 const MAX_TRIANGLES: usize = 2 * MAX_CORNERS - 4;
+/// A piece's corners, as (triangle slot, corner) of a use of each.
+type Refs = Vec<(u32, u8)>;
 /// No piece: a triangle marked on its own.
 pub(crate) const NONE: u32 = u32::MAX;
 /// Triangles a solid (`solids.rs`) holds at most: its silhouette is found
@@ -267,7 +269,7 @@ impl Shapes {
                 work <= 4 * n
             })
             .collect();
-        let found: Vec<Option<(Vec<(u32, u8)>, Solid)>> = candidates
+        let found: Vec<Option<(Refs, Solid)>> = candidates
             .par_iter()
             .map(|&(i, j)| {
                 let run = &slot[i..j];
@@ -360,7 +362,7 @@ fn likely_convex(tris: &[[Vec3; 3]], slots: &[u32]) -> bool {
 
 /// The solid of the triangles `slots` (input order), with its corners as
 /// (slot, corner) of their first use.
-fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Vec<(u32, u8)>, Solid)> {
+fn solid_run(tris: &[[Vec3; 3]], slots: &[u32]) -> Option<(Refs, Solid)> {
     // Corners matched bit for bit: their keys sorted, one id a key.
     let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(3 * slots.len());
     for (f, &s) in slots.iter().enumerate() {
@@ -421,15 +423,10 @@ fn edge_xor(t: &[Vec3; 3]) -> u64 {
 /// The triangles i..end (input order) where they close a surface of at
 /// most `MAX_CORNERS` corners first, and its corners; None where they do
 /// not (a corner too many, an edge shared by three).
-#[allow(clippy::type_complexity)]
-fn closed_run(
-    tris: &[[Vec3; 3]],
-    slot: &[u32],
-    i: usize,
-) -> Option<(usize, Vec<Vec3>, Vec<(u32, u8)>)> {
+fn closed_run(tris: &[[Vec3; 3]], slot: &[u32], i: usize) -> Option<(usize, Vec<Vec3>, Refs)> {
     let mut corners: Vec<[u32; 3]> = Vec::with_capacity(MAX_CORNERS);
     let mut at: Vec<Vec3> = Vec::with_capacity(MAX_CORNERS);
-    let mut refs: Vec<(u32, u8)> = Vec::with_capacity(MAX_CORNERS);
+    let mut refs: Refs = Vec::with_capacity(MAX_CORNERS);
     // Undirected edges (corner ids, low first) and how many triangles use each.
     let mut edges: Vec<([u8; 2], u8)> = Vec::with_capacity(3 * MAX_CORNERS);
     let mut open = 0usize;

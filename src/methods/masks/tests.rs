@@ -658,13 +658,24 @@ fn the_shapes_are_found_once_a_tree_shape_and_tested_again_where_they_move() {
     let again = Pieces::find(&refit);
     assert!(std::ptr::eq(first.of(), again.of()), "found again");
     assert!(again.live(0) && again.live(1));
-    assert_eq!(again.bounds[0][0], first.bounds[0][0] * 1.5 + Vec3::new(0.2, -0.1, 0.5));
+    assert_eq!(
+        again.bounds[0][0],
+        first.bounds[0][0] * 1.5 + Vec3::new(0.2, -0.1, 0.5)
+    );
     // A box pressed in at one corner is no longer convex: its triangles
     // are marked one by one.
     let dent = tris[0][0];
     let pressed: Vec<[Vec3; 3]> = tris
         .iter()
-        .map(|t| t.map(|v| if v == dent { Vec3::new(0.0, 0.0, 2.0) } else { v }))
+        .map(|t| {
+            t.map(|v| {
+                if v == dent {
+                    Vec3::new(0.0, 0.0, 2.0)
+                } else {
+                    v
+                }
+            })
+        })
         .collect();
     let refit = bvh.topology().refit(&pressed).unwrap();
     let pressed = Pieces::find(&refit);
