@@ -610,12 +610,11 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
 /// samples than it and fewer than `MASKS_FROM`: only the pixels it is unsure
 /// of trace them all. From `MASKS_FROM` samples they run the masks on every
 /// pixel, with no probe to miss a sliver: on the sixteen as-built scenes at
-/// 320x240 the masks took 1.05-5.3x less time than the probe and the rays
-/// at 1024 samples and 1.5-10x less at 2500, where the probe's answer
+/// 320x240 the masks took 1.9-7.3x less time than the probe and the rays
+/// at 1024 samples and 2.9-15x less at 2500, where the probe's answer
 /// differed from theirs on up to 1.5% of the pixels by up to 0.05; at
-/// 640x480 1.02-3.6x and 1.4-6.2x, but for blinds at 1024 (0.97x, one
-/// round) (docs/benchmarks/masks_*.md). A config the user gave runs as
-/// given.
+/// 640x480 1.4-6.3x and 2.3-12x (docs/benchmarks/masks_*.md). A config the
+/// user gave runs as given.
 fn probed(m: MethodConfig, planned: bool, backend: Backend) -> MethodConfig {
     use crate::methods::auto_config::EYE_PROBE;
     use crate::methods::exact::MASKS_FROM;

@@ -140,16 +140,14 @@ impl ShadowMethod for Exact {
 
 /// The fewest samples at which an unset `engine` is the masks (on the
 /// CPU, without a probe). Measured with `benchmarks/bench_masks.py` on the
-/// sixteen as-built scenes at 320x240, both sets (docs/benchmarks/
-/// masks_320x240.md): at 1024 samples the masks took 1.0-18x less time
-/// than the rays on every scene; at 256 they were slower on four (the slats
-/// of fence_slats and blinds, room_window's frame, table_and_chairs: many
-/// thin boxes whose edges cross the light, 0.46-0.72x) and faster on the
-/// other twelve (1.4-5.4x). At 640x480 (masks_640x480.md, one round) the
-/// masks at 1024 were faster on fifteen (1.7-19x) and not on blinds
-/// (0.93x). Judged on both sets alike: eight calibration scenes and eight
-/// held out, measured in one run (a speed rule; the answer is the same
-/// either way but for grazing rays).
+/// sixteen as-built scenes, both sets, one run each (docs/benchmarks/
+/// masks_320x240.md, masks_640x480.md): at 1024 samples the masks took
+/// 2.3-27x less time than the rays on every scene at 320x240 (2.4-30x at
+/// 640x480). At 256 they now take less on every scene too (1.08-8.4x,
+/// 1.1-8.7x; table_and_chairs' thin panels under a 3 m light the least),
+/// so 256 would do; it stays at 1024 until the tables that time `Exact()`
+/// at its default 256 samples are measured again with it. A speed rule:
+/// the answer is the same either way but for grazing rays.
 pub const MASKS_FROM: u32 = 1024;
 
 /// Ray casting through a BVH of the occluder triangles.
