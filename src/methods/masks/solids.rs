@@ -218,8 +218,10 @@ pub(crate) fn outline(
     s.front.extend(
         (0..n).map(|k| planes.nx[k] * o.x + planes.ny[k] * o.y + planes.nz[k] * o.z > planes.d[k]),
     );
-    if s.next.len() != corners.len() {
-        s.next = vec![NONE; corners.len()];
+    // Every entry is NONE between calls (the ones set are reset below), so
+    // the buffer only grows, to the largest solid's corners.
+    if s.next.len() < corners.len() {
+        s.next.resize(corners.len(), NONE);
     }
     // The silhouette edges, wound as their front triangle winds them.
     let mut count = 0usize;
