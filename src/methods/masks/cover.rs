@@ -423,7 +423,7 @@ pub(crate) fn mark(
             let bits = match cover.on_box(cells.lo[k], cells.hi[k]) {
                 Ok(false) => continue,
                 Ok(true) => full,
-                Err(straddle) => inside(cells, k, cover, straddle) & full,
+                Err(straddle) => inside(cells, k, planes, u64::from(straddle)) & full,
             };
             let before = mask[k];
             mask[k] |= bits;
@@ -434,11 +434,11 @@ pub(crate) fn mark(
     }
 }
 
-/// The bits of cell k's samples inside every lane of `cover` in
-/// `straddle` (the others hold on the whole cell), `LANE` samples at a
-/// time.
+/// The bits of cell k's samples inside every plane of `planes` whose bit
+/// is set in `straddle` (bit 63: that plane and every later one; the
+/// others hold on the whole cell), `LANE` samples at a time.
 #[inline(always)]
-fn inside(cells: &Cells, k: usize, cover: &Cover, straddle: u8) -> u64 {
+pub(crate) fn inside(cells: &Cells, k: usize, planes: &[HalfPlane], straddle: u64) -> u64 {
     let s = cells.start[k] as usize;
     let n = cells.count[k] as usize;
     let mut bits = 0u64;
@@ -447,8 +447,8 @@ fn inside(cells: &Cells, k: usize, cover: &Cover, straddle: u8) -> u64 {
         let xs: &[f32; LANE] = cells.xs[at..at + LANE].try_into().unwrap();
         let ys: &[f32; LANE] = cells.ys[at..at + LANE].try_into().unwrap();
         let mut ok = [true; LANE];
-        for (l, p) in cover.planes[..cover.n].iter().enumerate() {
-            if straddle >> l & 1 == 0 {
+        for (l, p) in planes.iter().enumerate() {
+            if straddle >> l.min(63) & 1 == 0 {
                 continue;
             }
             // Branch-free, so that the lanes run side by side.

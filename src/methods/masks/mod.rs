@@ -410,18 +410,14 @@ impl Ctx<'_> {
             // A node of one piece: its outline once, the node skipped
             // where it is marked.
             let whole = pieces.node()[k as usize];
-            if whole != pieces::NONE {
-                let m = &mut met[whole as usize];
-                if m.0 != round {
-                    *m = (round, self.outline(whole, o, side, mask, open, sil));
-                    if *open == 0 {
-                        return true;
-                    }
+            if whole != pieces::NONE
+                && self.outlined(whole, (o, side), (round, met), mask, open, sil)
+            {
+                if *open == 0 {
+                    return true;
                 }
-                if m.1 {
-                    touched = true;
-                    continue;
-                }
+                touched = true;
+                continue;
             }
             if n.count == 0 {
                 // Nearer the receiver (deeper) popped first.
@@ -438,17 +434,13 @@ impl Ctx<'_> {
             touched = true;
             let leaf = n.start as usize..(n.start + n.count) as usize;
             for (tri, &piece) in tris[leaf.clone()].iter().zip(&pieces.of()[leaf]) {
-                if piece != pieces::NONE {
-                    let m = &mut met[piece as usize];
-                    if m.0 != round {
-                        *m = (round, self.outline(piece, o, side, mask, open, sil));
-                        if *open == 0 {
-                            return true;
-                        }
+                if piece != pieces::NONE
+                    && self.outlined(piece, (o, side), (round, met), mask, open, sil)
+                {
+                    if *open == 0 {
+                        return true;
                     }
-                    if m.1 {
-                        continue;
-                    }
+                    continue;
                 }
                 let Some(bbox) = shadow_box(tri, o) else {
                     continue;
@@ -480,6 +472,26 @@ impl Ctx<'_> {
             }
         }
         touched
+    }
+
+    /// Whether piece `k` is marked by its outline from origin `o` (on
+    /// `side`): `outline` the first time this origin (`round`) meets it,
+    /// its answer kept in `met`.
+    #[inline(always)]
+    fn outlined(
+        &self,
+        k: u32,
+        (o, side): (glam::Vec3, Option<HalfPlane>),
+        (round, met): (u32, &mut [(u32, bool)]),
+        mask: &mut [u64],
+        open: &mut usize,
+        sil: &mut solids::Scratch,
+    ) -> bool {
+        let m = &mut met[k as usize];
+        if m.0 != round {
+            *m = (round, self.outline(k, o, side, mask, open, sil));
+        }
+        m.1
     }
 
     /// Marks the samples piece `k` hides from `o` (on `side`), by its

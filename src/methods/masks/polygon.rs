@@ -16,8 +16,8 @@
 //! The bands are widened by `x_span`'s hair, so a plane is only taken to
 //! hold where its box test would find it does.
 
-use super::cells::{Cells, LANE};
-use super::cover::HalfPlane;
+use super::cells::Cells;
+use super::cover::{inside, HalfPlane};
 
 /// Marks in `mask` the samples of the cells `range` inside every plane of
 /// `planes`, the edges of a convex polygon whose corners span the rows
@@ -131,35 +131,4 @@ fn band(p: &HalfPlane, y0: f32, y1: f32) -> [f32; 2] {
     } else {
         [f32::INFINITY, f32::NEG_INFINITY]
     }
-}
-
-/// The bits of cell k's samples inside every plane of `planes` whose bit
-/// is set in `straddle` (bit 63: that one and every later plane).
-#[inline(always)]
-fn inside(cells: &Cells, k: usize, planes: &[HalfPlane], straddle: u64) -> u64 {
-    let s = cells.start[k] as usize;
-    let n = cells.count[k] as usize;
-    let mut bits = 0u64;
-    for chunk in 0..n.div_ceil(LANE) {
-        let at = s + chunk * LANE;
-        let xs: &[f32; LANE] = cells.xs[at..at + LANE].try_into().unwrap();
-        let ys: &[f32; LANE] = cells.ys[at..at + LANE].try_into().unwrap();
-        let mut ok = [true; LANE];
-        for (l, p) in planes.iter().enumerate() {
-            if straddle >> l.min(63) & 1 == 0 {
-                continue;
-            }
-            let loose = !p.strict;
-            for j in 0..LANE {
-                let v = p.at(xs[j], ys[j]);
-                ok[j] &= (v > 0.0) | (loose & (v == 0.0));
-            }
-        }
-        let mut b = 0u64;
-        for (j, &o) in ok.iter().enumerate() {
-            b |= u64::from(o) << j;
-        }
-        bits |= b << (chunk * LANE);
-    }
-    bits
 }
