@@ -67,29 +67,6 @@ use rayon::prelude::*;
 const CHUNK: usize = 64;
 /// Receivers whose weights are summed side by side.
 const WEIGH: usize = 8;
-/// The least share of a solid's shadow box that must fall on the light for
-/// its silhouette to be worth finding. The silhouette costs a pass over
-/// all its triangles and edges (a few ns each); marking them costs those
-/// whose shadows reach the light, about that share of them, at some 50 ns
-/// each (a cover and its cells): under a sun whose light is a sliver of a
-/// sphere's shadow, the few triangles along the rim cost less. A speed
-/// rule only (the answer is the same either way but for grazing rays),
-/// set on two calibration scenes at 320x240, 1024 samples:
-/// spheres_sun_high took 53 ms with every solid outlined, 42 with an
-/// eighth, 40 with a 32nd; room_window 97, 132 and 96 (its sphere seen
-/// from beside it fills more than the window).
-const SOLID_OVERLAP: f32 = 1.0 / 32.0;
-
-/// The share of the box `b` that lies inside the box `light`.
-fn overlap(b: [[f32; 2]; 2], light: [[f32; 2]; 2]) -> f32 {
-    let w = |a: usize| (b[a][1].min(light[a][1]) - b[a][0].max(light[a][0])).max(0.0);
-    let area = (b[0][1] - b[0][0]) * (b[1][1] - b[1][0]);
-    if area > 0.0 {
-        w(0) * w(1) / area
-    } else {
-        1.0
-    }
-}
 
 /// `shadow_rays::visibilities_weighted` for the shared pattern (`s.jitter`
 /// must be `Jitter::Shared`): `[V, V_w]` of each receiver, `absent` for
@@ -523,9 +500,6 @@ impl Ctx<'_> {
         }
         let corners = self.pieces.corners(k);
         if let Some(solid) = self.pieces.solid(k) {
-            if overlap(bbox, self.light) < SOLID_OVERLAP {
-                return false;
-            }
             let ok = solids::outline(solid, corners, [lo, hi], o, self.t0, self.t1, side, sil);
             if ok {
                 polygon::mark_polygon(
