@@ -48,8 +48,23 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
 ) -> Vec<[f32; 2]> {
     match engine {
         Engine::Masks if s.jitter == Jitter::Shared => {
-            super::masks::visibilities_weighted(bvh, receivers, order, s, absent)
-                .unwrap_or_else(|| traced(bvh, receivers, key, order, s, absent))
+            match super::masks::visibilities_weighted(bvh, receivers, order, s, absent) {
+                Some((mut v, left)) => {
+                    // The receivers whose triangles would have cost more
+                    // than their rays: traced, in the order they came.
+                    if !left.is_empty() {
+                        let sub: Vec<Option<&R>> =
+                            left.iter().map(|&k| receivers[k].as_ref()).collect();
+                        let at: Vec<usize> = (0..left.len()).collect();
+                        let got = traced(bvh, &sub, |j| key(left[j]), &at, s, absent);
+                        for (&k, x) in left.iter().zip(got) {
+                            v[k] = x;
+                        }
+                    }
+                    v
+                }
+                None => traced(bvh, receivers, key, order, s, absent),
+            }
         }
         _ => traced(bvh, receivers, key, order, s, absent),
     }

@@ -121,6 +121,32 @@ pub(crate) trait RayOrigin: Sync {
     }
 }
 
+/// A receiver by reference: the masks hand the receivers they leave to the
+/// rays this way (`engine.rs`).
+impl<R: RayOrigin> RayOrigin for &R {
+    const WEIGHTED: bool = R::WEIGHTED;
+    #[inline(always)]
+    fn bounds(&self) -> (Vec3, Vec3) {
+        (*self).bounds()
+    }
+    #[inline(always)]
+    fn origin(&self, x: f32, y: f32) -> Vec3 {
+        (*self).origin(x, y)
+    }
+    #[inline(always)]
+    fn weight(&self, x: f32, y: f32) -> f32 {
+        (*self).weight(x, y)
+    }
+    #[inline(always)]
+    fn surface(&self) -> Option<SurfacePoint> {
+        (*self).surface()
+    }
+    #[inline(always)]
+    fn origins(&self) -> Origins {
+        (*self).origins()
+    }
+}
+
 /// A receiver's ray origins: one for every light point, or two, `above`
 /// for the light points (x, y) with side[0] + x side[1] + y side[2] >= 0
 /// (in that order of operations, f32) and `below` for the others.

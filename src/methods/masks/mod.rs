@@ -34,6 +34,27 @@
 //! sphere of room_window, 2 208 triangles a receiver behind it, became one
 //! polygon of about 60 edges.
 //!
+//! A receiver whose triangles would cost more than its rays is left to
+//! them: each counts its work (a node visited `NODE`, a shadow marked
+//! `MARK`, about one shadow ray's time and eight) and stops past
+//! `RAYS_PER_SAMPLE` times its samples; `engine.rs` traces the receivers
+//! left. The cost of a receiver is then at most about five times its rays'
+//! whatever the mesh, where a sphere of 2 million triangles, each one's
+//! shadow far smaller than a cell, took 51 s at 640x480 and 256 samples
+//! against the rays' 2.3 s. After a receiver is left, the next one in its
+//! chunk (its neighbour in the tile order) stops at a `TIGHT`th of that:
+//! a dense mesh's shadow costs its receivers little waste. Chosen on the
+//! calibration scenes and mesh_125k at 640x480 (`benchmarks/
+//! bench_masks.py`'s scenes, medians of 3): 2, 4 and 8 rays a sample, and
+//! none, took 168, 157, 155 and 206 ms on bunny_on_slab at 256 samples,
+//! 262, 274, 365 and 366 on torus_on_slab, 777, 759, 811 and 3 427 on
+//! mesh_125k, and within noise of each other on the five others but
+//! shelf_with_objects (230 ms at 2 against 192-194); at 1024 samples 4
+//! and none were within 5% on all but mesh_125k (2 227 against 3 315).
+//! Held out (the eight held-out as-built scenes, many_meshes, crowd):
+//! 4 against none within noise on every one at 256 and 1024 samples; on
+//! mesh_2m 1.7 s against the rays' 2.2 s.
+//!
 //! What it computes is what `exact` computes with the same samples
 //! (`shadow_rays::visibilities_weighted`, the shared pattern): a sample is
 //! marked where its segment crosses a triangle at t in (t0, t1), edges
@@ -65,21 +86,46 @@ use rayon::prelude::*;
 
 /// Receivers per parallel task.
 const CHUNK: usize = 64;
+/// A receiver's work, in about the time of one shadow ray: a node visited
+/// costs `NODE`, a triangle's or a piece's shadow marked `MARK`. Where it
+/// passes `RAYS_PER_SAMPLE` times its samples, the receiver is left to the
+/// rays (`engine.rs`), which answer the same question: a mesh of millions
+/// of triangles smaller than a cell of the pattern costs each receiver in
+/// its shadow thousands of marks, and its rays a few dozen nodes each.
+const NODE: u32 = 1;
+const MARK: u32 = 8;
+const RAYS_PER_SAMPLE: u32 = 4;
+const TIGHT: u32 = 8;
 /// Receivers whose weights are summed side by side.
 const WEIGH: usize = 8;
 
 /// `shadow_rays::visibilities_weighted` for the shared pattern (`s.jitter`
 /// must be `Jitter::Shared`): `[V, V_w]` of each receiver, `absent` for
-/// `None`, computed from the triangles instead of a ray per sample; None
-/// where the pattern has no cells (its samples coincide: a point light's),
-/// for the caller to trace.
+/// `None`, computed from the triangles instead of a ray per sample, and
+/// the receivers left to the rays (their work passed its budget: `MARK`;
+/// their entries are to be filled); None where the pattern has no cells
+/// (its samples coincide: a point light's), for the caller to trace.
 pub(crate) fn visibilities_weighted<R: RayOrigin>(
     bvh: &Bvh,
     receivers: &[Option<R>],
     order: &[usize],
     s: &Sampling,
     absent: f32,
-) -> Option<Vec<[f32; 2]>> {
+) -> Option<(Vec<[f32; 2]>, Vec<usize>)> {
+    let (na, nb) = s.light.grid;
+    let budget = RAYS_PER_SAMPLE.saturating_mul(na.saturating_mul(nb));
+    with_budget(bvh, receivers, order, s, absent, budget)
+}
+
+/// `visibilities_weighted` with a receiver's work capped at `budget`.
+fn with_budget<R: RayOrigin>(
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    order: &[usize],
+    s: &Sampling,
+    absent: f32,
+    budget: u32,
+) -> Option<(Vec<[f32; 2]>, Vec<usize>)> {
     debug_assert_eq!(s.jitter, Jitter::Shared);
     debug_assert_eq!(order.len(), receivers.len());
     let (na, nb) = s.light.grid;
@@ -96,6 +142,7 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
         t0: s.t0,
         t1: 1.0 - RAY_EPS,
         light,
+        budget,
     };
     let shaded: Vec<Vec<(usize, [f32; 2])>> = order
         .par_chunks(CHUNK)
@@ -107,10 +154,15 @@ pub(crate) fn visibilities_weighted<R: RayOrigin>(
         })
         .collect();
     let mut v = vec![[absent; 2]; receivers.len()];
+    let mut left = vec![];
     for (k, x) in shaded.into_iter().flatten() {
-        v[k] = x;
+        if x[0].is_nan() {
+            left.push(k);
+        } else {
+            v[k] = x;
+        }
     }
-    Some(v)
+    Some((v, left))
 }
 
 /// `SurfacePoint::weight` of `WEIGH` points at the light point (x, y),
@@ -135,6 +187,8 @@ struct Ctx<'a> {
     t0: f32,
     t1: f32,
     light: [[f32; 2]; 2],
+    /// The work after which a receiver is left to the rays.
+    budget: u32,
 }
 
 /// A worker's buffers, reused from receiver to receiver.
@@ -152,6 +206,10 @@ struct Scratch {
     /// its output, their index) and their masks, one after the other.
     pending: Vec<(usize, usize)>,
     masks: Vec<u64>,
+    /// The current receiver's work (`NODE`, `MARK`), and its cap: a
+    /// `TIGHT`th of the budget after a receiver left to the rays.
+    work: u32,
+    cap: u32,
 }
 
 impl Ctx<'_> {
@@ -198,12 +256,20 @@ impl Ctx<'_> {
         let mut out = Vec::with_capacity(chunk.len());
         scratch.pending.clear();
         scratch.masks.clear();
+        scratch.cap = self.budget;
         for &k in chunk {
             let Some(r) = receivers[k].as_ref() else {
                 continue;
             };
             let v = self.receiver(r, scratch);
-            if R::WEIGHTED && v[1].is_nan() {
+            // Its neighbour in the chunk likely costs as much: a receiver
+            // after one left to the rays gives up sooner.
+            scratch.cap = if v[0].is_nan() {
+                self.budget / TIGHT
+            } else {
+                self.budget
+            };
+            if R::WEIGHTED && v[1].is_nan() && !v[0].is_nan() {
                 scratch.pending.push((out.len(), k));
                 scratch.masks.extend_from_slice(&scratch.mask);
             }
@@ -307,8 +373,13 @@ impl Ctx<'_> {
             }
         };
         let mut touched = false;
+        scratch.work = 0;
         for &(o, side) in origins {
             touched |= self.mark_from(o, side, shaft.as_ref(), scratch, &mut open);
+            if scratch.work > scratch.cap {
+                // Left to the rays.
+                return [f32::NAN; 2];
+            }
             if open == 0 {
                 break;
             }
@@ -354,16 +425,22 @@ impl Ctx<'_> {
             scratch.round = 1;
         }
         let round = scratch.round;
-        let (mask, stack, met, sil) = (
+        let (mask, stack, met, sil, work) = (
             &mut scratch.mask,
             &mut scratch.stack,
             &mut scratch.met,
             &mut scratch.solids,
+            &mut scratch.work,
         );
+        let budget = scratch.cap;
         stack.clear();
         stack.push(0);
         let mut touched = false;
         while let Some(k) = stack.pop() {
+            *work += NODE;
+            if *work > budget {
+                return touched;
+            }
             let n = &nodes[k as usize];
             if shaft.is_some_and(|s| !s.meets(n)) {
                 continue;
@@ -388,7 +465,7 @@ impl Ctx<'_> {
             // where it is marked.
             let whole = pieces.node()[k as usize];
             if whole != pieces::NONE
-                && self.outlined(whole, (o, side), (round, met), mask, open, sil)
+                && self.outlined(whole, (o, side), (round, met), (mask, open, work), sil)
             {
                 if *open == 0 {
                     return true;
@@ -412,7 +489,7 @@ impl Ctx<'_> {
             let leaf = n.start as usize..(n.start + n.count) as usize;
             for (tri, &piece) in tris[leaf.clone()].iter().zip(&pieces.of()[leaf]) {
                 if piece != pieces::NONE
-                    && self.outlined(piece, (o, side), (round, met), mask, open, sil)
+                    && self.outlined(piece, (o, side), (round, met), (mask, open, work), sil)
                 {
                     if *open == 0 {
                         return true;
@@ -442,6 +519,10 @@ impl Ctx<'_> {
                 if let Some(p) = side {
                     c = c.and(p);
                 }
+                *work += MARK;
+                if *work > budget {
+                    return touched;
+                }
                 mark(&c, cells, range, mask, open);
                 if *open == 0 {
                     return true;
@@ -460,12 +541,12 @@ impl Ctx<'_> {
         k: u32,
         (o, side): (glam::Vec3, Option<HalfPlane>),
         (round, met): (u32, &mut [(u32, bool)]),
-        mask: &mut [u64],
-        open: &mut usize,
+        (mask, open, work): (&mut [u64], &mut usize, &mut u32),
         sil: &mut solids::Scratch,
     ) -> bool {
         let m = &mut met[k as usize];
         if m.0 != round {
+            *work += MARK;
             *m = (round, self.outline(k, o, side, mask, open, sil));
         }
         m.1

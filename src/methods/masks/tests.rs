@@ -10,7 +10,20 @@ use super::super::shadow_rays::{
     tile_order, visibilities_weighted as traced, Jitter, Origins, RayOrigin, Sampling,
     SurfacePoint, RAY_EPS,
 };
-use super::visibilities_weighted as masked;
+
+/// The masks' answer with no receiver left to the rays.
+fn masked<R: super::RayOrigin>(
+    bvh: &Bvh,
+    receivers: &[Option<R>],
+    order: &[usize],
+    s: &Sampling,
+    absent: f32,
+) -> Option<Vec<[f32; 2]>> {
+    super::with_budget(bvh, receivers, order, s, absent, u32::MAX).map(|(v, left)| {
+        assert!(left.is_empty());
+        v
+    })
+}
 use crate::geom::light_shape::LightShape;
 use glam::Vec3;
 
@@ -681,4 +694,69 @@ fn the_shapes_are_found_once_a_tree_shape_and_tested_again_where_they_move() {
     let pressed = Pieces::find(&refit);
     let box_piece = pressed.of()[bvh.order().iter().position(|&i| i == 0).unwrap()];
     assert!(!pressed.live(box_piece));
+}
+
+/// A mesh of thousands of triangles far smaller than a cell of the
+/// pattern: each receiver in its shadow would mark thousands of them, so
+/// it is left to the rays once its work passes the budget (`MARK`), and
+/// the engine's answer is the rays' where it is and the masks' elsewhere,
+/// in both views.
+#[test]
+fn receivers_whose_triangles_cost_more_than_their_rays_are_left_to_the_rays() {
+    use super::super::engine::{visibilities_weighted as engine, Engine};
+    // A bumpy open grid of 2 x 100 x 100 triangles at depth 2 over part
+    // of the receivers' light; the floor behind it.
+    let n = 100;
+    let p = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+        Vec3::new(
+            -1.5 + 1.6 * x,
+            -1.0 + 2.0 * y,
+            2.0 + 0.01 * ((i * 7 + j * 3) % 5) as f32,
+        )
+    };
+    let mut tris = vec![];
+    for j in 0..n {
+        for i in 0..n {
+            tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+            tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    let f = |x: f32, y: f32| Vec3::new(x, y, 4.0);
+    tris.push([f(-5.0, -5.0), f(5.0, -5.0), f(5.0, 5.0)]);
+    tris.push([f(-5.0, -5.0), f(5.0, 5.0), f(-5.0, 5.0)]);
+    let bvh = Bvh::build(tris);
+    let w = 30;
+    let order = tile_order(w, w);
+    for (samples, t0) in [(64, RAY_EPS), (256, 0.0)] {
+        let s = sampling(LightShape::rect([1.0, 1.0]), samples, t0);
+        let pts = floor_points(w);
+        let st = starts(w);
+        let (_, left) = super::visibilities_weighted(&bvh, &pts, &order, &s, 1.0).unwrap();
+        // Some are left to the rays, not all (the lit ones cost nothing).
+        assert!(
+            !left.is_empty() && left.len() < w * w,
+            "{} left",
+            left.len()
+        );
+        let a = traced(&bvh, &pts, |k| k as u64, &order, &s, 1.0);
+        let b = engine(Engine::Masks, &bvh, &pts, |k| k as u64, &order, &s, 1.0);
+        let (d, dv, _) = compare(&a, &b);
+        assert!(
+            d * 1000 <= a.len() && dv <= 2.0 / samples as f32,
+            "{d} differ, |dV| {dv}"
+        );
+        // The receivers left to the rays have the rays' bits.
+        assert!(left.iter().all(|&k| a[k] == b[k]));
+        let a = traced(&bvh, &st, |k| k as u64, &order, &s, 0.0);
+        let b = engine(Engine::Masks, &bvh, &st, |k| k as u64, &order, &s, 0.0);
+        let (d, dv, dw) = compare(&a, &b);
+        assert!(
+            d * 1000 <= a.len() && dv <= 2.0 / samples as f32,
+            "eye: {d} differ, |dV| {dv}"
+        );
+        assert!(dw <= 4.0 / samples as f32, "eye: |dV_w| {dw}");
+        // What is left is traced whole: no receiver stays absent.
+        assert!(b.iter().all(|v| v[0].is_finite() && v[1].is_finite()));
+    }
 }
