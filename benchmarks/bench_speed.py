@@ -150,7 +150,12 @@ def main(argv: list[str] | None = None) -> int:
                 scene: ss.Scene = scene, light: ss.RectLight = light, res: int = res, extent: Any = base.extent
             ) -> ss.ShadowMap:
                 return ss.soft_shadow_map(
-                    scene, light, resolution=res, extent=extent, method=ss.Exact(samples=EXACT_SAMPLES)
+                    scene,
+                    light,
+                    resolution=res,
+                    extent=extent,
+                    # Per shadow ray: the rays engine, whatever the default.
+                    method=ss.Exact(samples=EXACT_SAMPLES, engine="rays"),
                 )
 
             run_exact()  # warm-up

@@ -141,14 +141,25 @@ impl ShadowMethod for Exact {
 /// The fewest samples at which an unset `engine` is the masks (on the
 /// CPU, without a probe). Measured with `benchmarks/bench_masks.py` on the
 /// sixteen as-built scenes, both sets, one run each (docs/benchmarks/
-/// masks_320x240.md, masks_640x480.md): at 1024 samples the masks took
-/// 2.3-27x less time than the rays on every scene at 320x240 (2.4-30x at
-/// 640x480). At 256 they now take less on every scene too (1.08-8.4x,
-/// 1.1-8.7x; table_and_chairs' thin panels under a 3 m light the least),
-/// so 256 would do; it stays at 1024 until the tables that time `Exact()`
-/// at its default 256 samples are measured again with it. A speed rule:
-/// the answer is the same either way but for grazing rays.
-pub const MASKS_FROM: u32 = 1024;
+/// masks_320x240.md, masks_640x480.md), the masks leaving a receiver to
+/// the rays where its triangles would cost more (`masks/mod.rs`): at 256
+/// samples they took 1.07-8.2x less time than the rays on every scene at
+/// 320x240 (1.10-8.9x at 640x480; table_and_chairs' thin panels under a
+/// 3 m light the least), at 1024 2.4-26x (2.5-28x). On the scale scenes
+/// at 640x480 and 256 samples: mesh_125k 1.4x, mesh_2m 1.26x, many_meshes
+/// 6.4x, crowd 8x less. A speed rule: the answer is the same either way
+/// but for grazing rays. The eye view's; the light view's is
+/// `MASKS_FROM_LIGHT_VIEW`.
+pub const MASKS_FROM: u32 = 256;
+
+/// `MASKS_FROM` in the light view (no camera), where the receivers lie on
+/// the occluders: on the study's scenes at 256² (`scenes.SCENES`, one run,
+/// medians of 3) the masks took more time than the rays at 256 samples on
+/// bunny_floating (1.39x), bunny_on_floor (1.19x) and torus (1.53x), less
+/// on square_plate (2.6x) and two_spheres (1.02x); at 1024 still more on
+/// the bunnies (1.41x, 1.06x) and the torus (1.83x), and 3.4-5x less on
+/// the other two. It stays where it was set from the eye view's tables.
+pub const MASKS_FROM_LIGHT_VIEW: u32 = 1024;
 
 /// Ray casting through a BVH of the occluder triangles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -215,16 +226,20 @@ impl ExactConfig {
         }
     }
 
-    /// The engine that runs on `backend`: the one given, else the masks on
-    /// the CPU from `MASKS_FROM` samples without a probe (the probe traces
-    /// rays), the rays otherwise (and on the GPU, whose kernel traces rays).
-    pub fn engine_for(&self, backend: Backend) -> Engine {
+    /// The engine that runs on `backend` in the eye view (`eye`) or the
+    /// light view: the one given, else the masks on the CPU from
+    /// `MASKS_FROM` samples (`MASKS_FROM_LIGHT_VIEW` in the light view)
+    /// without a probe (the probe traces rays), the rays otherwise (and on
+    /// the GPU, whose kernel traces rays).
+    pub fn engine_for(&self, backend: Backend, eye: bool) -> Engine {
+        let from = if eye {
+            MASKS_FROM
+        } else {
+            MASKS_FROM_LIGHT_VIEW
+        };
         match self.engine {
             Some(e) => e,
-            None if backend == Backend::Cpu
-                && self.probe.is_none()
-                && self.samples >= MASKS_FROM =>
-            {
+            None if backend == Backend::Cpu && self.probe.is_none() && self.samples >= from => {
                 Engine::Masks
             }
             None => Engine::Rays,
@@ -303,7 +318,7 @@ impl MethodSpec for ExactConfig {
             ));
         }
         Ok(ExactConfig {
-            engine: Some(self.engine_for(ctx.backend)),
+            engine: Some(self.engine_for(ctx.backend, ctx.eye)),
             ..self
         })
     }
@@ -347,8 +362,8 @@ impl MethodSpec for ExactConfig {
                     name: "engine",
                     kind: Kind::Choice(Engine::ALL.iter().map(|e| e.name()).collect()),
                     default: Value::Resolved,
-                    default_doc: "None: \"masks\" on the CPU from 1024 samples without a probe, \
-                                  else \"rays\"",
+                    default_doc: "None: \"masks\" on the CPU without a probe from 256 samples \
+                                  in the eye view and 1024 in the light view, else \"rays\"",
                     doc: "how the samples are decided, with the same answer but for rays that \
                           graze an edge: \"rays\", a shadow ray a sample through the BVH (the \
                           reference); \"masks\", each receiver's samples marked by the \

@@ -242,8 +242,8 @@ impl MethodConfig {
                 samples: c.samples,
                 probe: c.probe,
                 // Resolved configs hold their engine; an unresolved one's is
-                // the CPU's.
-                engine: c.engine_for(crate::backend::Backend::Cpu),
+                // the CPU's in the light view (the eye view resolves first).
+                engine: c.engine_for(crate::backend::Backend::Cpu, false),
             },
             MethodConfig::Pcss(c) => Method::Pcss {
                 max_taps: c.max_taps,

@@ -119,6 +119,20 @@ def test_solids_marked_by_their_silhouette_give_the_rays_bits(samples):
     assert_both_views_give_the_rays_bits(rounded_solids(), samples, (0.0, 0.5, 0.0))
 
 
+def test_a_dense_bumpy_mesh_left_to_the_rays_gives_their_bits():
+    """A non-convex mesh of 80 000 triangles, each one's shadow far smaller
+    than a cell of the pattern: the receivers in its shadow pass the masks'
+    budget and are traced instead, the others marked; both views agree."""
+    import trimesh
+
+    ball = trimesh.creation.icosphere(subdivisions=6, radius=0.45)
+    v = np.asarray(ball.vertices)
+    bumps = 1.0 + 0.04 * np.sin(9.0 * v[:, 0] / 0.45) * np.cos(7.0 * v[:, 1] / 0.45)
+    v = v * bumps[:, None] + np.array([0.0, 0.6, 0.0])
+    scene = ss.Scene(meshes=[as_built.slab(), (v, np.asarray(ball.faces))])
+    assert_both_views_give_the_rays_bits(scene, 256, (0.0, 0.3, 0.0))
+
+
 def test_the_light_view_and_points_give_the_rays_bits():
     scene, light = scenes.bunny_floating()
     rays = ss.soft_shadow_map(scene, light, resolution=64, method=ss.Exact(samples=256, engine="rays"))
@@ -146,9 +160,15 @@ def test_a_disk_and_the_sun_give_the_rays_bits():
 def test_the_engine_resolves_by_samples_on_the_cpu():
     scene, light, cam = as_built.SCENES["blocks_on_table"]((32, 24))
     few = ss.render(scene, light, cam, method=ss.Exact(samples=64))
+    default = ss.render(scene, light, cam, method=ss.Exact())
     many = ss.render(scene, light, cam, method=ss.Exact(samples=1024))
     probed = ss.render(scene, light, cam, method=ss.Exact(samples=1024, probe=16))
     assert few.method.engine == "rays"
+    # From 256 samples in the eye view, `Exact()`'s own (MASKS_FROM); from
+    # 1024 in the light view (MASKS_FROM_LIGHT_VIEW).
+    assert default.method == ss.Exact(samples=256, engine="masks")
+    maps = {n: ss.soft_shadow_map(scene, light, resolution=16, method=ss.Exact(samples=n)) for n in (256, 1024)}
+    assert maps[256].method.engine == "rays" and maps[1024].method.engine == "masks"
     assert many.method.engine == "masks"
     assert probed.method.engine == "rays"
     assert ss.Exact().engine is None
