@@ -147,7 +147,7 @@ impl ShadowMethod for Exact {
 /// 320x240 (1.10-8.9x at 640x480; table_and_chairs' thin panels under a
 /// 3 m light the least), at 1024 2.4-26x (2.5-28x). On the scale scenes
 /// at 640x480 and 256 samples: mesh_125k 1.4x, mesh_2m 1.26x, many_meshes
-/// 6.4x, crowd 8x less. A speed rule: the answer is the same either way
+/// 6.4x, crowd 7.6x less. A speed rule: the answer is the same either way
 /// but for grazing rays. The eye view's; the light view's is
 /// `MASKS_FROM_LIGHT_VIEW`.
 pub const MASKS_FROM: u32 = 256;

@@ -122,7 +122,10 @@ def test_solids_marked_by_their_silhouette_give_the_rays_bits(samples):
 def test_a_dense_bumpy_mesh_left_to_the_rays_gives_their_bits():
     """A non-convex mesh of 80 000 triangles, each one's shadow far smaller
     than a cell of the pattern: the receivers in its shadow pass the masks'
-    budget and are traced instead, the others marked; both views agree."""
+    budget and are traced instead, the others marked (365 of the 2 205 eye-
+    view receivers and 30 of the 2 304 texels when written, counted in
+    `engine.rs`; the Rust test asserts that some are left); both views
+    agree."""
     import trimesh
 
     ball = trimesh.creation.icosphere(subdivisions=6, radius=0.45)
