@@ -208,7 +208,16 @@ pub fn visibility_weighted(
     match probe {
         Some(p) => {
             let coarse = sampling(p.samples, Jitter::PerReceiver);
-            probed_visibilities_weighted(bvh, starts, key, order, &fine, &coarse, 0.0, p.size)
+            probed_visibilities_weighted(
+                bvh,
+                starts,
+                key,
+                order,
+                (&fine, engine),
+                &coarse,
+                0.0,
+                p.size,
+            )
         }
         None => visibilities_weighted(engine, bvh, starts, key, order, &fine, 0.0),
     }

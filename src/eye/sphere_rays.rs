@@ -19,7 +19,8 @@
 //! origin moves off the surface along the geometric normal, to the side
 //! the ray leaves by. With a `probe`, a pixel whose probe and whose 3 x 3
 //! neighbours' probes saw all of the cap or none of it keeps that answer
-//! (`methods/probe.rs`), the others trace every sample.
+//! (`methods/probe.rs`), the others trace every sample (the rays whatever
+//! the engine: the masks need one pattern shared by every pixel).
 //!
 //! The rays go through the BVH of every triangle, relative to the sphere's
 //! centre in f32, eight neighbouring pixels' rays of one stratum together

@@ -38,9 +38,9 @@ use crate::geom::light_shape::LightSamples;
 use glam::Vec3;
 
 /// The exact method with `samples` light samples per receiver, decided by
-/// `engine` (`engine.rs`); with a `probe` (rays only), receivers whose first
-/// `probe` samples (and their neighbours') agree keep that answer
-/// (`probe.rs`).
+/// `engine` (`engine.rs`); with a `probe` (rays), receivers whose first
+/// `probe` samples (and their neighbours') agree keep that answer, the
+/// others are decided by `engine` (`probe.rs`).
 pub struct Exact {
     pub samples: u32,
     pub probe: Option<u32>,
@@ -90,7 +90,7 @@ impl Exact {
                 pts,
                 |k| k as u64,
                 order,
-                &fine,
+                (&fine, self.engine),
                 &sampling(p, Jitter::PerReceiver),
                 1.0,
                 (g.width, g.height),
@@ -202,13 +202,6 @@ impl ExactConfig {
                 })
             })
             .transpose()?;
-        if engine == Some(Engine::Masks) && probe.is_some() {
-            return Err(Error::invalid(
-                "probe",
-                "the masks engine decides every sample from the triangles and has no probe; \
-                 leave probe unset or pass engine=\"rays\"",
-            ));
-        }
         Ok(ExactConfig {
             samples,
             probe,
@@ -228,9 +221,10 @@ impl ExactConfig {
 
     /// The engine that runs on `backend` in the eye view (`eye`) or the
     /// light view: the one given, else the masks on the CPU from
-    /// `MASKS_FROM` samples (`MASKS_FROM_LIGHT_VIEW` in the light view)
-    /// without a probe (the probe traces rays), the rays otherwise (and on
-    /// the GPU, whose kernel traces rays).
+    /// `MASKS_FROM` samples (`MASKS_FROM_LIGHT_VIEW` in the light view),
+    /// with or without a probe (the probe's own samples are rays; the
+    /// receivers it is unsure of are decided by this engine), the rays
+    /// otherwise (and on the GPU, whose kernel traces rays).
     pub fn engine_for(&self, backend: Backend, eye: bool) -> Engine {
         let from = if eye {
             MASKS_FROM
@@ -239,9 +233,7 @@ impl ExactConfig {
         };
         match self.engine {
             Some(e) => e,
-            None if backend == Backend::Cpu && self.probe.is_none() && self.samples >= from => {
-                Engine::Masks
-            }
+            None if backend == Backend::Cpu && self.samples >= from => Engine::Masks,
             None => Engine::Rays,
         }
     }
@@ -350,11 +342,11 @@ impl MethodSpec for ExactConfig {
                         max: MAX_SAMPLES as i64,
                     },
                     default: Value::Resolved,
-                    default_doc: "None: every receiver traces `samples`",
+                    default_doc: "None: every receiver is decided on `samples`",
                     doc: "light samples of a first pass at every receiver (pixel, texel); one \
                           whose probe and whose 3x3 neighbours' probes all see the whole light \
-                          or none of it keeps that answer, the others trace `samples` (it saves \
-                          time when fewer than `samples`; points given as arrays have no \
+                          or none of it keeps that answer, the others are decided on `samples` \
+                          by `engine` (it saves time when fewer than `samples`; points given as arrays have no \
                           neighbours and trace every sample; the CPU only)",
                     restricted_on: vec![(Backend::Gpu, vec![Value::Resolved])],
                 },
@@ -362,8 +354,9 @@ impl MethodSpec for ExactConfig {
                     name: "engine",
                     kind: Kind::Choice(Engine::ALL.iter().map(|e| e.name()).collect()),
                     default: Value::Resolved,
-                    default_doc: "None: \"masks\" on the CPU without a probe from 256 samples \
-                                  in the eye view and 1024 in the light view, else \"rays\"",
+                    default_doc: "None: \"masks\" on the CPU from 256 samples in the eye view \
+                                  and 1024 in the light view (behind a probe, for the receivers it \
+                                  is unsure of), else \"rays\"",
                     doc: "how the samples are decided, with the same answer but for rays that \
                           graze an edge: \"rays\", a shadow ray a sample through the BVH (the \
                           reference); \"masks\", each receiver's samples marked by the \

@@ -138,7 +138,7 @@ def test_record_rebuilds_the_item_and_files_hold_the_channels(tmp_path):
 
 
 def test_auto_with_light_maps_runs_its_map_rule_and_auto_without_traces(tmp_path):
-    # The eye view's default call traces rays (no maps): a spec that writes
+    # The eye view's default call reads no maps (a probe, then the masks): a spec that writes
     # the light-view maps with name = "auto" runs auto's map rule instead.
     text = SMALL.replace('name = "ssm"\nmap_resolution = 64', 'name = "auto"')
     spec = load_spec(write_spec(tmp_path, text))
@@ -150,7 +150,7 @@ def test_auto_with_light_maps_runs_its_map_rule_and_auto_without_traces(tmp_path
     spec = load_spec(write_spec(tmp_path / "rays", text.replace("light_maps = true\n", "")))
     assert run(spec, tmp_path / "rays" / "out", count=1, progress=False).done == 1
     record = json.loads((tmp_path / "rays" / "out" / "items" / "00000" / "00000000.json").read_text())
-    assert record["method"]["config"] == "Exact(samples=256, probe=16, engine='rays')"
+    assert record["method"]["config"] == "Exact(samples=256, probe=16, engine='masks')"
 
 
 def test_zstd_items_hold_the_zip_items_pixels_and_only_that_spec_hash_changes(tmp_path):
