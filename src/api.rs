@@ -608,14 +608,16 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
 /// The `exact` runs an error target plans on the CPU trace behind the
 /// default call's probe (`auto_config::eye_default`) where they have more
 /// samples than it and fewer than `PLANNED_MASKS_FROM`: only the pixels it
-/// is unsure of trace them all. From `PLANNED_MASKS_FROM` samples they run
+/// is unsure of decide them all (by the engine `ExactConfig::engine_for`
+/// picks: the masks from `MASKS_FROM`, as the default call's). From `PLANNED_MASKS_FROM` samples they run
 /// the masks on every pixel, with no probe to miss a sliver: on the sixteen
-/// as-built scenes at 320x240 the masks took 1.8-7.1x less time than the
+/// as-built scenes at 320x240 the masks took 1.8-7.2x less time than the
 /// probe and the rays at 1024 samples and 2.8-14x less at 2500, where the
 /// probe's answer differed from theirs on up to 1.5% of the pixels by up to
-/// 0.05; at 640x480 1.4-6.2x and 2.3-11x (docs/benchmarks/masks_*.md).
-/// Below it the probe stays: at 256 samples the masks on every pixel took
-/// more time than the probe and the rays on torus_on_slab (1.10x at
+/// 0.05; at 640x480 1.4-5.9x and 2.2-11x (docs/benchmarks/masks_*.md).
+/// Below it the probe stays, the masks behind it: at 256 samples the
+/// masks on every pixel took more time than the probe and the rays on
+/// torus_on_slab (1.10x at
 /// 640x480), mesh_125k (1.45x) and mesh_2m (1.36x), whose dense meshes
 /// cost the masks their budget where the probe finds the pixel lit or
 /// hidden in 16 rays. A config the user gave runs as given.

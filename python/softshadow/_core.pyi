@@ -18,7 +18,8 @@ from typing_extensions import disjoint_base
 # What `from softshadow._core import *` gives (the module's `__all__`, made
 # from the core's table): the method configs, in the table's order, and
 # their parts. `softshadow.methods` exports them; a new method's class goes
-# here, in `_Ran` and its class below.
+# here and in `_Ran` (a config with a keyword form: its class below is
+# written by `python -m softshadow.experiments.method_stubs`).
 __all__ = [
     "Ssm",
     "Bitmask",
@@ -66,9 +67,13 @@ class _KeywordConfig:
     def to_dict(self) -> dict[str, Any]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
 
+# <keyword-configs:start>
+# Written by python -m softshadow.experiments.method_stubs: do not edit.
+
 @final
 class Ssm(_KeywordConfig):
-    """Soft shadow maps as published (Atty et al. 2005)."""
+    """Soft shadow maps (Atty et al. 2005) as published: micro-patches of the occluder maps
+    back-projected onto the light, their occlusions summed."""
 
     def __new__(
         cls,
@@ -76,7 +81,7 @@ class Ssm(_KeywordConfig):
         passes: int | None = None,
         occluder_resolution: _Resolution | None = None,
         hierarchy: bool | None = None,
-        precision: str | None = None,
+        precision: Literal["f32", "f64", "f16", "f16-batched"] | None = None,
     ) -> Ssm: ...
     @property
     def passes(self) -> int | None: ...
@@ -85,11 +90,12 @@ class Ssm(_KeywordConfig):
     @property
     def hierarchy(self) -> bool | None: ...
     @property
-    def precision(self) -> str: ...
+    def precision(self) -> Literal["f32", "f64", "f16", "f16-batched"]: ...
 
 @final
 class Bitmask(_KeywordConfig):
-    """Micro-patches marking light samples in a bit mask per receiver."""
+    """The same micro-patches marking the light samples they hide in a bit mask per receiver,
+    merged by OR (Schwarz & Stamminger 2007)."""
 
     def __new__(
         cls,
@@ -98,7 +104,7 @@ class Bitmask(_KeywordConfig):
         passes: int | None = None,
         occluder_resolution: _Resolution | None = None,
         hierarchy: bool | None = None,
-        gaps: str | None = None,
+        gaps: Literal["closed", "open"] | None = None,
     ) -> Bitmask: ...
     @property
     def samples(self) -> int: ...
@@ -109,14 +115,19 @@ class Bitmask(_KeywordConfig):
     @property
     def hierarchy(self) -> bool | None: ...
     @property
-    def gaps(self) -> str: ...
+    def gaps(self) -> Literal["closed", "open"]: ...
 
 @final
 class Exact(_KeywordConfig):
-    """Ray casting against the occluder triangles."""
+    """Ray casting against the occluder triangles (a BVH) with stratified light samples,
+    jittered deterministically: converges to the true visibility."""
 
     def __new__(
-        cls, *, samples: int | None = None, probe: int | None = None, engine: Literal["rays", "masks"] | None = None
+        cls,
+        *,
+        samples: int | None = None,
+        probe: int | None = None,
+        engine: Literal["rays", "masks"] | None = None,
     ) -> Exact: ...
     @property
     def samples(self) -> int: ...
@@ -124,6 +135,47 @@ class Exact(_KeywordConfig):
     def probe(self) -> int | None: ...
     @property
     def engine(self) -> Literal["rays", "masks"] | None: ...
+
+@final
+class PCSS(_KeywordConfig):
+    """Percentage-closer soft shadows (Fernando 2005), what real-time engines ship: a blocker
+    search on the shadow map, the penumbra estimated from the mean blocker depth, a box PCF of
+    that width."""
+
+    def __new__(
+        cls,
+        *,
+        max_taps: int | None = None,
+        occluder_resolution: _Resolution | None = None,
+    ) -> PCSS: ...
+    @property
+    def max_taps(self) -> int: ...
+    @property
+    def occluder_resolution(self) -> tuple[int, int] | None: ...
+
+@final
+class Smoothies(_KeywordConfig):
+    """Fake soft shadows (Chan & Durand 2003): the hard shadow map's umbra and an outer penumbra
+    from smoothies on the occluders' silhouette edges, their alpha remapped by 1/(1 - b/r)."""
+
+    def __new__(
+        cls,
+        *,
+        width: float | None = None,
+        falloff: Literal["linear", "sine"] | None = None,
+        filter: Literal["bilinear"] | None = None,
+        occluder_resolution: _Resolution | None = None,
+    ) -> Smoothies: ...
+    @property
+    def width(self) -> float: ...
+    @property
+    def falloff(self) -> Literal["linear", "sine"]: ...
+    @property
+    def filter(self) -> Literal["bilinear"]: ...
+    @property
+    def occluder_resolution(self) -> tuple[int, int] | None: ...
+
+# <keyword-configs:end>
 
 @final
 class ConstantBias:
@@ -208,37 +260,6 @@ class EyeSpaceBlur:
     def radius(self) -> float: ...
     def to_dict(self) -> dict[str, Any]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
-
-@final
-class PCSS(_KeywordConfig):
-    """Percentage-closer soft shadows (Fernando 2005)."""
-
-    def __new__(cls, *, max_taps: int | None = None, occluder_resolution: _Resolution | None = None) -> PCSS: ...
-    @property
-    def max_taps(self) -> int: ...
-    @property
-    def occluder_resolution(self) -> tuple[int, int] | None: ...
-
-@final
-class Smoothies(_KeywordConfig):
-    """Fake soft shadows from silhouette-edge smoothies (Chan & Durand 2003)."""
-
-    def __new__(
-        cls,
-        *,
-        width: float | None = None,
-        falloff: str | None = None,
-        filter: str | None = None,
-        occluder_resolution: _Resolution | None = None,
-    ) -> Smoothies: ...
-    @property
-    def width(self) -> float: ...
-    @property
-    def falloff(self) -> str: ...
-    @property
-    def filter(self) -> str: ...
-    @property
-    def occluder_resolution(self) -> tuple[int, int] | None: ...
 
 _Bias = ConstantBias | SlopeScaleBias | LinearDepthBias | BackFaces | MidpointBias
 
@@ -515,7 +536,7 @@ class MethodInfo:
     @property
     def name(self) -> str: ...
     @property
-    def config(self) -> type[Ssm] | type[Bitmask] | type[Exact] | type[Auto]: ...
+    def config(self) -> type[_Ran] | type[Auto]: ...
     @property
     def summary(self) -> str: ...
     @property

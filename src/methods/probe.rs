@@ -45,10 +45,19 @@ pub(crate) fn probed_visibilities<R: RayOrigin + Copy>(
     absent: f32,
     size: (usize, usize),
 ) -> Vec<f32> {
-    probed_visibilities_weighted(bvh, receivers, key, order, (fine, engine), coarse, absent, size)
-        .into_iter()
-        .map(|[v, _]| v)
-        .collect()
+    probed_visibilities_weighted(
+        bvh,
+        receivers,
+        key,
+        order,
+        (fine, engine),
+        coarse,
+        absent,
+        size,
+    )
+    .into_iter()
+    .map(|[v, _]| v)
+    .collect()
 }
 
 /// `probed_visibilities` with the weighted fractions beside them
@@ -188,16 +197,7 @@ mod tests {
         if engine == Engine::Rays {
             assert_eq!(all, visibilities(&bvh, &r, key, &order, &fine, 1.0));
         }
-        let got = probed_visibilities(
-            &bvh,
-            &r,
-            key,
-            &order,
-            (&fine, engine),
-            &coarse,
-            1.0,
-            (n, n),
-        );
+        let got = probed_visibilities(&bvh, &r, key, &order, (&fine, engine), &coarse, 1.0, (n, n));
         // Every receiver the probe was unsure of has exact's bits; a certain
         // one may miss a sliver of penumbra no probe ray met.
         let (mut kept, mut off, mut worst) = (0, 0f64, 0f32);

@@ -211,6 +211,23 @@ def test_the_docs_option_tables_are_the_cores():
     assert method_docs.main(["--check", "--docs", str(docs)]) == 0, "run python -m softshadow.experiments.method_docs"
 
 
+def test_the_stubs_method_classes_are_the_cores():
+    from softshadow.experiments import method_stubs
+
+    stub = Path(__file__).resolve().parents[2] / "python" / "softshadow" / "_core.pyi"
+    assert method_stubs.main(["--check", "--stub", str(stub)]) == 0, "run python -m softshadow.experiments.method_stubs"
+    # Each option's property says None exactly where the core resolves it
+    # later; a config built with no arguments gives the table's defaults.
+    for info in ss.methods.capabilities().values():
+        if not method_stubs._keyword_config(info.config):
+            continue
+        made = info.config()
+        for o in info.options.values():
+            assert getattr(made, o.name) == o.default, (info.name, o.name)
+            line = next(x for x in method_stubs._class(info).splitlines() if f"def {o.name}(self)" in x)
+            assert line.endswith("| None: ...") == (o.default is None), line
+
+
 def test_numpy_scalars_are_accepted_where_python_ones_are():
     assert ss.Ssm(hierarchy=np.True_, passes=np.int32(3)) == ss.Ssm(hierarchy=True, passes=3)
     assert ss.Bitmask(samples=np.uint16(64), occluder_resolution=(np.int64(8), 4)).occluder_resolution == (8, 4)

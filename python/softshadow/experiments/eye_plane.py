@@ -51,7 +51,7 @@ from .points import Point, mitsuba_seconds_at
 MITSUBA_SAMPLES = (1, 4, 16, 64, 256)
 #: (family, label, method): the family groups the study's plot.
 CALLS: list[tuple[str, str, Any]] = [
-    ("auto", "default (exact 256, probe 16)", "auto"),
+    ("auto", "default (probe 16, exact 256)", "auto"),
     ("ssm", "ssm", "ssm"),
     ("bitmask", "bitmask 64", Bitmask(samples=64)),
     ("bitmask", "bitmask 256", Bitmask(samples=256)),
@@ -128,6 +128,8 @@ def describe(img: Any) -> str:
         parts.append(f"{c.samples} samples")
     if getattr(c, "probe", None):
         parts.append(f"probe {c.probe}")
+    if getattr(c, "engine", None):
+        parts.append(str(c.engine))
     occ = getattr(c, "occluder_resolution", None)
     if occ is not None:
         parts.append(f"maps {occ[0]}×{occ[1]}")
