@@ -25,7 +25,7 @@ from pathlib import Path
 
 from _report import DOCS, ROOT, Report, add_output_arguments, command_line, runs
 
-from softshadow import Exact
+from softshadow import PCF, PCSS, Bitmask, Exact, ShadowMapping, SlopeScaleBias, Smoothies
 from softshadow.experiments.eye_plane import eye_plane, markdown_eye_plane
 from softshadow.reference.cache import cached_reference_image
 from softshadow.scenes.as_built import CALIBRATION, HELD_OUT, SCENES
@@ -40,7 +40,14 @@ CALLS = [
     # What four times the samples cost and buy (issue 50: the default is to
     # be noise-free at 1024 where that costs at most 1.5x).
     ("exact", "probe 16, exact 1024", Exact(samples=1024, probe=16), True),
+    # Exact's masks alone (no probe to miss a sliver), and every other
+    # method with its defaults: the accuracy-time plane of each.
+    ("exact", "exact 256, masks", Exact(samples=256, engine="masks"), True),
     ("ssm", "ssm", "ssm", True),
+    ("bitmask", "bitmask 256", Bitmask(samples=256), True),
+    ("pcss", "pcss", PCSS(), True),
+    ("smoothies", "smoothies", Smoothies(), True),
+    ("shadow map", "shadow map, PCF 3", ShadowMapping(filter=PCF(size=3), bias=SlopeScaleBias(slope=4)), True),
     ("exact", "exact 64", Exact(samples=64), False),
 ]
 MITSUBA_SAMPLES = (1, 4, 16, 64, 256, 1024)

@@ -57,6 +57,10 @@ CALLS: list[tuple[str, str, Any]] = [
     ("bitmask", "bitmask 256", Bitmask(samples=256)),
     ("exact", "exact 16", Exact(samples=16)),
     ("exact", "exact 64", Exact(samples=64)),
+    # Exact's masks alone at 256 samples, and four times the samples
+    # behind the default's probe.
+    ("exact", "exact 256, masks", Exact(samples=256, engine="masks")),
+    ("exact", "probe 16, exact 1024", Exact(samples=1024, probe=16)),
     ("pcss", "pcss", PCSS()),
     ("pcss", "pcss, 8 taps", PCSS(max_taps=8)),
     ("smoothies", "smoothies", Smoothies()),
