@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import softshadow as ss
+from softshadow.experiments.markers import replace_between
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs" / "benchmarks"
@@ -68,13 +69,11 @@ def replace_block(path: Path, start: str, end: str, lines: list[str]) -> bool:
     """Replaces what lies between the markers ``start`` and ``end`` in the
     file at ``path`` by ``lines``; False (and the file as it was) when it has
     no such markers."""
-    text = path.read_text()
-    if start not in text or end not in text:
-        print(f"{path.name} has no {start} ... {end} markers: left as it is", file=sys.stderr)
+    try:
+        path.write_text(replace_between(path.read_text(), start, end, "\n".join(lines), path.name))
+    except ValueError as e:
+        print(f"{e}: left as it is", file=sys.stderr)
         return False
-    head, rest = text.split(start, 1)
-    _, tail = rest.split(end, 1)
-    path.write_text(head + start + "\n" + "\n".join(lines) + "\n" + end + tail)
     return True
 
 

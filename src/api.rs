@@ -609,16 +609,21 @@ pub fn render(call: &EyeCall) -> Result<Run<EyeImage>> {
 /// default call's probe (`auto_config::eye_default`) where they have more
 /// samples than it and fewer than `PLANNED_MASKS_FROM`: only the pixels it
 /// is unsure of decide them all (by the engine `ExactConfig::engine_for`
-/// picks: the masks from `MASKS_FROM`, as the default call's). From `PLANNED_MASKS_FROM` samples they run
-/// the masks on every pixel, with no probe to miss a sliver: on the sixteen
+/// picks: the masks from `MASKS_FROM`, as the default call's). From
+/// `PLANNED_MASKS_FROM` samples they run the masks on every pixel, with no
+/// probe to miss a sliver: on the sixteen
 /// as-built scenes at 320x240 the masks took 1.8-7.2x less time than the
-/// probe and the rays at 1024 samples and 2.8-14x less at 2500, where the
+/// probe and the rays at 1024 samples and 2.9-14x less at 2500, where the
 /// probe's answer differed from theirs on up to 1.5% of the pixels by up to
-/// 0.05; at 640x480 1.4-5.9x and 2.2-11x (docs/benchmarks/masks_*.md).
+/// 0.05; at 640x480 1.4-5.7x and 2.2-11x (docs/benchmarks/masks_*.md).
+/// Against the probe with the masks behind it they took 0.81-1.29x its
+/// time at 1024 and 0.66-1.18x at 2500 (0.76-1.16x and 0.61-1.17x at
+/// 640x480), more on eight to twelve scenes: what this rule buys is the
+/// answer without the probe's misses, not time.
 /// Below it the probe stays, the masks behind it: at 256 samples the
 /// masks on every pixel took more time than the probe and the rays on
-/// torus_on_slab (1.10x at
-/// 640x480), mesh_125k (1.45x) and mesh_2m (1.36x), whose dense meshes
+/// torus_on_slab (1.07x at 640x480), mesh_125k (1.45x) and mesh_2m
+/// (1.36x), whose dense meshes
 /// cost the masks their budget where the probe finds the pixel lit or
 /// hidden in 16 rays. A config the user gave runs as given.
 const PLANNED_MASKS_FROM: u32 = 1024;

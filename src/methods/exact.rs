@@ -143,9 +143,9 @@ impl ShadowMethod for Exact {
 /// sixteen as-built scenes, both sets, one run each (docs/benchmarks/
 /// masks_320x240.md, masks_640x480.md), the masks leaving a receiver to
 /// the rays where its triangles would cost more (`masks/mod.rs`): at 256
-/// samples they took 1.07-8.2x less time than the rays on every scene at
-/// 320x240 (1.10-8.9x at 640x480; table_and_chairs' thin panels under a
-/// 3 m light the least), at 1024 2.4-26x (2.5-28x). On the scale scenes
+/// samples they took 1.11-7.9x less time than the rays on every scene at
+/// 320x240 (1.22-7.6x at 640x480; table_and_chairs' thin panels under a
+/// 3 m light the least), at 1024 2.3-25x (2.3-26x). On the scale scenes
 /// at 640x480 and 256 samples: mesh_125k 1.4x, mesh_2m 1.26x, many_meshes
 /// 6.4x, crowd 7.6x less. A speed rule: the answer is the same either way
 /// but for grazing rays. The eye view's; the light view's is

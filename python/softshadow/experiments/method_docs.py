@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from .. import methods
+from .markers import replace_between
 
 START, END = "<!-- options:start -->", "<!-- options:end -->"
 # Run from the checkout's root.
@@ -61,11 +62,7 @@ def table(name: str) -> str:
 
 def render(page: str, name: str) -> str:
     """``page`` with its options block replaced by the current table."""
-    if START not in page or END not in page:
-        raise ValueError(f"docs/methods/{name}.md: no {START} ... {END} block")
-    head, rest = page.split(START, 1)
-    _, tail = rest.split(END, 1)
-    return f"{head}{START}\n{table(name)}\n{END}{tail}"
+    return replace_between(page, START, END, table(name), f"docs/methods/{name}.md")
 
 
 def main(argv: list[str] | None = None) -> int:

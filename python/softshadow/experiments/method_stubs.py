@@ -23,6 +23,7 @@ import textwrap
 from pathlib import Path
 
 from .. import _core, methods
+from .markers import replace_between
 
 START, END = "# <keyword-configs:start>", "# <keyword-configs:end>"
 # Run from the checkout's root.
@@ -79,12 +80,8 @@ def block() -> str:
 
 def render(stub: str) -> str:
     """``stub`` with its keyword-configs block replaced by the current one."""
-    if START not in stub or END not in stub:
-        raise ValueError(f"{STUB}: no {START} ... {END} block")
-    head, rest = stub.split(START, 1)
-    _, tail = rest.split(END, 1)
     note = "# Written by python -m softshadow.experiments.method_stubs: do not edit."
-    return f"{head}{START}\n{note}\n\n{block()}\n\n{END}{tail}"
+    return replace_between(stub, START, END, f"{note}\n\n{block()}\n", str(STUB))
 
 
 def main(argv: list[str] | None = None) -> int:
