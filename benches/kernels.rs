@@ -27,7 +27,7 @@ use softshadow::frame::{light_space_triangles, ShadowResult};
 use softshadow::geom::mesh::MeshRef;
 use softshadow::methods::bitmask::Gaps;
 use softshadow::methods::ssm::Precision;
-use softshadow::methods::{Method, ShadowInputs};
+use softshadow::methods::{BitmaskKernel, Exact, Method, ShadowInputs, SsmKernel};
 use softshadow::raster::rasterize;
 use softshadow::{AreaLight, BackendChoice, BitmaskConfig, ExactConfig, MethodConfig, SsmConfig};
 
@@ -216,57 +216,57 @@ fn bench_kernels(c: &mut Criterion) {
     let kernels = [
         (
             "ssm",
-            Method::Ssm {
+            Method::Ssm(SsmKernel {
                 hierarchy: false,
                 precision: Precision::F32,
-            },
+            }),
         ),
         (
             "ssm_hierarchy",
-            Method::Ssm {
+            Method::Ssm(SsmKernel {
                 hierarchy: true,
                 precision: Precision::F32,
-            },
+            }),
         ),
         (
             "bitmask256",
-            Method::Bitmask {
+            Method::Bitmask(BitmaskKernel {
                 samples: 256,
                 hierarchy: false,
                 gaps: Gaps::Closed,
-            },
+            }),
         ),
         (
             "bitmask256_open",
-            Method::Bitmask {
+            Method::Bitmask(BitmaskKernel {
                 samples: 256,
                 hierarchy: false,
                 gaps: Gaps::Open,
-            },
+            }),
         ),
         (
             "bitmask256_hierarchy",
-            Method::Bitmask {
+            Method::Bitmask(BitmaskKernel {
                 samples: 256,
                 hierarchy: true,
                 gaps: Gaps::Closed,
-            },
+            }),
         ),
         (
             "exact64",
-            Method::Exact {
+            Method::Exact(Exact {
                 samples: 64,
                 probe: None,
                 engine: softshadow::methods::engine::Engine::Rays,
-            },
+            }),
         ),
         (
             "masks64",
-            Method::Exact {
+            Method::Exact(Exact {
                 samples: 64,
                 probe: None,
                 engine: softshadow::methods::engine::Engine::Masks,
-            },
+            }),
         ),
     ];
     let mut g = configure(c, "kernel");

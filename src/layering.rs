@@ -480,6 +480,49 @@ fn no_module_reaches_itself() {
     );
 }
 
+/// The variants of the kernel enum (`Method::Exact`, ...) a file's code
+/// (tests left out) names.
+fn method_variants(code: &str) -> Vec<String> {
+    let b = code.as_bytes();
+    let mut out = vec![];
+    for (k, _) in code.match_indices("Method::") {
+        let word_start = k == 0 || !(b[k - 1].is_ascii_alphanumeric() || b[k - 1] == b'_');
+        let rest = &code[k + "Method::".len()..];
+        if word_start && rest.starts_with(|c: char| c.is_ascii_uppercase()) {
+            let end = rest
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(rest.len());
+            out.push(rest[..end].to_string());
+        }
+    }
+    out
+}
+
+/// No stage, orchestrator, planner, API or binding tells the methods apart
+/// by their kernel's variant: each asks the kernel (`methods::Kernel`,
+/// `ShadowMethod`), so a new method is its module, its registry line and
+/// its GPU kernel (`gpu/`, whose `gpu::kernel` is the one place there that
+/// picks one). Checked on the code outside tests.
+#[test]
+fn no_stage_names_a_method() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut named = vec![];
+    for (m, p) in modules(&src) {
+        if m.is_empty() || test_only(&m) || matches!(m[0].as_str(), "methods" | "gpu") {
+            continue;
+        }
+        let found = method_variants(&code(&std::fs::read_to_string(&p).unwrap()));
+        if !found.is_empty() {
+            named.push((name(&m), found));
+        }
+    }
+    assert!(named.is_empty(), "files naming a method's kernel: {named:?}");
+    assert_eq!(
+        method_variants("let a = Method::Exact(k); ShadowMethod::f(); Method::kernel;"),
+        ["Exact"]
+    );
+}
+
 /// The checks find what they look for: a circle and an upward import in a
 /// small made-up crate, and the re-export rule.
 #[test]

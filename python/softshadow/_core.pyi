@@ -17,9 +17,10 @@ from typing_extensions import disjoint_base
 
 # What `from softshadow._core import *` gives (the module's `__all__`, made
 # from the core's table): the method configs, in the table's order, and
-# their parts. `softshadow.methods` exports them; a new method's class goes
-# here and in `_Ran` (a config with a keyword form: its class below is
-# written by `python -m softshadow.experiments.method_stubs`).
+# their parts. `softshadow.methods` exports them. This list, `_Ran` and the
+# classes of the configs with a keyword form are written by
+# `python -m softshadow.experiments.method_stubs`.
+# <all:start>
 __all__ = [
     "Ssm",
     "Bitmask",
@@ -37,6 +38,7 @@ __all__ = [
     "LiSPSM",
     "EyeSpaceBlur",
 ]
+# <all:end>
 
 __version__: str
 ENV_THREADS: str
@@ -312,8 +314,10 @@ class Auto:
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
 
 # The configs a result says ran (every method's, resolved: never Auto), and
-# what a call takes. A new method's class goes in `_Ran` once.
+# what a call takes.
+# <ran:start>
 _Ran = Ssm | Bitmask | Exact | PCSS | Smoothies | ShadowMapping
+# <ran:end>
 _MethodArg = str | _Ran | Auto
 
 @final

@@ -33,7 +33,7 @@
 use super::plan::{exact_samples, square_samples, Decision, MAX_REFINED_SAMPLES};
 use crate::error::Result;
 use crate::error_estimate::ErrorEstimate;
-use crate::methods::{ExactConfig, Method, MethodConfig};
+use crate::methods::{ExactConfig, MethodConfig};
 
 /// Runs after the planned one, at most.
 pub const MAX_REFINES: usize = 2;
@@ -56,8 +56,8 @@ pub fn next(
         "the estimate {:.4} (95% interval up to {:.4}) misses the target {target}",
         e.error, e.high
     );
-    let (samples, how) = match ran.kernel() {
-        Method::Exact { samples, .. } => {
+    let (samples, how) = match ran.kernel().rays() {
+        Some((samples, ..)) => {
             if samples >= MAX_REFINED_SAMPLES {
                 return None;
             }
@@ -87,7 +87,7 @@ pub fn next(
                 ),
             )
         }
-        _ => {
+        None => {
             let n = exact_samples(law, target);
             (
                 n,
@@ -146,7 +146,8 @@ pub fn refined<T>(
 ) -> Result<(T, MethodConfig, f64)> {
     let (mut out, mut ran) = first;
     let (mut replaced, mut last) = (0.0, first_seconds);
-    let pilot = matches!(ran.kernel(), Method::Exact { samples, .. } if samples < exact_samples(law, target));
+    let pilot =
+        matches!(ran.kernel().rays(), Some((samples, ..)) if samples < exact_samples(law, target));
     for _ in 0..MAX_REFINES + pilot as usize {
         let Some(e) = estimate_of(&out) else { break };
         if met(target, &e) {

@@ -130,12 +130,8 @@ pub fn resolve_at_camera(call: &EyeCall, backend: Backend) -> Result<MethodConfi
 /// that decides them: a hard light needs one ray (every sample would be the
 /// same) and no probe.
 pub fn exact_samples(call: &EyeCall, method: &MethodConfig) -> (u32, Option<u32>, Engine) {
-    match method.kernel() {
-        crate::methods::Method::Exact {
-            samples,
-            probe,
-            engine,
-        } if !call.light.is_hard() => (samples, probe, engine),
+    match method.kernel().rays() {
+        Some(rays) if !call.light.is_hard() => rays,
         _ => (1, None, Engine::Rays),
     }
 }
@@ -154,18 +150,14 @@ pub fn traced_triangles(f: &Framed, scene: &SceneTriangles) -> Vec<[Vec3; 3]> {
 /// asked about: their visibility is 0 whatever shadows them
 /// (`maps::shading_points`, the tangent-plane bound), and a box floor's
 /// sides facing away from the light would otherwise keep its top face a
-/// caster. Smoothies keep every face: their falloff reads the depth of the
-/// receiver behind each silhouette from the map (without the floor there,
-/// its error on contact_boxes went from under 0.1 to 0.26).
+/// caster. A kernel that reads every face keeps them all
+/// (`Kernel::READS_EVERY_FACE`: the smoothies).
 pub fn casting_faces<'s>(
     call: &EyeCall,
     scene: &'s SceneTriangles,
     f: &Framed,
 ) -> Cow<'s, [[u32; 3]]> {
-    if matches!(
-        call.method.kernel(),
-        crate::methods::Method::Smoothies { .. }
-    ) {
+    if call.method.kernel().reads_every_face() {
         return Cow::Borrowed(&scene.faces);
     }
     let facing: Vec<[f64; 3]> = f

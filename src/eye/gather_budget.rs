@@ -18,8 +18,8 @@ use super::maps::{kernel_point, EMPTY_POINT};
 use crate::error::Result;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::methods::gather::work::{visit_cost, visits_bound, PLANNED_VISITS};
-use crate::methods::{LightPoint, Method, MethodConfig};
+use crate::methods::gather::work::{visits_bound, PLANNED_VISITS};
+use crate::methods::{LightPoint, MethodConfig};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -51,12 +51,9 @@ pub fn within_budget(
     planned: (MapGrid, MethodConfig),
     at: impl Fn((usize, usize)) -> Result<(MapGrid, MethodConfig)>,
 ) -> Result<((MapGrid, MethodConfig), (usize, usize))> {
-    if !matches!(
-        planned.1.kernel(),
-        Method::Ssm { .. } | Method::Bitmask { .. }
-    ) {
+    let Some(visit_cost) = planned.1.kernel().visit_cost() else {
         return Ok((planned, resolution));
-    }
+    };
     let Some(z_near) = nearest_occluder(&f, faces) else {
         return Ok((planned, resolution));
     };
@@ -77,7 +74,8 @@ pub fn within_budget(
         .collect();
     let bound = |(grid, method): &(MapGrid, MethodConfig)| {
         let layers = method.passes() as usize;
-        visit_cost(method.kernel()) * visits_bound(grid, f.light_shape, z_near, layers, &points)
+        let cost = method.kernel().visit_cost().unwrap_or(visit_cost);
+        cost * visits_bound(grid, f.light_shape, z_near, layers, &points)
     };
     let budget = PLANNED_VISITS;
     let mut plan = planned;

@@ -30,7 +30,7 @@ use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::geom::plane_gradient::plane_gradient;
-use crate::methods::{Input, LightPoint, Method, ShadowInputs};
+use crate::methods::{EyePoints, Input, LightPoint, Method, ShadowInputs};
 use crate::raster::Prepared;
 pub(crate) use crate::timing::Stopwatch;
 use glam::DVec3;
@@ -239,7 +239,7 @@ pub fn shading_points(
 /// What the map methods give for the visible points: each one's visibility,
 /// beside it its weighted visibility where the method weighs its samples
 /// (under an area light the bitmask's and the SSM's,
-/// `methods::shade_points_weighted`, and PCSS's filter cells,
+/// `ShadowMethod::visibility_eye`, and PCSS's filter cells,
 /// `Pcss::weighted_on_planes`),
 /// and the maps.
 pub struct MapShading {
@@ -307,37 +307,14 @@ pub(crate) fn shade(
         occluder_triangles: None,
     };
     debug_assert!(method.reads_input(Input::OccluderLayers));
-    let shade = || match method {
-        // Every mesh is an occluder: its silhouette straight from the mesh.
-        Method::Smoothies { width, falloff } => (
-            crate::methods::smoothies::Smoothies {
-                width: width.0,
-                falloff,
-            }
-            .shade(&inputs, &tris.verts, tris.faces, &sp.points, &sp.planes),
-            None,
-        ),
-        Method::Pcss { max_taps } => {
-            let pcss = crate::methods::pcss::Pcss { max_taps };
-            match &receivers {
-                Some(r) => {
-                    let (v, w) = pcss.weighted_on_planes(&inputs, &sp.points, &sp.planes, r);
-                    (v, Some(w))
-                }
-                None => (
-                    pcss.visibility_on_planes(&inputs, &sp.points, &sp.planes),
-                    None,
-                ),
-            }
-        }
-        _ => match &receivers {
-            Some(r) => crate::methods::shade_points_weighted(method, &inputs, &sp.points, r),
-            None => (
-                crate::methods::shade_points(method, &inputs, &sp.points),
-                None,
-            ),
-        },
+    let eye = EyePoints {
+        points: &sp.points,
+        planes: &sp.planes,
+        starts: receivers.as_deref(),
+        verts: &tris.verts,
+        faces: tris.faces,
     };
+    let shade = || crate::methods::shade_eye(method, &inputs, &eye);
     let (mut v, mut weighted) =
         crate::methods::bounded(method, &inputs, Some(&sp.points), arg, shade)?;
     sw.lap("shadow");

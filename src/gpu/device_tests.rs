@@ -7,7 +7,7 @@ use crate::frame::{MapSettings, ShadowResult};
 use crate::geom::light::AreaLight;
 use crate::geom::light_shape::LightShape;
 use crate::geom::mesh::MeshRef;
-use crate::methods::Method;
+use crate::methods::{BitmaskKernel, Exact, Method, SsmKernel};
 use crate::pipeline;
 
 fn device_or_skip() -> bool {
@@ -106,10 +106,10 @@ fn same_bits(a: &[f32], b: &[f32]) -> usize {
 }
 
 /// The paper's method as the GPU runs it (no hierarchy, f32 sums).
-const SSM: Method = Method::Ssm {
+const SSM: Method = Method::Ssm(SsmKernel {
     hierarchy: false,
     precision: crate::methods::ssm::Precision::F32,
-};
+});
 
 #[test]
 fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
@@ -117,25 +117,25 @@ fn gpu_maps_are_the_cpu_maps_bit_for_bit() {
         return;
     }
     let methods = [
-        Method::Ssm {
+        Method::Ssm(SsmKernel {
             hierarchy: false,
             precision: Default::default(),
-        },
-        Method::Bitmask {
+        }),
+        Method::Bitmask(BitmaskKernel {
             samples: 16,
             hierarchy: false,
             gaps: crate::methods::bitmask::Gaps::Open,
-        },
-        Method::Bitmask {
+        }),
+        Method::Bitmask(BitmaskKernel {
             samples: 256,
             hierarchy: false,
             gaps: crate::methods::bitmask::Gaps::Open,
-        },
-        Method::Exact {
+        }),
+        Method::Exact(Exact {
             samples: 16,
             probe: None,
             engine: crate::methods::engine::Engine::Rays,
-        },
+        }),
     ];
     for (passes, method) in [1, 2, 4].into_iter().flat_map(|p| methods.map(|m| (p, m))) {
         let c = run(false, passes, method);
@@ -187,10 +187,12 @@ fn bitmask_kernels() -> Vec<Method> {
     [16, 256, 1024]
         .into_iter()
         .flat_map(|samples| {
-            Gaps::ALL.map(|gaps| Method::Bitmask {
-                samples,
-                hierarchy: false,
-                gaps,
+            Gaps::ALL.map(|gaps| {
+                Method::Bitmask(BitmaskKernel {
+                    samples,
+                    hierarchy: false,
+                    gaps,
+                })
             })
         })
         .collect()
@@ -272,17 +274,17 @@ fn gpu_bitmask_is_the_cpus_bit_for_bit_both_gaps_every_mask() {
             let [(a, va), (b, vb)] = pair else { panic!() };
             assert!(matches!(
                 a,
-                Method::Bitmask {
+                Method::Bitmask(BitmaskKernel {
                     gaps: Gaps::Closed,
                     ..
-                }
+                })
             ));
             assert!(matches!(
                 b,
-                Method::Bitmask {
+                Method::Bitmask(BitmaskKernel {
                     gaps: Gaps::Open,
                     ..
-                }
+                })
             ));
             assert!(same_bits(va, vb) > 0, "{a:?}: closed and open agree");
         }
@@ -403,10 +405,10 @@ fn gpu_bitmask_from_depth_maps_is_the_cpus_bit_for_bit() {
                 assert_eq!(n, 0, "{method:?}, back {}, {og:?}", back.is_some());
                 let closed = matches!(
                     method,
-                    Method::Bitmask {
+                    Method::Bitmask(BitmaskKernel {
                         gaps: crate::methods::bitmask::Gaps::Closed,
                         ..
-                    }
+                    })
                 );
                 assert_eq!(t.iter().any(|s| s.0 == "corners"), closed);
             }
@@ -430,7 +432,7 @@ fn wide_bitmask_penumbrae_on_fine_maps_take_many_chunks() {
     let light = LightShape::rect([2.5, 2.0]);
     for method in bitmask_kernels()
         .into_iter()
-        .filter(|m| matches!(m, Method::Bitmask { samples: 1024, .. }))
+        .filter(|m| matches!(m, Method::Bitmask(BitmaskKernel { samples: 1024, .. })))
     {
         // Chunks from the depths' own bound (depth unit 1: the receivers
         // lie within [2^-16, 2^16]).
@@ -480,11 +482,11 @@ fn depth_maps_cannot_be_traced() {
     };
     let e = pipeline::from_depth(
         &maps,
-        Method::Exact {
+        Method::Exact(Exact {
             samples: 4,
             probe: None,
             engine: crate::methods::engine::Engine::Rays,
-        },
+        }),
         Backend::Gpu,
     )
     .unwrap_err()
@@ -1645,7 +1647,7 @@ mod smoothies {
     use crate::geom::light::MapGrid;
     use crate::methods::shadow_mapping::config::Real;
     use crate::methods::smoothies::{shadow_map, Falloff, SmoothieBuffer, Smoothies};
-    use crate::methods::Method;
+    use crate::methods::{Method, SmoothiesKernel};
     use glam::DVec3;
 
     /// Texels whose alpha or depth differ beyond f32 rounding (1e-5,
@@ -1729,10 +1731,10 @@ mod smoothies {
         }
     }
 
-    const SMOOTHIES: Method = Method::Smoothies {
+    const SMOOTHIES: Method = Method::Smoothies(SmoothiesKernel {
         width: Real(1.0),
         falloff: Falloff::Linear,
-    };
+    });
 
     /// |dV| statistics: mean, max, and the count over 2e-3 (a smoothie
     /// texel flipped by an f32 tie moves one texel's tent).
@@ -1754,10 +1756,10 @@ mod smoothies {
         }
         for method in [
             SMOOTHIES,
-            Method::Smoothies {
+            Method::Smoothies(SmoothiesKernel {
                 width: Real(2.0),
                 falloff: Falloff::Sine,
-            },
+            }),
         ] {
             let c = run(false, 1, method);
             let g = run(true, 1, method);
@@ -1830,7 +1832,7 @@ mod pcss {
         // sides (the maps are bit for bit the CPU's); what remains is f32
         // against f64 in the box ends, weights and sums: ~1e-6.
         for (taps, res) in [(32, (64, 48)), (4, (64, 48)), (1, (64, 48)), (6, (97, 61))] {
-            let method = Method::Pcss { max_taps: taps };
+            let method = Method::Pcss(Pcss { max_taps: taps });
             let c = run_at(false, 1, method, res);
             let g = run_at(true, 1, method, res);
             assert_eq!(same_bits(&c.receiver, &g.receiver), 0, "receiver");
@@ -1899,7 +1901,7 @@ mod pcss {
             (12, LightShape::disk(0.7)),
             (32, LightShape::disk(0.05)),
         ] {
-            let method = Method::Pcss { max_taps: taps };
+            let method = Method::Pcss(Pcss { max_taps: taps });
             let maps = pipeline::DepthMaps {
                 grid: &grid,
                 occluder_grid: &og,

@@ -21,7 +21,7 @@ use crate::frame::light_space_triangles;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::methods::exact::{Bvh, RAY_EPS};
-use crate::methods::Method;
+use crate::methods::{Exact, Method};
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -257,7 +257,7 @@ impl GpuKernel for ExactKernel {
         method: Method,
         i: LightViewInputs<'a>,
     ) -> Result<Option<MakeStage<'a>>> {
-        let Method::Exact { samples, .. } = method else {
+        let Method::Exact(Exact { samples, .. }) = method else {
             return Err(mismatch(method));
         };
         let (verts, faces) = i.occluders.ok_or_else(|| needs_triangles(method))?;

@@ -19,7 +19,7 @@ use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::methods::bitmask::Gaps;
 use crate::methods::ssm::Precision;
-use crate::methods::Method;
+use crate::methods::{BitmaskKernel, Method, SsmKernel};
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -257,7 +257,7 @@ pub fn chunking(og: &MapGrid, light_shape: LightShape, w_max: f64, method: Metho
 /// 32), in case the compiler keeps them a loop.
 pub fn texel_cost(method: Method) -> usize {
     match method {
-        Method::Bitmask { samples, .. } => mask_words(samples) as usize / 4 + 1,
+        Method::Bitmask(BitmaskKernel { samples, .. }) => mask_words(samples) as usize / 4 + 1,
         _ => 1,
     }
 }
@@ -305,25 +305,25 @@ fn variant(method: Method) -> Result<Variant> {
         )
     };
     match method {
-        Method::Ssm {
+        Method::Ssm(SsmKernel {
             hierarchy: true, ..
-        }
-        | Method::Bitmask {
+        })
+        | Method::Bitmask(BitmaskKernel {
             hierarchy: true, ..
-        } => Err(no_hierarchy()),
-        Method::Ssm {
+        }) => Err(no_hierarchy()),
+        Method::Ssm(SsmKernel {
             precision: Precision::F32,
             ..
-        } => Ok(Variant::Ssm),
-        Method::Ssm { precision, .. } => Err(Error::invalid(
+        }) => Ok(Variant::Ssm),
+        Method::Ssm(SsmKernel { precision, .. }) => Err(Error::invalid(
             "precision",
             format!("the GPU backend sums in f32 only, got {precision:?}; use backend=\"cpu\""),
         )),
-        Method::Bitmask { samples, gaps, .. } => Ok(Variant::Bitmask {
+        Method::Bitmask(BitmaskKernel { samples, gaps, .. }) => Ok(Variant::Bitmask {
             words: mask_words(samples),
             gaps,
         }),
-        Method::Exact { .. } => Err(Error::invalid(
+        Method::Exact(_) => Err(Error::invalid(
             "method",
             format!(
                 "{:?} does not shade occluder maps (GPU map methods: \"ssm\", \"bitmask\")",
@@ -430,7 +430,7 @@ const CORNERS_BINDING: usize = 13;
 /// one mask (bitmask: `mask_words`).
 pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
     match method {
-        Method::Bitmask { samples, .. } => mask_words(samples),
+        Method::Bitmask(BitmaskKernel { samples, .. }) => mask_words(samples),
         _ => n_layers,
     }
 }
@@ -440,7 +440,7 @@ pub fn accumulator_words(method: Method, n_layers: u32) -> u32 {
 /// None.
 pub fn method_tables(method: Method, light: LightShape) -> Option<Vec<u32>> {
     match method {
-        Method::Bitmask { samples, gaps, .. } => {
+        Method::Bitmask(BitmaskKernel { samples, gaps, .. }) => {
             let disk = matches!(light, LightShape::Disk { .. });
             let t = crate::methods::bitmask::Bitmask::for_shape(samples, gaps, None, disk)
                 .rank_tables();

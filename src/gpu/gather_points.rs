@@ -40,7 +40,7 @@ use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::methods::bitmask::Bitmask;
 use crate::methods::gather::{point_group, point_order, POINTS_PER_GROUP};
-use crate::methods::{Input, LightPoint, Method};
+use crate::methods::{BitmaskKernel, Input, LightPoint, Method};
 use crate::raster::setup_triangles;
 use crate::timing::{Stopwatch, Timings};
 use rayon::prelude::*;
@@ -188,7 +188,7 @@ struct Weighing {
 /// receivers) for the methods that weigh (`bitmask`, `ssm`); None for the
 /// others and other lights.
 fn weigh_inputs(method: Method, f: &Framed, order: &[u32], n_lanes: usize) -> Option<Weighing> {
-    if !matches!(method, Method::Bitmask { .. } | Method::Ssm { .. })
+    if !matches!(method, Method::Bitmask(_) | Method::Ssm(_))
         || !matches!(f.space, LightSpace::Area(_))
         || f.light_shape.is_point()
     {
@@ -201,7 +201,7 @@ fn weigh_inputs(method: Method, f: &Framed, order: &[u32], n_lanes: usize) -> Op
         .collect();
     lanes.resize(n_lanes, GpuWeighPoint::default());
     let light_samples = match method {
-        Method::Bitmask { samples, gaps, .. } => {
+        Method::Bitmask(BitmaskKernel { samples, gaps, .. }) => {
             let disk = matches!(f.light_shape, LightShape::Disk { .. });
             let b = Bitmask::for_shape(samples, gaps, None, disk);
             Some(b.light_samples(f.light_shape.half_extent()))
@@ -254,7 +254,7 @@ fn shade_points(
     let (lanes, groups) = point_lanes(&sorted);
     let n_points = lanes.len();
     let weigh = weigh_inputs(method, f, &order, n_points);
-    let ssm = matches!(method, Method::Ssm { .. });
+    let ssm = matches!(method, Method::Ssm(_));
     // Weighed, the SSM's weighted sums follow its plain ones.
     let acc_words = gather::accumulator_words(method, passes) as u64
         * n_points as u64

@@ -83,10 +83,10 @@ use method_kernel::GpuKernel;
 /// the methods apart.
 fn kernel(method: Method) -> &'static dyn GpuKernel {
     match method {
-        Method::Ssm { .. } | Method::Bitmask { .. } => &gather_points::GatherKernel,
-        Method::Exact { .. } => &exact::ExactKernel,
-        Method::Smoothies { .. } => &smoothies::SmoothiesKernel,
-        Method::Pcss { .. } => &pcss::PcssKernel,
+        Method::Ssm(_) | Method::Bitmask(_) => &gather_points::GatherKernel,
+        Method::Exact(_) => &exact::ExactKernel,
+        Method::Smoothies(_) => &smoothies::SmoothiesKernel,
+        Method::Pcss(_) => &pcss::PcssKernel,
         // Its eye view is a stage of its own (`EyeStages::shadow_mapping`).
         Method::ShadowMapping(_) => &method_kernel::NoKernel,
     }

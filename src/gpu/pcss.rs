@@ -30,7 +30,7 @@ use crate::geom::light_shape::LightShape;
 use crate::geom::light_space::LightSpace;
 use crate::geom::plane_gradient::{split, Plane};
 use crate::methods::pcss::{half_per_w, MAX_TAPS};
-use crate::methods::{LightPoint, Method};
+use crate::methods::{LightPoint, Method, Pcss};
 use crate::timing::{Stopwatch, Timings};
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
@@ -496,7 +496,7 @@ impl GpuKernel for PcssKernel {
         method: Method,
         i: LightViewInputs<'a>,
     ) -> Result<Option<MakeStage<'a>>> {
-        let Method::Pcss { max_taps } = method else {
+        let Method::Pcss(Pcss { max_taps }) = method else {
             return Err(mismatch(method));
         };
         Ok(Some(Box::new(move || {
@@ -514,7 +514,7 @@ impl GpuKernel for PcssKernel {
         inputs: &EyeInputs,
         sw: &mut Stopwatch,
     ) -> Result<(MapShading, Timings)> {
-        let Method::Pcss { max_taps } = method else {
+        let Method::Pcss(Pcss { max_taps }) = method else {
             return Err(mismatch(method));
         };
         shade_points(g, inputs, max_taps, sw)

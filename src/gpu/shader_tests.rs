@@ -146,14 +146,14 @@ fn bitmask_modules_have_their_words_and_read_the_corners_only_with_closed_gaps()
 fn mask_words_are_the_rank_tables_entries_and_cost_their_loop() {
     use super::gather::{mask_words, method_tables, texel_cost};
     use crate::methods::bitmask::{Gaps, SAMPLE_COUNTS};
-    use crate::methods::Method;
+    use crate::methods::{BitmaskKernel, Method};
     for samples in SAMPLE_COUNTS {
         for gaps in Gaps::ALL {
-            let m = Method::Bitmask {
+            let m = Method::Bitmask(BitmaskKernel {
                 samples,
                 hierarchy: false,
                 gaps,
-            };
+            });
             // method_tables asserts the length; the words hold every sample.
             let t =
                 method_tables(m, crate::geom::light_shape::LightShape::rect([1.0, 1.0])).unwrap();

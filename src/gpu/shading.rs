@@ -14,7 +14,7 @@ use super::timing::StageTimer;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use crate::methods::Method;
+use crate::methods::{BitmaskKernel, Method};
 
 /// Refuses maps (and accumulators, and the corners) that do not fit one
 /// buffer binding, or offsets beyond u32.
@@ -84,14 +84,16 @@ pub(super) fn gather_params(
         layer0_offset: grid.len() as u32,
         layer_stride: og.len() as u32,
         samples: match method {
-            Method::Bitmask { samples, .. } => samples,
+            Method::Bitmask(BitmaskKernel { samples, .. }) => samples,
             _ => 0,
         },
         counted: match method {
-            Method::Bitmask { samples, .. } => crate::methods::bitmask::counted_samples(
-                samples,
-                matches!(light_shape, LightShape::Disk { .. }),
-            ),
+            Method::Bitmask(BitmaskKernel { samples, .. }) => {
+                crate::methods::bitmask::counted_samples(
+                    samples,
+                    matches!(light_shape, LightShape::Disk { .. }),
+                )
+            }
             _ => 0,
         },
         disk: u32::from(matches!(light_shape, LightShape::Disk { .. })),

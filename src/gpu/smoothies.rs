@@ -596,9 +596,9 @@ impl SmoothieShading {
 /// The smoothies' options of `method`.
 fn options(method: Method) -> Result<Smoothies> {
     match method {
-        Method::Smoothies { width, falloff } => Ok(Smoothies {
-            width: width.0,
-            falloff,
+        Method::Smoothies(k) => Ok(Smoothies {
+            width: k.width.0,
+            falloff: k.falloff,
         }),
         _ => Err(mismatch(method)),
     }

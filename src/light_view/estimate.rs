@@ -46,13 +46,13 @@ use crate::methods::Method;
 /// trace: 1024 texels at 1024 samples took 13 ms on the fence.
 pub const REFERENCE_SAMPLES: u32 = 4 * crate::eye::estimate::REFERENCE_SAMPLES;
 
-/// The exact rays' light samples for a result of `method`: `exact`
-/// against four times its own samples (its sampling error), the map
+/// The exact rays' light samples for a result of `method`: a ray-traced
+/// kernel (`exact`) against four times its own samples (its sampling error), the map
 /// methods against `REFERENCE_SAMPLES`.
 pub fn reference_samples(method: Method) -> u32 {
-    match method {
-        Method::Exact { samples, .. } => samples.saturating_mul(4).min(MAX_SAMPLES),
-        _ => REFERENCE_SAMPLES,
+    match method.rays() {
+        Some((samples, ..)) => samples.saturating_mul(4).min(MAX_SAMPLES),
+        None => REFERENCE_SAMPLES,
     }
 }
 

@@ -5,8 +5,8 @@
 use super::config::{CallContext, LooseOptions, MethodSpec};
 use super::config::{DEFAULT_PASSES, SAMPLES_ONLY};
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
-use super::ssm::{Precision, SsmConfig};
-use super::Input;
+use super::kernel::Kernel;
+use super::ssm::{Precision, SsmConfig, SsmKernel};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 
@@ -77,6 +77,11 @@ impl MethodSpec for AutoConfig {
         })
     }
     type Resolved = SsmConfig;
+    /// What "auto" always resolves to.
+    type Kernel = SsmKernel;
+    fn kernel(&self) -> SsmKernel {
+        self.given.kernel()
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         let given = self.given;
         let rule = match ctx.depth_layers {
@@ -102,7 +107,8 @@ impl MethodSpec for AutoConfig {
                       most the output's), the point of the study's accuracy-time plane furthest \
                       ahead of ray tracing; with error= or time=, the setting planned from the \
                       scene (light-view maps from meshes; sm.plan says why)",
-            reads: vec![Input::OccluderLayers],
+            // The kernel's (`Kernel::READS`).
+            reads: SsmKernel::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
                 OptionInfo {

@@ -168,6 +168,11 @@ pub trait MethodSpec: Copy {
     /// The config that runs for `ctx`: every call-dependent default filled
     /// in, backend restrictions checked ("auto" replaced by its rule).
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved>;
+    /// The kernel it runs (`kernel::Kernel`, in the method's module).
+    type Kernel;
+    /// The kernel of the config; of a resolved one, what ran (an unresolved
+    /// one's call-dependent options take their CPU defaults).
+    fn kernel(&self) -> Self::Kernel;
     /// Occluder layers of a resolved config (0 for methods that read none).
     fn passes(&self) -> u32 {
         0

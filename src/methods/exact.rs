@@ -25,6 +25,7 @@ use super::config::{
 };
 use super::engine::{visibilities_weighted, Engine};
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::kernel::Kernel;
 use super::keywords::{count, KeywordForm, Keywords};
 use super::probe::probed_visibilities;
 pub(crate) use super::shadow_rays::RAY_EPS;
@@ -41,6 +42,7 @@ use glam::Vec3;
 /// `engine` (`engine.rs`); with a `probe` (rays), receivers whose first
 /// `probe` samples (and their neighbours') agree keep that answer, the
 /// others are decided by `engine` (`probe.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Exact {
     pub samples: u32,
     pub probe: Option<u32>,
@@ -122,6 +124,19 @@ pub(crate) fn receiver_points(grid: &MapGrid, receiver: &[f32]) -> Vec<Option<Ve
             })
         })
         .collect()
+}
+
+/// `Exact` is its own kernel (`kernel.rs`): its options are all it runs.
+impl Kernel for Exact {
+    const READS: &'static [Input] = &[Input::OccluderTriangles];
+
+    fn rays(&self) -> Option<(u32, Option<u32>, Engine)> {
+        Some((self.samples, self.probe, self.engine))
+    }
+
+    fn implementation(&self) -> Box<dyn ShadowMethod> {
+        Box::new(*self)
+    }
 }
 
 impl ShadowMethod for Exact {
@@ -287,6 +302,16 @@ impl MethodSpec for ExactConfig {
         ExactConfig::new(o.samples, None, None)
     }
     type Resolved = Self;
+    type Kernel = Exact;
+    fn kernel(&self) -> Exact {
+        Exact {
+            samples: self.samples,
+            probe: self.probe,
+            // Resolved configs hold their engine; an unresolved one's is
+            // the CPU's in the light view (the eye view resolves first).
+            engine: self.engine_for(Backend::Cpu, false),
+        }
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         if ctx.depth_layers.is_some() {
             return Err(Error::invalid(
@@ -321,7 +346,8 @@ impl MethodSpec for ExactConfig {
             config: "Exact",
             summary: "Ray casting against the occluder triangles (a BVH) with stratified light \
                       samples, jittered deterministically: converges to the true visibility",
-            reads: vec![Input::OccluderTriangles],
+            // The kernel's (`Kernel::READS`).
+            reads: Exact::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
                 OptionInfo {

@@ -2,9 +2,11 @@
 //! one (`mod.rs`): the methods' modules read these types, the registry
 //! reads the methods.
 
+use super::ray_start::RayStart;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
-use glam::Vec3;
+use crate::geom::plane_gradient::Plane;
+use glam::{DVec3, Vec3};
 
 /// What every method reads: the light-view maps and the light's size.
 #[derive(Debug, Clone)]
@@ -32,6 +34,24 @@ pub struct LightPoint {
     pub z: f32,
 }
 
+/// The eye view's visible points as a map method shades them (`eye/maps.rs`).
+#[derive(Debug, Clone, Copy)]
+pub struct EyePoints<'a> {
+    /// The points moved by the biases, kernel light space.
+    pub points: &'a [LightPoint],
+    /// Each point's tangent plane on the grid (for the kernels that test
+    /// their texels on it, `Kernel::TESTS_PLANES`); else empty.
+    pub planes: &'a [Plane],
+    /// Where the shaded image is asked for under an area light, each
+    /// point's surface and ray start (the unbiased point): the kernel's
+    /// weighted visibility is taken from it, where it has one.
+    pub starts: Option<&'a [Option<RayStart>]>,
+    /// Every mesh, in kernel light space: the vertices and the faces
+    /// (every mesh is an occluder in the eye view).
+    pub verts: &'a [DVec3],
+    pub faces: &'a [[u32; 3]],
+}
+
 /// The interface of a shadow method.
 pub trait ShadowMethod: Sync {
     /// Visibility of the light (fraction of its area) for every receiver texel;
@@ -39,6 +59,17 @@ pub trait ShadowMethod: Sync {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32>;
     /// Visibility at receiver points given in light space.
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32>;
+    /// Visibility at the eye view's points, and beside it their weighted
+    /// visibility (the share of each point's irradiance its visible part
+    /// of the light gives) where the kernel has one and `eye.starts` asks
+    /// for it. By default the plain visibility at the points, no weights.
+    fn visibility_eye(
+        &self,
+        inputs: &ShadowInputs,
+        eye: &EyePoints,
+    ) -> (Vec<f32>, Option<Vec<f32>>) {
+        (self.visibility_points(inputs, eye.points), None)
+    }
 }
 
 /// What a method reads besides the receivers: the pipeline builds only that.

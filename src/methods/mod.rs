@@ -6,13 +6,16 @@
 //! table of methods, options, defaults and limits.
 //!
 //! The registry is this file: a method is declared here once, by its module
-//! (`pub mod`), its line of `methods!` (which makes its `MethodConfig`
-//! variant, its name, the dispatch and its capabilities row:
-//! `registry.rs`) and its kernel (`Method`: the options that change what it
-//! computes, what it reads, its implementation). The configs' modules never
-//! name this file, so the registry imports them without a circle. A line
-//! marked `keywords` is a config with a keyword form (`keywords.rs`): the
-//! bindings make its Python class from it, with no code of the method's.
+//! (`pub mod`) and its line of `methods!`, `Variant(Config => Kernel)`,
+//! which makes its `MethodConfig` variant, its name, the dispatch and its
+//! capabilities row, and its `Method` variant, the kernel a resolved config
+//! runs (`registry.rs`). Both types are the method module's own: the config
+//! implements `config::MethodSpec`, the kernel `kernel::Kernel` (what it
+//! reads, how its work is bounded, its implementation). The configs' and
+//! kernels' modules never name this file, so the registry imports them
+//! without a circle. A line marked `keywords` is a config with a keyword
+//! form (`keywords.rs`): the bindings make its Python class from it, with
+//! no code of the method's.
 
 pub mod auto_config;
 pub mod bitmask;
@@ -26,6 +29,7 @@ pub mod exact;
 pub(crate) mod gather;
 pub mod info;
 pub mod inputs;
+pub mod kernel;
 pub mod keywords;
 pub(crate) mod masks;
 pub(crate) mod packet;
@@ -35,6 +39,7 @@ pub mod pcss;
 mod pcss_weighted;
 pub mod point_light;
 pub(crate) mod probe;
+pub(crate) mod ray_start;
 mod registry;
 pub mod shadow_mapping;
 pub(crate) mod shadow_rays;
@@ -44,218 +49,41 @@ pub mod ssm;
 pub mod target;
 
 pub use auto_config::{auto_rule, AutoConfig};
-pub use bitmask::{BitmaskConfig, HIERARCHY_DEFAULT_BITMASK};
-pub use exact::ExactConfig;
-pub use gather::Hierarchy;
-pub use inputs::{is_receiver, Input, LightPoint, ShadowInputs, ShadowMethod};
-pub use pcss::PcssConfig;
+pub use bitmask::{BitmaskConfig, BitmaskKernel, HIERARCHY_DEFAULT_BITMASK};
+pub use exact::{Exact, ExactConfig};
+pub use gather::{Hierarchy, HIERARCHY};
+pub use inputs::{is_receiver, EyePoints, Input, LightPoint, ShadowInputs, ShadowMethod};
+pub use kernel::Kernel;
+pub use pcss::{Pcss, PcssConfig};
 pub use shadow_mapping::config::ShadowMappingConfig;
 pub use smoothies::config::SmoothiesConfig;
-pub use ssm::{SsmConfig, HIERARCHY_DEFAULT_SSM};
+pub use smoothies::method::SmoothiesKernel;
+pub use ssm::{SsmConfig, SsmKernel, HIERARCHY_DEFAULT_SSM};
 
 registry::methods! {
-    Ssm(SsmConfig, keywords),
-    Bitmask(BitmaskConfig, keywords),
-    Exact(ExactConfig, keywords),
+    Ssm(SsmConfig => ssm::SsmKernel, keywords),
+    Bitmask(BitmaskConfig => bitmask::BitmaskKernel, keywords),
+    Exact(ExactConfig => exact::Exact, keywords),
     /// Fernando 2005's percentage-closer soft shadows (`pcss.rs`).
-    Pcss(PcssConfig, keywords),
+    Pcss(PcssConfig => pcss::Pcss, keywords),
     /// Chan & Durand 2003's smoothies (`smoothies/`).
-    Smoothies(SmoothiesConfig, keywords),
+    Smoothies(SmoothiesConfig => smoothies::method::SmoothiesKernel, keywords),
     /// Scherzer 2005's practical shadow mapping (hard shadows from the
     /// light's centre or direction; `shadow_mapping/`).
-    ShadowMapping(ShadowMappingConfig),
+    ShadowMapping(ShadowMappingConfig => ShadowMappingConfig),
     Auto(AutoConfig),
 }
 
-/// A method's kernel, with the options that change what it computes (the
-/// options that change what it reads, layers and their resolution, are the
-/// pipeline's: see `config.rs`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Soft shadow maps, Atty et al. 2005, as published (additive
-    /// micro-patches); `hierarchy` reads coarser occluder texels where the
-    /// penumbra is wide (off by default: the paper has none).
-    Ssm {
-        hierarchy: bool,
-        precision: ssm::Precision,
-    },
-    /// Ray casting against the occluder triangles with stratified light
-    /// samples; with a probe, only where a first pass is unsure (`probe.rs`).
-    Exact {
-        samples: u32,
-        probe: Option<u32>,
-        engine: engine::Engine,
-    },
-    /// Micro-patches marking light samples in a bit mask per receiver (OR);
-    /// `hierarchy` as for Ssm (on by default); `gaps` how neighbouring
-    /// micro-patches meet (closed: connected micro-quads).
-    Bitmask {
-        samples: u32,
-        hierarchy: bool,
-        gaps: bitmask::Gaps,
-    },
-    /// Scherzer 2005's shadow mapping: its own map and depth test
-    /// (`shadow_mapping/`, the eye view only).
-    ShadowMapping(shadow_mapping::config::ShadowMappingConfig),
-    /// Smoothies (Chan & Durand 2003) from the front layer and the
-    /// occluders' silhouette.
-    Smoothies {
-        width: shadow_mapping::config::Real,
-        falloff: smoothies::Falloff,
-    },
-    /// PCSS (Fernando 2005) on the front layer.
-    Pcss { max_taps: u32 },
-}
-
-/// The level choice of the occluder hierarchy: a texel may back-project onto
-/// at most this fraction of the light's width, seen from the receiver it is
-/// nearest to. Measured with bitmask (256 samples, two passes) against
-/// Mitsuba on the study's scenes (`benchmarks/bench_hierarchy.py`): at 3% the
-/// error moves by at most 0.001 while 512² maps take 1.2-4.4x less time; at
-/// 6% the error grew by up to 0.003 (a coarse texel misplaces an edge by half
-/// its back-projection), at 12.5% by up to 0.02.
-pub const HIERARCHY: Hierarchy = Hierarchy {
-    max_texel_on_light: 0.03,
-};
-
 impl Method {
-    /// The name a user passes as `method=`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Ssm { .. } => "ssm",
-            Method::Exact { .. } => "exact",
-            Method::Bitmask { .. } => "bitmask",
-            Method::ShadowMapping(_) => "shadow_mapping",
-            Method::Smoothies { .. } => "smoothies",
-            Method::Pcss { .. } => "pcss",
-        }
-    }
-
-    /// What the method reads of the occluders.
-    pub fn reads(&self) -> &'static [Input] {
-        match self {
-            Method::Ssm { .. } | Method::Bitmask { .. } | Method::Pcss { .. } => {
-                &[Input::OccluderLayers]
-            }
-            Method::Exact { .. } => &[Input::OccluderTriangles],
-            Method::ShadowMapping(_) => &[Input::SceneTriangles, Input::Camera],
-            Method::Smoothies { .. } => &[Input::OccluderLayers, Input::OccluderTriangles],
-        }
-    }
-
     /// Whether the method only traces triangles (reads no occluder maps):
     /// `exact`.
     pub fn traces(&self) -> bool {
         self.reads_input(Input::OccluderTriangles) && !self.reads_input(Input::OccluderLayers)
     }
 
-    /// Whether the kernel tests its texels on each receiver point's tangent
-    /// plane where the eye view gives one (`geom/plane_gradient.rs`): the
-    /// methods whose taps reach texels beside the point's, PCSS's boxes and
-    /// the smoothies' tent. (The gather methods bound a receiver by its
-    /// tangent plane already, and ShadowMapping has its own.)
-    pub fn tests_planes(&self) -> bool {
-        matches!(self, Method::Pcss { .. } | Method::Smoothies { .. })
-    }
-
     /// Whether the method reads `input`.
     pub fn reads_input(&self, input: Input) -> bool {
         self.reads().contains(&input)
-    }
-
-    /// f32 maps the kernel keeps per occluder layer, each of the occluder
-    /// grid's size: for the gather methods the 1/depth copy and its nearest
-    /// and farthest bounds (`gather/hierarchy.rs`), and for connected
-    /// micro-quads their corner 1/depths and those corners' reciprocals
-    /// from the receivers' common plane (4 each); a hierarchy's levels add
-    /// a third. Other methods: one map.
-    pub fn kernel_maps_per_layer(&self) -> usize {
-        let (maps, hierarchy): (usize, bool) = match *self {
-            Method::Bitmask {
-                hierarchy, gaps, ..
-            } => (
-                if gaps == bitmask::Gaps::Closed { 11 } else { 3 },
-                hierarchy,
-            ),
-            Method::Ssm { hierarchy, .. } => (3, hierarchy),
-            _ => (1, false),
-        };
-        if hierarchy {
-            maps + maps.div_ceil(3)
-        } else {
-            maps
-        }
-    }
-
-    pub fn implementation(&self) -> Box<dyn ShadowMethod> {
-        match *self {
-            Method::Ssm {
-                hierarchy,
-                precision,
-            } => Box::new(ssm::Ssm {
-                hierarchy: hierarchy.then_some(HIERARCHY),
-                precision,
-            }),
-            Method::Exact {
-                samples,
-                probe,
-                engine,
-            } => Box::new(exact::Exact {
-                samples,
-                probe,
-                engine,
-            }),
-            Method::Bitmask {
-                samples,
-                hierarchy,
-                gaps,
-            } => Box::new(bitmask::Bitmask::new(
-                samples,
-                gaps,
-                hierarchy.then_some(HIERARCHY),
-            )),
-            // Refused outside the eye view when the config is resolved.
-            Method::ShadowMapping(_) => unreachable!("ShadowMapping has no light-view kernel"),
-            Method::Smoothies { width, falloff } => Box::new(smoothies::Smoothies {
-                width: width.0,
-                falloff,
-            }),
-            Method::Pcss { max_taps } => Box::new(pcss::Pcss { max_taps }),
-        }
-    }
-}
-
-impl MethodConfig {
-    /// The kernel of a config; resolve it first for the backend's defaults.
-    pub fn kernel(&self) -> Method {
-        match *self {
-            MethodConfig::Ssm(c) => Method::Ssm {
-                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
-                precision: c.precision,
-            },
-            MethodConfig::Bitmask(c) => Method::Bitmask {
-                samples: c.samples,
-                hierarchy: c.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
-                gaps: c.gaps,
-            },
-            MethodConfig::Exact(c) => Method::Exact {
-                samples: c.samples,
-                probe: c.probe,
-                // Resolved configs hold their engine; an unresolved one's is
-                // the CPU's in the light view (the eye view resolves first).
-                engine: c.engine_for(crate::backend::Backend::Cpu, false),
-            },
-            MethodConfig::Pcss(c) => Method::Pcss {
-                max_taps: c.max_taps,
-            },
-            MethodConfig::Smoothies(c) => Method::Smoothies {
-                width: c.width,
-                falloff: c.falloff,
-            },
-            MethodConfig::ShadowMapping(c) => Method::ShadowMapping(c),
-            // What "auto" always resolves to.
-            MethodConfig::Auto(a) => MethodConfig::Ssm(a.given).kernel(),
-        }
     }
 }
 
@@ -271,9 +99,9 @@ pub fn shade_map(method: Method, inputs: &ShadowInputs) -> Vec<f32> {
 
 /// Runs `shade` (a call of `method` on `inputs`: `shade_map`, `shade_points`
 /// or a method's own entry), refusing a call whose cost grows with a
-/// parameter rather than with what the answer needs: PCSS's texel reads,
-/// bounded before any receiver is shaded (`Pcss::check_reads`); the gather
-/// kernels' visits, counted as they are made (`gather::meter::metered`) and
+/// parameter rather than with what the answer needs: a bound known before
+/// any receiver is shaded (`Kernel::check_cost`: PCSS's texel reads); the
+/// gather kernels' visits (`Kernel::visit_cost`), counted as they are made (`gather::meter::metered`) and
 /// stopped past `gather::work::visit_limit` (a number a receiver),
 /// naming `arg`, the option whose size drove them. `pts`: the receivers,
 /// or None for the receiver map's texels.
@@ -284,25 +112,23 @@ pub fn bounded<T>(
     arg: &str,
     shade: impl FnOnce() -> T,
 ) -> crate::error::Result<T> {
-    match method {
-        Method::Pcss { max_taps } => {
-            pcss::Pcss { max_taps }.check_reads(inputs, pts)?;
-            Ok(shade())
-        }
-        Method::Ssm { .. } | Method::Bitmask { .. } if !inputs.light_shape.is_point() => {
-            let receivers = match pts {
-                Some(p) => p.iter().filter(|p| is_receiver(p.z)).count(),
-                None => inputs.receiver.iter().filter(|&&z| is_receiver(z)).count(),
-            };
-            let limit = gather::work::visit_limit(method, receivers);
-            let (v, visits) = gather::meter::metered(limit, shade);
-            if visits > limit {
-                return Err(gather::work::refusal(method, inputs, receivers, arg));
-            }
-            Ok(v)
-        }
-        _ => Ok(shade()),
+    let Some(cost) = method
+        .visit_cost()
+        .filter(|_| !inputs.light_shape.is_point())
+    else {
+        method.check_cost(inputs, pts)?;
+        return Ok(shade());
+    };
+    let receivers = match pts {
+        Some(p) => p.iter().filter(|p| is_receiver(p.z)).count(),
+        None => inputs.receiver.iter().filter(|&&z| is_receiver(z)).count(),
+    };
+    let limit = gather::work::visit_limit(cost, receivers);
+    let (v, visits) = gather::meter::metered(limit, shade);
+    if visits > limit {
+        return Err(gather::work::refusal(cost, inputs, receivers, arg));
     }
+    Ok(v)
 }
 
 /// Visibility at receiver points, as `shade_map`.
@@ -314,40 +140,15 @@ pub fn shade_points(method: Method, inputs: &ShadowInputs, pts: &[LightPoint]) -
     }
 }
 
-/// `shade_points`, and beside it each point's weighted visibility seen from
-/// `receivers` (its surface point and tangent plane: the share of its
-/// irradiance each part of the light gives, `RayOrigin::weight`) where the
-/// method has them (`bitmask`'s samples: `bitmask/weighted.rs`; `ssm`'s
-/// micro-patches: `ssm/weighted.rs`); `None` for the others.
-pub(crate) fn shade_points_weighted<R: shadow_rays::RayOrigin + Copy + Sync>(
+/// The eye view's points shaded by `method` (`ShadowMethod::visibility_eye`):
+/// the visibility, and the weighted one where the kernel has it and `eye`
+/// asks for it.
+pub fn shade_eye(
     method: Method,
     inputs: &ShadowInputs,
-    pts: &[LightPoint],
-    receivers: &[Option<R>],
+    eye: &EyePoints,
 ) -> (Vec<f32>, Option<Vec<f32>>) {
-    match method {
-        Method::Bitmask {
-            samples,
-            hierarchy,
-            gaps,
-        } if !inputs.light_shape.is_point() => {
-            let m = bitmask::Bitmask::new(samples, gaps, hierarchy.then_some(HIERARCHY));
-            let (v, w) = m.weighted_points(inputs, pts, receivers);
-            (v, Some(w))
-        }
-        Method::Ssm {
-            hierarchy,
-            precision,
-        } if !inputs.light_shape.is_point() => {
-            let m = ssm::Ssm {
-                hierarchy: hierarchy.then_some(HIERARCHY),
-                precision,
-            };
-            let (v, w) = m.weighted_points(inputs, pts, receivers);
-            (v, Some(w))
-        }
-        _ => (shade_points(method, inputs, pts), None),
-    }
+    method.implementation().visibility_eye(inputs, eye)
 }
 
 /// A texel-aligned square plate over a parallel floor, whose visibility has

@@ -104,7 +104,7 @@ use super::pcf_disk;
 use super::pcss_weighted::{weighted_visibility, Weigh};
 use super::shadow_rays::RayOrigin;
 use super::Input;
-use super::{point_light, LightPoint, ShadowInputs, ShadowMethod};
+use super::{point_light, EyePoints, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
@@ -293,6 +293,22 @@ impl<'a> Kernel<'a> {
     }
 }
 
+/// `Pcss` is its own kernel (`kernel.rs`; `Kernel` here is the taps'
+/// own, below).
+impl super::kernel::Kernel for Pcss {
+    const READS: &'static [Input] = &[Input::OccluderLayers];
+    const TESTS_PLANES: bool = true;
+
+    /// Its texel reads, bounded before any receiver is shaded.
+    fn check_cost(&self, inputs: &ShadowInputs, points: Option<&[LightPoint]>) -> Result<()> {
+        self.check_reads(inputs, points)
+    }
+
+    fn implementation(&self) -> Box<dyn ShadowMethod> {
+        Box::new(*self)
+    }
+}
+
 impl ShadowMethod for Pcss {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         if inputs.light_shape.is_point() {
@@ -319,6 +335,25 @@ impl ShadowMethod for Pcss {
     fn visibility_points(&self, inputs: &ShadowInputs, points: &[LightPoint]) -> Vec<f32> {
         // No planes: every texel tested at the point's own depth.
         self.visibility_on_planes(inputs, points, &[])
+    }
+
+    /// On each point's tangent plane; weighted where asked for
+    /// (`pcss_weighted.rs`).
+    fn visibility_eye(
+        &self,
+        inputs: &ShadowInputs,
+        eye: &EyePoints,
+    ) -> (Vec<f32>, Option<Vec<f32>>) {
+        match eye.starts {
+            Some(r) => {
+                let (v, w) = self.weighted_on_planes(inputs, eye.points, eye.planes, r);
+                (v, Some(w))
+            }
+            None => (
+                self.visibility_on_planes(inputs, eye.points, eye.planes),
+                None,
+            ),
+        }
     }
 }
 
@@ -508,6 +543,12 @@ impl MethodSpec for PcssConfig {
         PcssConfig::new(None, o.occluder_resolution)
     }
     type Resolved = Self;
+    type Kernel = Pcss;
+    fn kernel(&self) -> Pcss {
+        Pcss {
+            max_taps: self.max_taps,
+        }
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         // From depth maps: the front layer the user gave.
         let (_, occ, _) = resolve_maps(
@@ -540,7 +581,8 @@ impl MethodSpec for PcssConfig {
             summary: "Percentage-closer soft shadows (Fernando 2005), what real-time engines \
                       ship: a blocker search on the shadow map, the penumbra estimated from the \
                       mean blocker depth, a box PCF of that width",
-            reads: vec![Input::OccluderLayers],
+            // The kernel's (`Kernel::READS`).
+            reads: <Pcss as super::kernel::Kernel>::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
                 OptionInfo {

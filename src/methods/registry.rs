@@ -2,7 +2,10 @@
 //! the `MethodConfig` enum (a variant per config), `METHOD_NAMES`,
 //! `From<Config> for MethodConfig`, the string form's lookup and the
 //! dispatch of every `MethodConfig` method to the config's `MethodSpec`
-//! (its own module), the capabilities rows in the list's order.
+//! (its own module), the capabilities rows in the list's order; and for a
+//! line that names its kernel (`Config => Kernel`), the `Method` variant
+//! that a resolved config runs and the dispatch of every `Method` method
+//! to the kernel's `Kernel` (`kernel.rs`, also in the method's module).
 //!
 //! A macro, not a trait object: `MethodConfig` stays a plain `Copy + Eq +
 //! Hash` enum that the stages match on. It names only `config.rs` (the
@@ -13,12 +16,116 @@
 /// The registry of method configs; see the module's doc. Invoked once, in
 /// `mod.rs`, where each method's module is declared.
 macro_rules! methods {
-    ($($(#[doc = $doc:literal])* $variant:ident($config:ty $(, $kw:ident)?),)*) => {
+    ($($(#[doc = $doc:literal])* $variant:ident($config:ty $(=> $kernel:ty)? $(, $kw:ident)?),)*) => {
         /// What a user picks: a method with its options, or `Auto` (see
         /// `AutoConfig`).
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub enum MethodConfig {
             $($(#[doc = $doc])* $variant($config),)*
+        }
+
+        /// A method's kernel, with the options that change what it computes
+        /// (the options that change what it reads, layers and their
+        /// resolution, are the pipeline's: see `config.rs`): what a
+        /// resolved config runs (`MethodConfig::kernel`), one variant per
+        /// registry line that names a kernel. The stages ask it through
+        /// `Kernel` (`kernel.rs`), never by its variant.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Method {
+            $($(
+                #[doc = concat!("The kernel of `", stringify!($config), "`.")]
+                $variant($kernel),
+            )?)*
+        }
+
+        $($(impl From<$kernel> for Method {
+            fn from(k: $kernel) -> Self {
+                Method::$variant(k)
+            }
+        })?)*
+
+        impl Method {
+            /// The name a user passes as `method=`.
+            pub fn name(&self) -> &'static str {
+                use $crate::methods::config::MethodSpec;
+                match self {
+                    $($(Method::$variant(k) => {
+                        let _: &$kernel = k;
+                        <$config as MethodSpec>::NAME
+                    })?)*
+                }
+            }
+
+            /// What the method reads of the occluders (`Kernel::READS`).
+            pub fn reads(&self) -> &'static [$crate::methods::Input] {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(_) => <$kernel as Kernel>::READS,)?)*
+                }
+            }
+
+            /// `Kernel::TESTS_PLANES`.
+            pub fn tests_planes(&self) -> bool {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(_) => <$kernel as Kernel>::TESTS_PLANES,)?)*
+                }
+            }
+
+            /// `Kernel::READS_EVERY_FACE`.
+            pub fn reads_every_face(&self) -> bool {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(_) => <$kernel as Kernel>::READS_EVERY_FACE,)?)*
+                }
+            }
+
+            /// f32 maps the kernel keeps per occluder layer
+            /// (`Kernel::maps_per_layer`).
+            pub fn kernel_maps_per_layer(&self) -> usize {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(k) => <$kernel as Kernel>::maps_per_layer(k),)?)*
+                }
+            }
+
+            /// `Kernel::visit_cost`: `None` for a kernel that does not
+            /// gather over the occluder maps.
+            pub fn visit_cost(&self) -> Option<f64> {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(k) => <$kernel as Kernel>::visit_cost(k),)?)*
+                }
+            }
+
+            /// `Kernel::rays`: the light samples a receiver, the probe's
+            /// and the engine of a ray-traced kernel.
+            pub fn rays(&self) -> Option<(u32, Option<u32>, $crate::methods::engine::Engine)> {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(k) => <$kernel as Kernel>::rays(k),)?)*
+                }
+            }
+
+            /// `Kernel::check_cost`.
+            pub fn check_cost(
+                &self,
+                inputs: &$crate::methods::ShadowInputs,
+                points: Option<&[$crate::methods::LightPoint]>,
+            ) -> $crate::error::Result<()> {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(k) => <$kernel as Kernel>::check_cost(k, inputs, points),)?)*
+                }
+            }
+
+            /// The CPU implementation.
+            pub fn implementation(&self) -> Box<dyn $crate::methods::ShadowMethod> {
+                use $crate::methods::kernel::Kernel;
+                match self {
+                    $($(Method::$variant(k) => <$kernel as Kernel>::implementation(k),)?)*
+                }
+            }
         }
 
         /// The method names a user can pass as `method=`, in the table's order.
@@ -155,6 +262,15 @@ macro_rules! methods {
                     .collect()
             }
 
+            /// The kernel of a config (`MethodSpec::kernel`); resolve it
+            /// first for the backend's defaults.
+            pub fn kernel(&self) -> Method {
+                use $crate::methods::config::MethodSpec;
+                match self {
+                    $(MethodConfig::$variant(c) => Method::from(c.kernel()),)*
+                }
+            }
+
             /// Every method's row of `capabilities()`, in the registry's order.
             pub fn infos() -> Vec<$crate::methods::info::MethodInfo> {
                 use $crate::methods::config::MethodSpec;
@@ -184,7 +300,7 @@ mod tests {
     use crate::backend::Backend;
     use crate::error::Error;
     use crate::methods::config::{CallContext, LooseOptions};
-    use crate::methods::{bitmask, AutoConfig, BitmaskConfig, Method, MethodConfig};
+    use crate::methods::{bitmask, AutoConfig, BitmaskConfig, BitmaskKernel, Method, MethodConfig};
 
     fn cpu(resolution: (usize, usize)) -> CallContext {
         CallContext {
@@ -213,11 +329,11 @@ mod tests {
         let b = MethodConfig::Bitmask(BitmaskConfig::default());
         assert_eq!(
             b.resolve(&cpu((8, 8))).unwrap().kernel(),
-            Method::Bitmask {
+            Method::Bitmask(BitmaskKernel {
                 samples: 256,
                 hierarchy: true,
                 gaps: bitmask::Gaps::Closed,
-            }
+            })
         );
         let gpu = CallContext {
             backend: Backend::Gpu,
@@ -225,11 +341,11 @@ mod tests {
         };
         assert_eq!(
             b.resolve(&gpu).unwrap().kernel(),
-            Method::Bitmask {
+            Method::Bitmask(BitmaskKernel {
                 samples: 256,
                 hierarchy: false,
                 gaps: bitmask::Gaps::Closed,
-            }
+            })
         );
         let depth = CallContext {
             depth_layers: Some((1, (4, 4))),

@@ -73,6 +73,7 @@ pub fn from_depth_with<S: LightViewStages>(
 mod tests {
     use super::*;
     use crate::error::Error;
+    use crate::methods::{BitmaskKernel, SsmKernel};
 
     /// `from_depth` on the CPU, the maps given one by one.
     fn cpu(
@@ -117,15 +118,15 @@ mod tests {
         // without it the SSM loses these shadows at 2^60 and 2^-70.
         let n = 24;
         let grid = MapGrid::new(n, n, [0.5, 0.5]).unwrap();
-        let ssm = Method::Ssm {
+        let ssm = Method::Ssm(SsmKernel {
             hierarchy: false,
             precision: Default::default(),
-        };
-        let bitmask = Method::Bitmask {
+        });
+        let bitmask = Method::Bitmask(BitmaskKernel {
             samples: 64,
             hierarchy: true,
             gaps: Default::default(),
-        };
+        });
         for method in [ssm, bitmask] {
             let (f, r) = plate_maps(n, 1.0);
             let (base, _) = cpu(
@@ -162,10 +163,10 @@ mod tests {
             &f,
             None,
             &r,
-            Method::Ssm {
+            Method::Ssm(SsmKernel {
                 hierarchy: false,
                 precision: Default::default(),
-            },
+            }),
         )
         .unwrap_err();
         assert!(matches!(err, Error::InvalidArgument { ref arg, .. } if arg == "light_size"));

@@ -70,12 +70,8 @@ pub fn from_scene(
         let tris: Vec<[Vec3; 3]> = light_space_triangles(&occ_ls, scene.faces);
         sw.lap("triangles");
         let starts = rays::ray_starts(light, unit, &points, &normals);
-        let (samples, probe, engine) = match s.method {
-            crate::methods::Method::Exact {
-                samples,
-                probe,
-                engine,
-            } if !light_shape.is_point() => (samples, probe, engine),
+        let (samples, probe, engine) = match s.method.rays() {
+            Some(rays) if !light_shape.is_point() => rays,
             _ => (1, None, crate::methods::engine::Engine::Rays),
         };
         // Keys are texel indices, as the light-view exact's.

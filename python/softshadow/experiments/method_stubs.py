@@ -1,7 +1,9 @@
 """Writes the keyword method configs' classes in ``python/softshadow/_core.pyi``
 from the core's capabilities table, so the stub cannot drift from what the
 core accepts (stubtest then checks the names against the compiled module;
-this checks the types and defaults too).
+this checks the types and defaults too); and the lists a new method would
+otherwise be added to by hand: the module's ``__all__`` and ``_Ran``, the
+configs a result says ran.
 
     python -m softshadow.experiments.method_stubs [--check] [--stub python/softshadow/_core.pyi]
 
@@ -11,8 +13,11 @@ subclasses: one per method whose config has a keyword form) sit between
 order. Each option is a keyword-only argument that may be ``None`` (the
 default: the core resolves it), and a property of the type the core gives
 back: ``None`` only where the table's default is resolved when the config
-runs. ``--check`` exits 1 when the block differs from what this would
-write, and writes nothing.
+runs. ``__all__`` (between ``# <all:start>`` and ``# <all:end>``) is the
+compiled module's; ``_Ran`` (between ``# <ran:start>`` and ``# <ran:end>``)
+every method's config class but ``Auto``'s, which never runs (it resolves
+to another), in the table's order. ``--check`` exits 1 when a block differs
+from what this would write, and writes nothing.
 """
 
 from __future__ import annotations
@@ -26,6 +31,8 @@ from .. import _core, methods
 from .markers import replace_between
 
 START, END = "# <keyword-configs:start>", "# <keyword-configs:end>"
+ALL = "# <all:start>", "# <all:end>"
+RAN = "# <ran:start>", "# <ran:end>"
 # Run from the checkout's root.
 STUB = Path("python") / "softshadow" / "_core.pyi"
 
@@ -78,10 +85,23 @@ def block() -> str:
     return "\n\n".join(_class(i) for i in infos)
 
 
+def all_names() -> str:
+    """The stub's ``__all__``: the compiled module's."""
+    return "__all__ = [\n" + "".join(f'    "{n}",\n' for n in _core.__all__) + "]"
+
+
+def ran() -> str:
+    """The stub's ``_Ran``: every method's config class but ``Auto``'s."""
+    names = [i.config.__name__ for i in methods.capabilities().values() if i.config is not methods.Auto]
+    return "_Ran = " + " | ".join(names)
+
+
 def render(stub: str) -> str:
-    """``stub`` with its keyword-configs block replaced by the current one."""
+    """``stub`` with its generated blocks replaced by the current ones."""
     note = "# Written by python -m softshadow.experiments.method_stubs: do not edit."
-    return replace_between(stub, START, END, f"{note}\n\n{block()}\n", str(STUB))
+    stub = replace_between(stub, START, END, f"{note}\n\n{block()}\n", str(STUB))
+    stub = replace_between(stub, *ALL, all_names(), str(STUB))
+    return replace_between(stub, *RAN, ran(), str(STUB))
 
 
 def main(argv: list[str] | None = None) -> int:

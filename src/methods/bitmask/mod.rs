@@ -29,13 +29,16 @@ use super::config::{
     resolve_maps, CallContext, LooseOptions, MethodSpec, DEFAULT_PASSES, DEFAULT_SAMPLES,
     PRECISION_SSM_ONLY,
 };
+use super::gather::work::{BITMASK_1024_VISIT, BITMASK_VISIT};
 use super::gather::{
-    self, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
+    self, maps_with_levels, Accumulator, Group, Hierarchy, Lanes, RowLanes, HIERARCHY, LANES,
+    ROWS_PER_GROUP, TILE_W,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::kernel::Kernel;
 use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
 use super::Input;
-use super::{LightPoint, ShadowInputs, ShadowMethod};
+use super::{point_light, EyePoints, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light_shape::LightShape;
@@ -702,6 +705,42 @@ macro_rules! with_kernel {
 // definition on).
 mod weighted;
 
+/// The kernel a resolved `BitmaskConfig` runs (`kernel.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BitmaskKernel {
+    pub samples: u32,
+    pub hierarchy: bool,
+    pub gaps: Gaps,
+}
+
+impl Kernel for BitmaskKernel {
+    const READS: &'static [Input] = &[Input::OccluderLayers];
+
+    /// The gather maps of `ssm` (3), or for connected micro-quads their
+    /// corner 1/depths and those corners' reciprocals from the receivers'
+    /// common plane (4 each) besides, and the hierarchy's levels.
+    fn maps_per_layer(&self) -> usize {
+        let maps = if self.gaps == Gaps::Closed { 11 } else { 3 };
+        maps_with_levels(maps, self.hierarchy)
+    }
+
+    fn visit_cost(&self) -> Option<f64> {
+        Some(if self.samples > 256 {
+            BITMASK_1024_VISIT
+        } else {
+            BITMASK_VISIT
+        })
+    }
+
+    fn implementation(&self) -> Box<dyn ShadowMethod> {
+        Box::new(Bitmask::new(
+            self.samples,
+            self.gaps,
+            self.hierarchy.then_some(HIERARCHY),
+        ))
+    }
+}
+
 impl ShadowMethod for Bitmask {
     fn visibility_map(&self, inputs: &ShadowInputs) -> Vec<f32> {
         if let Some(disk) = self.on(inputs) {
@@ -720,6 +759,25 @@ impl ShadowMethod for Bitmask {
             points,
             self.hierarchy
         ))
+    }
+
+    /// Weighted where asked for (`weighted.rs`); under a point light, its
+    /// hard shadow (`point_light.rs`).
+    fn visibility_eye(
+        &self,
+        inputs: &ShadowInputs,
+        eye: &EyePoints,
+    ) -> (Vec<f32>, Option<Vec<f32>>) {
+        if inputs.light_shape.is_point() {
+            return (point_light::visibility_points(inputs, eye.points), None);
+        }
+        match eye.starts {
+            Some(r) => {
+                let (v, w) = self.weighted_points(inputs, eye.points, r);
+                (v, Some(w))
+            }
+            None => (self.visibility_points(inputs, eye.points), None),
+        }
     }
 }
 
@@ -830,6 +888,14 @@ impl MethodSpec for BitmaskConfig {
         )
     }
     type Resolved = Self;
+    type Kernel = BitmaskKernel;
+    fn kernel(&self) -> BitmaskKernel {
+        BitmaskKernel {
+            samples: self.samples,
+            hierarchy: self.hierarchy.unwrap_or(HIERARCHY_DEFAULT_BITMASK),
+            gaps: self.gaps,
+        }
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         let c = self;
         let (passes, occ, hierarchy) = resolve_maps(
@@ -860,7 +926,8 @@ impl MethodSpec for BitmaskConfig {
             config: "Bitmask",
             summary: "The same micro-patches marking the light samples they hide in a bit mask \
                       per receiver, merged by OR (Schwarz & Stamminger 2007)",
-            reads: vec![Input::OccluderLayers],
+            // The kernel's (`Kernel::READS`).
+            reads: BitmaskKernel::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
                 OptionInfo {

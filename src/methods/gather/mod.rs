@@ -29,7 +29,7 @@ mod simd;
 mod traverse;
 pub mod work;
 
-pub use hierarchy::Hierarchy;
+pub use hierarchy::{maps_with_levels, Hierarchy, HIERARCHY};
 use kernel::Kernel;
 pub(in crate::methods) use kernel::{
     max, min, Accumulator, Group, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,

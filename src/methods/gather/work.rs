@@ -19,10 +19,10 @@ use crate::error::Error;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::methods::inputs::MIN_RECEIVERS;
-use crate::methods::{LightPoint, Method, ShadowInputs};
+use crate::methods::{LightPoint, ShadowInputs};
 use rayon::prelude::*;
 
-/// The weighted visits (`visit_cost`) a fitted map is planned under
+/// The weighted visits (`BITMASK_VISIT`) a fitted map is planned under
 /// (`eye::gather_budget`). Set above every case of the as-built scenes
 /// (calibration and held out, 640x480, `ssm` and `bitmask`: up to about
 /// 4.7e8, inferred from the coarsening an earlier 4e7 made), which it
@@ -35,7 +35,7 @@ use rayon::prelude::*;
 /// makes (`meter::Meter`, `VISITS_PER_RECEIVER`), not this prediction.
 pub const PLANNED_VISITS: f64 = 6e8;
 
-/// The weighted visits (`visit_cost`) a call may make per receiver it
+/// The weighted visits (`BITMASK_VISIT`) a call may make per receiver it
 /// shades, counted as they are made (`meter::Meter`), with at least
 /// `inputs::MIN_RECEIVERS` receivers' worth: so the work a call may do grows
 /// with its answer, not with a map size or sample count that no answer
@@ -53,20 +53,19 @@ pub const PLANNED_VISITS: f64 = 6e8;
 /// the pixels, run again on a coarser one (`pipeline::eye_view`).
 pub const VISITS_PER_RECEIVER: f64 = 250.0;
 
-/// What one visit of `method`'s kernel costs, in visits of `bitmask` with
-/// 256 samples, as measured per counted visit (benchmarks/calibrate_visits.py,
-/// on 2 cores): about 200 ns for the bitmask's masks of up to 256 samples
-/// (16 and 64 samples cost as much: the kernel's masks are 256 bits), 1.5-2.3
-/// us for 1 024 samples' (counted as 12), 7-11 ns for `ssm`'s sums: counted
-/// as an eighth, above what it measures, which is the weight the plan's
-/// threshold (`PLANNED_VISITS`) was judged with on the as-built scenes.
-pub fn visit_cost(method: Method) -> f64 {
-    match method {
-        Method::Bitmask { samples, .. } if samples > 256 => 12.0,
-        Method::Bitmask { .. } => 1.0,
-        _ => 0.125,
-    }
-}
+/// What one visit of a gather kernel costs (`Kernel::visit_cost`), in
+/// visits of `bitmask` with 256 samples, as measured per counted visit
+/// (benchmarks/calibrate_visits.py, on 2 cores): about 200 ns for the
+/// bitmask's masks of up to 256 samples (16 and 64 samples cost as much:
+/// the kernel's masks are 256 bits), 1.5-2.3 us for 1 024 samples' (counted
+/// as 12), 7-11 ns for `ssm`'s sums: counted as an eighth, above what it
+/// measures, which is the weight the plan's threshold (`PLANNED_VISITS`)
+/// was judged with on the as-built scenes.
+pub const BITMASK_VISIT: f64 = 1.0;
+/// `BITMASK_VISIT` for more than 256 samples.
+pub const BITMASK_1024_VISIT: f64 = 12.0;
+/// `BITMASK_VISIT` for `ssm`'s sums.
+pub const SSM_VISIT: f64 = 0.125;
 
 /// The bound on the kernel's visits for receivers `points` (kernel light
 /// space: tangents and depth; an empty point has z = inf) on occluder grid
@@ -103,17 +102,18 @@ pub fn visits_bound(
     per_receiver / LANES as f64 * layers as f64
 }
 
-/// The raw visits (`meter::Meter`) a call of `method` shading `receivers`
-/// receivers may make: `VISITS_PER_RECEIVER` each (at least
-/// `MIN_RECEIVERS`), weighted by `visit_cost`.
-pub fn visit_limit(method: Method, receivers: usize) -> u64 {
-    (VISITS_PER_RECEIVER * receivers.max(MIN_RECEIVERS) as f64 / visit_cost(method)) as u64
+/// The raw visits (`meter::Meter`) a call of a kernel whose visit costs
+/// `cost` (`Kernel::visit_cost`) shading `receivers` receivers may make:
+/// `VISITS_PER_RECEIVER` each (at least `MIN_RECEIVERS`), weighted by the
+/// cost.
+pub fn visit_limit(cost: f64, receivers: usize) -> u64 {
+    (VISITS_PER_RECEIVER * receivers.max(MIN_RECEIVERS) as f64 / cost) as u64
 }
 
-/// The refusal of a call of `method` whose kernel passed `visit_limit`,
-/// naming `arg`, the option whose map size drove the visits.
-pub fn refusal(method: Method, inputs: &ShadowInputs, receivers: usize, arg: &str) -> Error {
-    let limit = visit_limit(method, receivers) as f64;
+/// The refusal of a call of a kernel of visit cost `cost` that passed
+/// `visit_limit`, naming `arg`, the option whose map size drove the visits.
+pub fn refusal(cost: f64, inputs: &ShadowInputs, receivers: usize, arg: &str) -> Error {
+    let limit = visit_limit(cost, receivers) as f64;
     let og = &inputs.occluder_grid;
     Error::too_costly(
         arg,

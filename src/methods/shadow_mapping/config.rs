@@ -9,8 +9,9 @@ use crate::error::{Error, Result};
 use crate::geom::shadow_projection::ViewVector;
 use crate::methods::config::{CallContext, LooseOptions, MethodSpec};
 use crate::methods::info::{Kind, MethodInfo, OptionInfo, Value};
+use crate::methods::kernel::Kernel;
 use crate::methods::shadow_mapping::raster::{Distribution, Offset};
-use crate::methods::Input;
+use crate::methods::{Input, ShadowMethod};
 
 /// A finite f64 that configs can hash and compare (by its bits).
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
@@ -319,6 +320,17 @@ impl ShadowMappingConfig {
     }
 }
 
+/// Its own eye-view stage (`eye::shadow_mapping`): it reads every mesh and
+/// the camera, and has no light-view kernel.
+impl Kernel for ShadowMappingConfig {
+    const READS: &'static [Input] = &[Input::SceneTriangles, Input::Camera];
+
+    fn implementation(&self) -> Box<dyn ShadowMethod> {
+        // Refused outside the eye view when the config is resolved.
+        unreachable!("ShadowMapping has no light-view kernel")
+    }
+}
+
 impl MethodSpec for ShadowMappingConfig {
     const NAME: &'static str = "shadow_mapping";
     fn from_loose(o: &LooseOptions, refuse: &dyn Fn(&str, &str) -> Error) -> Result<Self> {
@@ -331,6 +343,11 @@ impl MethodSpec for ShadowMappingConfig {
         Ok(ShadowMappingConfig::default())
     }
     type Resolved = Self;
+    /// Its options are its kernel's.
+    type Kernel = Self;
+    fn kernel(&self) -> Self {
+        *self
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         if !ctx.eye {
             return Err(Error::invalid(
@@ -364,7 +381,8 @@ impl MethodSpec for ShadowMappingConfig {
                   2005's practical extensions: bias methods, PCF, focusing on the \
                   intersection body, LiSPSM (directional lights), the eye-space blur; hard \
                   shadows, the eye view only",
-            reads: vec![Input::SceneTriangles, Input::Camera],
+            // The kernel's (`Kernel::READS`).
+            reads: <Self as Kernel>::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
             OptionInfo {

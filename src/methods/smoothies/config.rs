@@ -2,15 +2,16 @@
 //! its checks, defaults and its `MethodSpec` (name, string form,
 //! resolution, capabilities row).
 
+use super::method::SmoothiesKernel;
 use super::Falloff;
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::methods::config::{check_resolution, occluder_resolution_option};
 use crate::methods::config::{CallContext, LooseOptions, MethodSpec};
 use crate::methods::info::{Kind, MethodInfo, OptionInfo, Value};
+use crate::methods::kernel::Kernel;
 use crate::methods::keywords::{resolution, KeywordForm, Keywords};
 use crate::methods::shadow_mapping::config::{check_real, Real};
-use crate::methods::Input;
 
 /// Smoothies (Chan & Durand 2003): fake soft shadows from the hard shadow
 /// map and silhouette-edge smoothies.
@@ -126,6 +127,13 @@ impl MethodSpec for SmoothiesConfig {
         SmoothiesConfig::new(None, None, None, o.occluder_resolution)
     }
     type Resolved = Self;
+    type Kernel = SmoothiesKernel;
+    fn kernel(&self) -> SmoothiesKernel {
+        SmoothiesKernel {
+            width: self.width,
+            falloff: self.falloff,
+        }
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         if ctx.depth_layers.is_some() {
             return Err(Error::invalid(
@@ -154,7 +162,8 @@ impl MethodSpec for SmoothiesConfig {
             summary: "Fake soft shadows (Chan & Durand 2003): the hard shadow map's umbra and an \
                       outer penumbra from smoothies on the occluders' silhouette edges, their \
                       alpha remapped by 1/(1 - b/r)",
-            reads: vec![Input::OccluderLayers, Input::OccluderTriangles],
+            // The kernel's (`Kernel::READS`).
+            reads: SmoothiesKernel::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
                 OptionInfo {

@@ -25,14 +25,17 @@ use super::config::{
     check_passes, check_resolution, hierarchy_option, occluder_resolution_option, passes_option,
     resolve_maps, CallContext, LooseOptions, MethodSpec, DEFAULT_PASSES, SAMPLES_ONLY,
 };
+use super::gather::work::SSM_VISIT;
 use super::gather::{
-    self, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
+    self, maps_with_levels, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, HIERARCHY,
+    LANES, ROWS_PER_GROUP, TILE_W,
 };
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
+use super::kernel::Kernel;
 use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
 use super::shadow_rays::RayOrigin;
 use super::Input;
-use super::{LightPoint, ShadowInputs, ShadowMethod};
+use super::{point_light, EyePoints, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light_shape::disk_clip::rect_overlap_f32;
@@ -456,6 +459,54 @@ impl ShadowMethod for Ssm {
             &a, inputs, points, h
         ))
     }
+
+    /// Weighted where asked for (`weighted.rs`); under a point light, its
+    /// hard shadow (`point_light.rs`).
+    fn visibility_eye(
+        &self,
+        inputs: &ShadowInputs,
+        eye: &EyePoints,
+    ) -> (Vec<f32>, Option<Vec<f32>>) {
+        if inputs.light_shape.is_point() {
+            return (point_light::visibility_points(inputs, eye.points), None);
+        }
+        match eye.starts {
+            Some(r) => {
+                let (v, w) = self.weighted_points(inputs, eye.points, r);
+                (v, Some(w))
+            }
+            None => (self.visibility_points(inputs, eye.points), None),
+        }
+    }
+}
+
+/// The kernel a resolved `SsmConfig` runs (`kernel.rs`): the hierarchy on
+/// or off, and the sums' precision.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SsmKernel {
+    pub hierarchy: bool,
+    pub precision: Precision,
+}
+
+impl Kernel for SsmKernel {
+    const READS: &'static [Input] = &[Input::OccluderLayers];
+
+    /// The 1/depth copy and its nearest and farthest bounds
+    /// (`gather/hierarchy.rs`), and the hierarchy's levels.
+    fn maps_per_layer(&self) -> usize {
+        maps_with_levels(3, self.hierarchy)
+    }
+
+    fn visit_cost(&self) -> Option<f64> {
+        Some(SSM_VISIT)
+    }
+
+    fn implementation(&self) -> Box<dyn ShadowMethod> {
+        Box::new(Ssm {
+            hierarchy: self.hierarchy.then_some(HIERARCHY),
+            precision: self.precision,
+        })
+    }
 }
 
 /// Whether the hierarchy is on by default on the CPU: off for the paper's
@@ -538,6 +589,13 @@ impl MethodSpec for SsmConfig {
         SsmConfig::new(o.passes, o.occluder_resolution, o.hierarchy, o.precision)
     }
     type Resolved = Self;
+    type Kernel = SsmKernel;
+    fn kernel(&self) -> SsmKernel {
+        SsmKernel {
+            hierarchy: self.hierarchy.unwrap_or(HIERARCHY_DEFAULT_SSM),
+            precision: self.precision,
+        }
+    }
     fn resolve(self, ctx: &CallContext) -> Result<Self::Resolved> {
         let c = self;
         if ctx.backend == Backend::Gpu && c.precision != Precision::F32 {
@@ -576,7 +634,8 @@ impl MethodSpec for SsmConfig {
             config: "Ssm",
             summary: "Soft shadow maps (Atty et al. 2005) as published: micro-patches of the \
                       occluder maps back-projected onto the light, their occlusions summed",
-            reads: vec![Input::OccluderLayers],
+            // The kernel's (`Kernel::READS`).
+            reads: SsmKernel::READS.to_vec(),
             backends: Backend::built().to_vec(),
             options: vec![
                 passes_option(),
