@@ -516,7 +516,10 @@ fn no_stage_names_a_method() {
             named.push((name(&m), found));
         }
     }
-    assert!(named.is_empty(), "files naming a method's kernel: {named:?}");
+    assert!(
+        named.is_empty(),
+        "files naming a method's kernel: {named:?}"
+    );
     assert_eq!(
         method_variants("let a = Method::Exact(k); ShadowMethod::f(); Method::kernel;"),
         ["Exact"]

@@ -50,8 +50,24 @@ def light_space(v: np.ndarray, light: ss.RectLight) -> np.ndarray:
     return np.stack(cols, axis=-1)
 
 
+#: bench_scale.py's single meshes (125 000 and 2 000 000 triangles of a
+#: bumpy sphere over a box floor), seen from their light.
+SCALE = ["mesh_125k", "mesh_2m"]
+
+
+def scene_of(name: str) -> tuple[ss.Scene, ss.RectLight]:
+    """A study scene, or one of bench_scale.py's single meshes."""
+    if name not in SCALE:
+        return scenes.SCENES[name]()
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import bench_scale
+
+    scene, light, _ = bench_scale.scenes(1.0)[name]((64, 48))
+    return scene, light
+
+
 def export(name: str, resolution: int, samples: int) -> None:
-    scene, light = scenes.SCENES[name]()
+    scene, light = scene_of(name)
     sm = ss.soft_shadow_map(scene, light, resolution=resolution, method=ss.Exact(samples=samples))
     tris = np.concatenate([light_space(v, light)[f] for v, f in scene.occluders]).astype(np.float32)
     out = OUT / name

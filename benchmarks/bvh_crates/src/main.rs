@@ -5,10 +5,15 @@
 //!
 //!     cargo run --release --manifest-path benchmarks/bvh_crates/Cargo.toml \
 //!         [-- --repeats 3] [--scenes bunny_floating torus] [--no-write] [--no-mitsuba]
+//!
+//! `--scenes` also takes bench_scale.py's `mesh_125k` and `mesh_2m` (the
+//! doc's table is written for the study's scenes).
 
 mod contenders;
+mod wide8;
 
 use contenders::{Contender, Obvhs, Ours, Parry, SvenstaroBvh};
+use wide8::Wide8;
 use glam::Vec3;
 use rayon::prelude::*;
 use softshadow::geom::light_shape::LightShape;
@@ -319,8 +324,9 @@ fn bench(
     let exact = Exact {
         samples: s.samples,
         probe: None,
+        engine: softshadow::methods::engine::Engine::Rays,
     };
-    let (mut ours, mut sven, mut ob, mut parry) = (None, None, None, None);
+    let (mut ours, mut sven, mut ob, mut parry, mut w8) = (None, None, None, None, None);
     let (mut map, mut pts) = ([vec![], vec![]], [vec![], vec![]]);
     let (mut v_map, mut v_pts) = (vec![], vec![]);
     // The cores every all-core run had (CPU time over wall time).
@@ -331,6 +337,17 @@ fn bench(
         run::<SvenstaroBvh>(s, &rays, pools, &mut sven, &mut cores);
         run::<Obvhs>(s, &rays, pools, &mut ob, &mut cores);
         run::<Parry>(s, &rays, pools, &mut parry, &mut cores);
+        run::<Wide8>(s, &rays, pools, &mut w8, &mut cores);
+        {
+            use std::sync::atomic::Ordering::Relaxed;
+            let r = wide8::RAYS.swap(0, Relaxed) as f64;
+            eprintln!(
+                "wide8 stats: {:.2} nodes, {:.2} leaf blocks a ray, {:.1}% blocked",
+                wide8::NODES.swap(0, Relaxed) as f64 / r,
+                wide8::BLOCKS.swap(0, Relaxed) as f64 / r,
+                100.0 * wide8::HITS.swap(0, Relaxed) as f64 / r
+            );
+        }
         for (p, pool) in pools.iter().enumerate() {
             let (t, got) = pool.install(|| timed(|| v_map = exact.visibility_map(&inputs)));
             map[p].push(t);
@@ -403,6 +420,7 @@ fn bench(
         row(name_of::<Obvhs>(), &ob.unwrap()),
         row(name_of::<Parry>(), &parry.unwrap()),
         row(name_of::<Ours>(), &ours),
+        row(name_of::<Wide8>(), &w8.unwrap()),
         method(
             "ours, the method (`Exact::visibility_points`, rows of 8)",
             &pts,
