@@ -11,7 +11,7 @@
 //!   backend choice) -> planner (`auto`) -> orchestrators (`pipeline`: one
 //!   per view) -> stages (`eye`, `light_view`, `frame`, and their GPU
 //!   twins `gpu`) ->
-//!   methods and raster -> geometry (`geom`) -> leaves (`error`, `memory`,
+//!   methods and raster -> the ray engine (`trace`) -> geometry (`geom`) -> leaves (`error`, `memory`,
 //!   `threads`, `timing`, `backend`, `block_cache`). A file may import its
 //!   own layer or lower ones, never a higher one (so `gpu/` never imports
 //!   an orchestrator).
@@ -23,12 +23,13 @@ use std::path::{Path, PathBuf};
 /// The layer of a module path (its first segment); higher runs first.
 fn layer(module: &[String]) -> usize {
     match module.first().map(String::as_str) {
-        Some("python") => 8,
-        Some("api") => 7,
-        Some("auto") => 6,
-        Some("pipeline") => 5,
-        Some("eye" | "frame" | "light_view" | "gpu") => 4,
-        Some("methods" | "raster") => 3,
+        Some("python") => 9,
+        Some("api") => 8,
+        Some("auto") => 7,
+        Some("pipeline") => 6,
+        Some("eye" | "frame" | "light_view" | "gpu") => 5,
+        Some("methods" | "raster") => 4,
+        Some("trace") => 3,
         Some("geom") => 2,
         Some(
             "error" | "error_estimate" | "memory" | "threads" | "timing" | "backend"

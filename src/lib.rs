@@ -60,6 +60,7 @@ pub mod pipeline;
 pub mod raster;
 pub mod threads;
 pub mod timing;
+pub mod trace;
 
 #[cfg(test)]
 mod layering;

@@ -8,7 +8,7 @@ main.rs runs this after tracing SCENE (it reads the scene from
 .cache/bvh_crates/SCENE/ and ours.bits, which main.rs writes: one bit a ray,
 set where ``Bvh::occluded`` found it blocked). The rays are rebuilt here bit
 for bit: ``exact``'s jitter hash and light point (``Sampling::point`` in
-src/methods/shadow_rays.rs) replayed in uint64 and float32 numpy, one f32
+src/trace/shadow_rays.rs) replayed in uint64 and float32 numpy, one f32
 operation at a time as the Rust does them. Embree takes no t_min, so the
 segment t in (T0, T1) of o + t d becomes the ray from o + T0 d along d with
 maxt = T1 - T0 (the same segment up to one rounding of the origin).

@@ -37,7 +37,7 @@ use crate::error_estimate::{
 use crate::geom::sphere_light::SphereLight;
 use crate::methods::engine::Engine;
 use crate::methods::exact::Bvh;
-use crate::methods::shadow_rays::RayOrigin;
+use crate::trace::shadow_rays::RayOrigin;
 
 /// Light samples of the exact rays at each drawn pixel, for a result of
 /// the map methods: their stratified error (about 1/256 in a penumbra) is

@@ -29,7 +29,7 @@ use super::gbuffer::SceneTriangles;
 use crate::error::Result;
 use crate::geom::light_space::Light;
 use crate::geom::mesh::MeshRef;
-use crate::methods::bvh::Topology;
+use crate::trace::bvh::Topology;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};

@@ -16,8 +16,8 @@ use crate::geom::light_space::LightSpace;
 use crate::methods::engine::{visibilities_weighted, Engine};
 use crate::methods::exact::Bvh;
 use crate::methods::probe::probed_visibilities_weighted;
-pub use crate::methods::ray_start::RayStart;
-use crate::methods::shadow_rays::{tile_order, Jitter, Sampling};
+pub use crate::trace::ray_start::RayStart;
+use crate::trace::shadow_rays::{tile_order, Jitter, Sampling};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 

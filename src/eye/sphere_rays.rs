@@ -24,7 +24,7 @@
 //!
 //! The rays go through the BVH of every triangle, relative to the sphere's
 //! centre in f32, eight neighbouring pixels' rays of one stratum together
-//! (`methods/packet.rs`, with its shadow cache; no shafts: each pixel's rays
+//! (`trace/packet.rs`, with its shadow cache; no shafts: each pixel's rays
 //! go to its own cap). Each ray is the segment from its origin to its point
 //! on the sphere, t in (0, 1 − RAY_EPS).
 
@@ -33,10 +33,10 @@ use super::rays::{tiled, RAY_EPSILON};
 use crate::geom::light_shape::sphere::CapFrame;
 use crate::geom::light_shape::{disk, sphere, LightShape};
 use crate::geom::sphere_light::SphereLight;
-use crate::methods::bvh::Bvh;
-use crate::methods::packet::{Mask, Rays, LANES};
 use crate::methods::probe::certain_by_pixel;
-use crate::methods::shadow_rays::{Jitter, Sampling, RAY_EPS};
+use crate::trace::bvh::Bvh;
+use crate::trace::packet::{Mask, Rays, LANES};
+use crate::trace::shadow_rays::{Jitter, Sampling, RAY_EPS};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 

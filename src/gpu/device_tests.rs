@@ -1975,7 +1975,7 @@ mod pcss {
             return;
         }
         use crate::methods::plate_case::WeightedPlate;
-        use crate::methods::shadow_rays::RayOrigin;
+        use crate::trace::shadow_rays::RayOrigin;
         for (shape, taps) in [
             (LightShape::rect([1.0, 1.0]), 64),
             (LightShape::rect([1.0, 1.0]), 5),

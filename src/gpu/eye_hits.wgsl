@@ -2,7 +2,7 @@
 // pixel-centre ray o + t d (o = 0: the eye; d = gbuffer::pixel_ray, uploaded
 // in f32) through the camera BVH (gbuffer::camera_bvh, built on the CPU) and
 // writes the BVH slot of the nearest triangle crossed with t in (0, best),
-// or NONE. The CPU twin is Bvh::nearest in src/methods/bvh.rs, followed
+// or NONE. The CPU twin is Bvh::nearest in src/trace/bvh.rs, followed
 // here operation for operation: the same slab test (glam 0.34's Vec3
 // min/max and min/max_element, which pick the second operand unless the
 // first compares strictly smaller/larger, then f32::max(0) and

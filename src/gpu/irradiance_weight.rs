@@ -2,10 +2,10 @@
 //! (`irradiance_weight.wgsl`, which gather.rs and pcss.rs prepend with
 //! `concat!` to the modules whose weighted resolves read it), and the
 //! per-point struct they read. The CPU twins are `SurfacePoint::weight` and
-//! `shadow_rays::light_weight` (methods/shadow_rays.rs).
+//! `shadow_rays::light_weight` (trace/shadow_rays.rs).
 
 use crate::eye::rays::RayStart;
-use crate::methods::shadow_rays::SurfacePoint;
+use crate::trace::shadow_rays::SurfacePoint;
 use bytemuck::{Pod, Zeroable};
 
 /// `WeighPoint` of irradiance_weight.wgsl: a point's surface point (kernel

@@ -34,8 +34,8 @@ use crate::frame::{light_space_triangles, FramedScene};
 use crate::geom::light_shape::LightShape;
 use crate::methods::config::MAX_SAMPLES;
 use crate::methods::exact::{receiver_points, Bvh, RAY_EPS};
-use crate::methods::shadow_rays::{tile_order, visibilities, Jitter, RayOrigin, Sampling};
 use crate::methods::Method;
+use crate::trace::shadow_rays::{tile_order, visibilities, Jitter, RayOrigin, Sampling};
 
 /// Light samples of the exact rays at each drawn texel, for a result of
 /// the map methods: four times the eye view's `REFERENCE_SAMPLES`. At 256

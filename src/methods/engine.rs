@@ -4,8 +4,8 @@
 //! (`masks/`). Both answer the same question on the same shared pattern and
 //! differ only on rays that graze an edge (`masks/tests.rs`).
 
-use super::bvh::Bvh;
-use super::shadow_rays::{visibilities_weighted as traced, Jitter, RayOrigin, Sampling};
+use crate::trace::bvh::Bvh;
+use crate::trace::shadow_rays::{visibilities_weighted as traced, Jitter, RayOrigin, Sampling};
 
 /// The way `exact`'s samples are decided.
 /// An unset `engine` is resolved by `ExactConfig::engine_for`.

@@ -18,7 +18,6 @@
 //! Its config (`ExactConfig`, its checks and its `MethodSpec`: name, string
 //! form, resolution, capabilities row) is at the end of this file.
 
-pub use super::bvh::Bvh;
 use super::config::{
     check_passes, CallContext, LooseOptions, MethodSpec, DEFAULT_SAMPLES, MAX_SAMPLES,
     PRECISION_SSM_ONLY,
@@ -28,14 +27,15 @@ use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::kernel::Kernel;
 use super::keywords::{count, KeywordForm, Keywords};
 use super::probe::probed_visibilities;
-pub(crate) use super::shadow_rays::RAY_EPS;
-use super::shadow_rays::{tile_order, Jitter, Sampling};
 use super::Input;
 use super::{LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightSamples;
+pub use crate::trace::bvh::Bvh;
+pub(crate) use crate::trace::shadow_rays::RAY_EPS;
+use crate::trace::shadow_rays::{tile_order, Jitter, Sampling};
 use glam::Vec3;
 
 /// The exact method with `samples` light samples per receiver, decided by

@@ -2,10 +2,10 @@
 //! one (`mod.rs`): the methods' modules read these types, the registry
 //! reads the methods.
 
-use super::ray_start::RayStart;
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::plane_gradient::Plane;
+use crate::trace::ray_start::RayStart;
 use glam::{DVec3, Vec3};
 
 /// What every method reads: the light-view maps and the light's size.

@@ -19,9 +19,6 @@
 
 pub mod auto_config;
 pub mod bitmask;
-pub mod bvh;
-mod bvh_node;
-pub(crate) mod bvh_wide;
 pub mod capabilities;
 pub mod config;
 pub mod engine;
@@ -32,18 +29,14 @@ pub mod inputs;
 pub mod kernel;
 pub mod keywords;
 pub(crate) mod masks;
-pub(crate) mod packet;
 pub mod pcf;
 mod pcf_disk;
 pub mod pcss;
 mod pcss_weighted;
 pub mod point_light;
 pub(crate) mod probe;
-pub(crate) mod ray_start;
 mod registry;
 pub mod shadow_mapping;
-pub(crate) mod shadow_rays;
-pub(crate) mod shaft;
 pub mod smoothies;
 pub mod ssm;
 pub mod target;
@@ -155,10 +148,10 @@ pub fn shade_eye(
 /// a closed form: the methods' shared accuracy check.
 #[cfg(test)]
 pub(crate) mod plate_case {
-    use super::shadow_rays::{RayOrigin, SurfacePoint};
     use super::{LightPoint, ShadowInputs, ShadowMethod};
     use crate::geom::light::MapGrid;
     use crate::geom::light_shape::LightShape;
+    use crate::trace::shadow_rays::{RayOrigin, SurfacePoint};
     use glam::Vec3;
 
     /// Largest |V - V_exact| of `method` on an n x n map of a plate covering

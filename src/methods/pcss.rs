@@ -102,7 +102,6 @@ use super::keywords::{count, resolution, KeywordForm, Keywords};
 use super::pcf::{self, occludes, Axis, Border};
 use super::pcf_disk;
 use super::pcss_weighted::{weighted_visibility, Weigh};
-use super::shadow_rays::RayOrigin;
 use super::Input;
 use super::{point_light, EyePoints, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
@@ -110,6 +109,7 @@ use crate::error::{Error, Result};
 use crate::geom::light::MapGrid;
 use crate::geom::light_shape::LightShape;
 use crate::geom::plane_gradient::{plane_depth, split, Plane};
+use crate::trace::shadow_rays::RayOrigin;
 use rayon::prelude::*;
 
 /// The default taps per axis per stage (at most 16 x 16 taps per stage per

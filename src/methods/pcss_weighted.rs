@@ -33,8 +33,8 @@
 
 use super::pcf::Axis;
 use super::pcf_disk;
-use super::shadow_rays::{light_weight, SurfacePoint};
 use crate::geom::light_shape::disk::rect_overlap;
+use crate::trace::shadow_rays::{light_weight, SurfacePoint};
 use std::f64::consts::FRAC_1_PI;
 
 /// The receiver a weighted filter weighs for: its surface point and the

@@ -24,9 +24,9 @@
 //! pixels (texels) in a `width` x `height` image: the receivers of points
 //! the user gave have no neighbours and trace every sample.
 
-use super::bvh::Bvh;
 use super::engine::{visibilities_weighted, Engine};
-use super::shadow_rays::{visibilities, RayOrigin, Sampling};
+use crate::trace::bvh::Bvh;
+use crate::trace::shadow_rays::{visibilities, RayOrigin, Sampling};
 use rayon::prelude::*;
 
 /// The visibility of each receiver of `receivers`, as
@@ -139,7 +139,7 @@ fn certain<R: Sync>(
 mod tests {
     use super::*;
     use crate::geom::light_shape::LightShape;
-    use crate::methods::shadow_rays::Jitter;
+    use crate::trace::shadow_rays::Jitter;
     use glam::Vec3;
 
     /// A plate of half-width `h` at depth 1 over receivers at depth 2, a

@@ -82,7 +82,7 @@ pub fn from_scene(
             }
             all
         };
-        let order = crate::methods::shadow_rays::tile_order(grid.width, grid.height);
+        let order = crate::trace::shadow_rays::tile_order(grid.width, grid.height);
         let probe = probe.map(|samples| rays::Probe {
             samples,
             size: (grid.width, grid.height),

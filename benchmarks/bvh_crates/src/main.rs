@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// `exact`'s segment: t in (T0, T1) of receiver -> light point
-/// (`RAY_EPS` in src/methods/shadow_rays.rs, which is crate-private).
+/// (`RAY_EPS` in src/trace/shadow_rays.rs, which is crate-private).
 pub const T0: f32 = 1e-5;
 pub const T1: f32 = 1.0 - 1e-5;
 

@@ -21,8 +21,8 @@
 
 use super::{sample_ranks, Bitmask, Gaps, MaskKernel, Masks, Patterns};
 use crate::methods::gather::{self, Accumulator, Group, Lanes, RowLanes};
-use crate::methods::shadow_rays::RayOrigin;
 use crate::methods::{LightPoint, ShadowInputs};
+use crate::trace::shadow_rays::RayOrigin;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// A sample on the light: its bit in the masks and its point (x, y, 0) in

@@ -83,9 +83,9 @@ mod solids;
 #[cfg(test)]
 mod tests;
 
-use super::bvh::Bvh;
-use super::shadow_rays::{Jitter, Origins, RayOrigin, Sampling, SurfacePoint, RAY_EPS};
-use super::shaft::Shaft;
+use crate::trace::bvh::Bvh;
+use crate::trace::shadow_rays::{Jitter, Origins, RayOrigin, Sampling, SurfacePoint, RAY_EPS};
+use crate::trace::shaft::Shaft;
 use cells::Cells;
 use cover::{all_marked, beside, box_shadow, cell_range, cover, mark, shadow_box, HalfPlane};
 use pieces::Pieces;

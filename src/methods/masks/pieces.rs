@@ -34,7 +34,7 @@
 
 use super::cover::{Cover, HalfPlane, PLANES};
 use super::solids::{Planes, Solid};
-use crate::methods::bvh::Bvh;
+use crate::trace::bvh::Bvh;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 use std::sync::Arc;

@@ -4,9 +4,9 @@
 //! triangles touching the receivers and the light), one origin a receiver
 //! (the light view) and two (the eye view's above/below starts).
 
-use super::super::bvh::tests::rng;
-use super::super::bvh::Bvh;
-use super::super::shadow_rays::{
+use crate::trace::bvh::tests::rng;
+use crate::trace::bvh::Bvh;
+use crate::trace::shadow_rays::{
     tile_order, visibilities_weighted as traced, Jitter, Origins, RayOrigin, Sampling,
     SurfacePoint, RAY_EPS,
 };

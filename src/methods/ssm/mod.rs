@@ -33,13 +33,13 @@ use super::gather::{
 use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::kernel::Kernel;
 use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
-use super::shadow_rays::RayOrigin;
 use super::Input;
 use super::{point_light, EyePoints, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light_shape::disk_clip::rect_overlap_f32;
 use crate::geom::light_shape::LightShape;
+use crate::trace::shadow_rays::RayOrigin;
 
 /// The published method; with a hierarchy, occluder texels are read at a
 /// coarser level where the penumbra is wide (not in the paper).

@@ -28,8 +28,8 @@ use crate::geom::light_shape::LightShape;
 use crate::methods::gather::{
     self, max, min, Accumulator, Group, Hierarchy, Lanes, RowLanes, LANES,
 };
-use crate::methods::shadow_rays::{light_weight, RayOrigin};
 use crate::methods::{LightPoint, ShadowInputs};
+use crate::trace::shadow_rays::{light_weight, RayOrigin};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The centre of micro-patch [x0, x1] x (row)'s back-projection clipped to

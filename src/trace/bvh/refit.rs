@@ -18,7 +18,7 @@
 //! SAH build.
 
 use super::{bounds, edge_words, Bvh};
-use crate::methods::bvh_wide::refit_slots;
+use crate::trace::bvh_wide::refit_slots;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -111,7 +111,7 @@ impl Topology {
 mod tests {
     use super::super::tests::{random_tris as scene, rng};
     use super::*;
-    use crate::methods::packet::{Rays, ALL, LANES};
+    use crate::trace::packet::{Rays, ALL, LANES};
 
     /// The triangles in another frame: rotated about z and x, scaled,
     /// moved (what another light space does to them).
@@ -148,7 +148,7 @@ mod tests {
             assert_eq!((n.min, n.max), (lo, hi), "node {k}");
         }
         // The wide nodes are those of the refitted binary tree.
-        let (wide, _, _) = crate::methods::bvh_wide::collapse(&refit.nodes);
+        let (wide, _, _) = crate::trace::bvh_wide::collapse(&refit.nodes);
         for (a, b) in wide.iter().zip(&refit.wide) {
             assert_eq!((a.lo, a.hi, a.child), (b.lo, b.hi, b.child));
         }

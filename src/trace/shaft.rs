@@ -115,7 +115,7 @@ pub(crate) fn is_clear(bvh: &Bvh, olo: Vec3, ohi: Vec3, rect: [[f32; 2]; 2]) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::methods::bvh::tests::rng;
+    use crate::trace::bvh::tests::rng;
 
     /// Small triangles at depths 1.5 to 2.5 (the light is at 0).
     fn scene(n: usize, seed: u64) -> Vec<[Vec3; 3]> {

@@ -128,7 +128,7 @@ fn empty() -> Wide {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::methods::bvh::{tests::rng, Bvh};
+    use crate::trace::bvh::{tests::rng, Bvh};
     use glam::Vec3;
 
     #[test]

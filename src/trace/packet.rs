@@ -119,7 +119,7 @@ impl Bvh {
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::{Bvh, Mask, Rays};
-    use crate::methods::bvh_wide::Wide;
+    use crate::trace::bvh_wide::Wide;
     use core::arch::x86_64::*;
 
     struct Lanes {
@@ -282,7 +282,7 @@ mod avx2 {
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     use super::{Bvh, Mask, Rays};
-    use crate::methods::bvh_wide::Wide;
+    use crate::trace::bvh_wide::Wide;
     use core::arch::x86_64::*;
 
     /// The environment variable that, set to 1, keeps the AVX2 path on a
@@ -466,7 +466,7 @@ mod avx512 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::methods::bvh::tests::rng;
+    use crate::trace::bvh::tests::rng;
 
     #[test]
     fn every_lane_answers_as_its_ray_alone() {
