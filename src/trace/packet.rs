@@ -15,7 +15,8 @@
 //! less time a shadow ray than AVX2 (mesh_125k 23 -> 20-21 ns, mesh_2m
 //! 51-53 -> 50-51, many_meshes 28-29 -> 26, crowd 17 -> 16; two
 //! interleaved runs each, `SOFTSHADOW_NO_AVX512=1` for the AVX2 path),
-//! and 10-20% less again with the pairs built by one permute each.
+//! and 10-20% less again by the medians of four interleaved runs with the
+//! pairs built by one permute each (docs/methods/exact.md).
 //!
 //! Every lane gets the answer its ray alone gets from `Bvh::occluded`:
 //! the lane operations are the scalar ones, in the same order (glam's
@@ -338,7 +339,7 @@ mod avx512 {
         let slab = |x: usize| {
             // Slot a's value in the low eight lanes, b's in the high: one
             // permute of the slots' row (two broadcasts and an insert took
-            // 10-15% more time a ray on mesh_125k and crowd).
+            // more time a ray on mesh_125k and crowd: docs/methods/exact.md).
             let idx =
                 _mm512_inserti64x4::<1>(_mm512_set1_epi32(a as i32), _mm256_set1_epi32(b as i32));
             // SAFETY: each row is 4 f32s, an unaligned 128-bit load.

@@ -338,16 +338,6 @@ fn bench(
         run::<Obvhs>(s, &rays, pools, &mut ob, &mut cores);
         run::<Parry>(s, &rays, pools, &mut parry, &mut cores);
         run::<Wide8>(s, &rays, pools, &mut w8, &mut cores);
-        {
-            use std::sync::atomic::Ordering::Relaxed;
-            let r = wide8::RAYS.swap(0, Relaxed) as f64;
-            eprintln!(
-                "wide8 stats: {:.2} nodes, {:.2} leaf blocks a ray, {:.1}% blocked",
-                wide8::NODES.swap(0, Relaxed) as f64 / r,
-                wide8::BLOCKS.swap(0, Relaxed) as f64 / r,
-                100.0 * wide8::HITS.swap(0, Relaxed) as f64 / r
-            );
-        }
         for (p, pool) in pools.iter().enumerate() {
             let (t, got) = pool.install(|| timed(|| v_map = exact.visibility_map(&inputs)));
             map[p].push(t);

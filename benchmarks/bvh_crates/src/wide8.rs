@@ -23,11 +23,6 @@ const EMPTY: u32 = u32::MAX;
 const MAX_LEAF: usize = 4;
 const BINS: usize = 16;
 const ORDERED: bool = false;
-const STATS: bool = false;
-pub static NODES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-pub static BLOCKS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-pub static RAYS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-pub static HITS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// Eight child boxes by axis, then the children.
 #[derive(Clone, Copy)]
@@ -297,25 +292,12 @@ impl Wide8 {
         let mut stack = [0u32; 64];
         let mut sp = 0usize;
         let mut cur = self.root;
-        let (mut nn, mut nb) = (0u64, 0u64);
-        let flush = |nn: u64, nb: u64, hit: bool| {
-            if STATS {
-                use std::sync::atomic::Ordering::Relaxed;
-                NODES.fetch_add(nn, Relaxed);
-                BLOCKS.fetch_add(nb, Relaxed);
-                RAYS.fetch_add(1, Relaxed);
-                HITS.fetch_add(hit as u64, Relaxed);
-            }
-        };
         loop {
             if cur & LEAF != 0 {
-                nb += ((cur >> 27) & 0xF) as u64;
                 if self.leaf_hits(cur, o, d) {
-                    flush(nn, nb, true);
                     return true;
                 }
             } else {
-                nn += 1;
                 let n = self.nodes.get_unchecked(cur as usize);
                 let mut tn = t0;
                 let mut tf = t1;
@@ -360,7 +342,6 @@ impl Wide8 {
                 }
             }
             if sp == 0 {
-                flush(nn, nb, false);
                 return false;
             }
             sp -= 1;

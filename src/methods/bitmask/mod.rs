@@ -38,7 +38,7 @@ use super::info::{Kind, MethodInfo, OptionInfo, Value};
 use super::kernel::Kernel;
 use super::keywords::{count, flag, resolution, KeywordForm, Keywords};
 use super::Input;
-use super::{point_light, EyePoints, LightPoint, ShadowInputs, ShadowMethod};
+use super::{EyePoints, LightPoint, ShadowInputs, ShadowMethod};
 use crate::backend::Backend;
 use crate::error::{Error, Result};
 use crate::geom::light_shape::LightShape;
@@ -761,23 +761,18 @@ impl ShadowMethod for Bitmask {
         ))
     }
 
-    /// Weighted where asked for (`weighted.rs`); under a point light, its
-    /// hard shadow (`point_light.rs`).
+    /// Weighted where asked for (`weighted.rs`): `gather::visibility_eye`.
     fn visibility_eye(
         &self,
         inputs: &ShadowInputs,
         eye: &EyePoints,
     ) -> (Vec<f32>, Option<Vec<f32>>) {
-        if inputs.light_shape.is_point() {
-            return (point_light::visibility_points(inputs, eye.points), None);
-        }
-        match eye.starts {
-            Some(r) => {
-                let (v, w) = self.weighted_points(inputs, eye.points, r);
-                (v, Some(w))
-            }
-            None => (self.visibility_points(inputs, eye.points), None),
-        }
+        gather::visibility_eye(
+            inputs,
+            eye,
+            |p| self.visibility_points(inputs, p),
+            |p, r| self.weighted_points(inputs, p, r),
+        )
     }
 }
 

@@ -35,9 +35,35 @@ pub(in crate::methods) use kernel::{
     max, min, Accumulator, Group, Lanes, RowLanes, LANES, ROWS_PER_GROUP, TILE_W,
 };
 
-use super::{LightPoint, ShadowInputs};
+use super::{EyePoints, LightPoint, ShadowInputs};
 use crate::geom::light::MapGrid;
+use crate::trace::ray_start::RayStart;
 use rayon::prelude::*;
+
+/// The eye view's points shaded by a gather method (`ShadowMethod::
+/// visibility_eye` of `ssm` and `bitmask`): weighted by `weighted` where
+/// `eye` asks for it, plain by `plain` otherwise; under a point light, its
+/// hard shadow (`point_light.rs`), unweighted.
+pub(in crate::methods) fn visibility_eye(
+    inputs: &ShadowInputs,
+    eye: &EyePoints,
+    plain: impl FnOnce(&[LightPoint]) -> Vec<f32>,
+    weighted: impl FnOnce(&[LightPoint], &[Option<RayStart>]) -> (Vec<f32>, Vec<f32>),
+) -> (Vec<f32>, Option<Vec<f32>>) {
+    if inputs.light_shape.is_point() {
+        return (
+            crate::methods::point_light::visibility_points(inputs, eye.points),
+            None,
+        );
+    }
+    match eye.starts {
+        Some(r) => {
+            let (v, w) = weighted(eye.points, r);
+            (v, Some(w))
+        }
+        None => (plain(eye.points), None),
+    }
+}
 
 /// Shades every receiver texel of the output map with accumulator `a`.
 pub(super) fn visibility_map<A: Accumulator>(
