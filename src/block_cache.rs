@@ -17,22 +17,27 @@
 //! two, so at most 1/8 is wasted) and taken from the cache when a block of
 //! that class is there, else from the system allocator. A freed block of a
 //! class goes into the cache, which evicts its idle blocks round robin to
-//! hold at most SLOTS blocks and MAX_CACHED_BYTES in all. Every block of a
+//! hold at most SLOTS blocks and its limit in bytes in all: a sixteenth of
+//! the machine's memory, within [MIN_LIMIT, MAX_LIMIT]. (A fixed 256 MB
+//! was too small for a 2 000 000-triangle scene, whose call frees more than
+//! that: its BVH refit took 98 ms with it, 32 ms with 1 GiB, on 2 cores.) Every block of a
 //! cached layout is allocated at its class size, so a block's size is
 //! always known from its layout. Smaller requests go straight to the system.
-//! `SOFTSHADOW_BLOCK_CACHE=off`, read when the extension is imported, turns
-//! the cache off (`benchmarks/bench_alloc.py` measures both).
+//! `SOFTSHADOW_BLOCK_CACHE`, read when the extension is imported, turns the
+//! cache `off` (`benchmarks/bench_alloc.py` measures both) or sets its limit
+//! in bytes.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Requests smaller than this go straight to the system allocator.
 pub const MIN_CACHED: usize = 1 << 17;
 /// Largest alignment the cache serves (what Vec of any core type needs).
 pub const MAX_ALIGN: usize = 64;
-/// The most bytes idle in the cache.
-pub const MAX_CACHED_BYTES: usize = 256 << 20;
+/// The least and the most bytes the cache's default limit keeps idle.
+pub const MIN_LIMIT: usize = 256 << 20;
+pub const MAX_LIMIT: usize = 1 << 30;
 /// The most blocks idle in the cache.
 pub const SLOTS: usize = 128;
 const CLASSES_PER_OCTAVE: u32 = 8;
@@ -70,9 +75,12 @@ struct Cache {
 pub struct BlockCache {
     cache: Mutex<Cache>,
     enabled: AtomicBool,
+    /// The most bytes idle in the cache.
+    limit: AtomicUsize,
 }
 
-/// The environment variable that turns the cache off (`off`).
+/// The environment variable that turns the cache off (`off`) or sets its
+/// limit (a count of bytes).
 pub const TOGGLE_VAR: &str = "SOFTSHADOW_BLOCK_CACHE";
 
 impl Default for BlockCache {
@@ -90,6 +98,7 @@ impl BlockCache {
                 next_evict: 0,
             }),
             enabled: AtomicBool::new(true),
+            limit: AtomicUsize::new(MIN_LIMIT),
         }
     }
 
@@ -102,10 +111,32 @@ impl BlockCache {
         }
     }
 
-    /// Reads TOGGLE_VAR (call it outside any allocation: it allocates).
+    /// Reads TOGGLE_VAR and the machine's memory (call it outside any
+    /// allocation: it allocates).
     pub fn configure_from_env(&self) {
-        let off = std::env::var(TOGGLE_VAR).is_ok_and(|v| v.trim().eq_ignore_ascii_case("off"));
-        self.set_enabled(!off);
+        let var = std::env::var(TOGGLE_VAR).unwrap_or_default();
+        let var = var.trim();
+        let limit = var.parse::<usize>().ok().unwrap_or_else(|| {
+            let sixteenth = crate::memory::total_bytes().map_or(0, |b| (b / 16) as usize);
+            sixteenth.clamp(MIN_LIMIT, MAX_LIMIT)
+        });
+        self.set_limit(limit);
+        self.set_enabled(!var.eq_ignore_ascii_case("off"));
+    }
+
+    /// The most bytes idle in the cache from now on (idle blocks over it
+    /// are given back).
+    pub fn set_limit(&self, bytes: usize) {
+        self.limit.store(bytes, Ordering::Relaxed);
+        let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if c.bytes > bytes {
+            c.release();
+        }
+    }
+
+    #[inline]
+    fn limit(&self) -> usize {
+        self.limit.load(Ordering::Relaxed)
     }
 
     /// Whether blocks of `layout` go through the cache.
@@ -149,12 +180,13 @@ impl BlockCache {
     /// it fits; false for a block larger than the whole cache.
     fn keep(&self, ptr: *mut u8, class: Layout) -> bool {
         let size = class.size();
-        if !self.is_enabled() || size > MAX_CACHED_BYTES {
+        let limit = self.limit();
+        if !self.is_enabled() || size > limit {
             return false;
         }
         let mut c = self.cache.lock().unwrap_or_else(|e| e.into_inner());
         let mut free = c.slots.iter().position(|s| s.addr == 0);
-        while free.is_none() || c.bytes + size > MAX_CACHED_BYTES {
+        while free.is_none() || c.bytes + size > limit {
             let k = c.next_evict;
             c.next_evict = (k + 1) % SLOTS;
             let s = c.slots[k];
@@ -324,16 +356,16 @@ mod tests {
             let t = a.realloc(s, Layout::from_size_align(8 << 20, 8).unwrap(), 100);
             assert!(std::slice::from_raw_parts(t, 16).iter().all(|&b| b == 9));
             a.dealloc(t, Layout::from_size_align(100, 8).unwrap());
-            // Never more than MAX_CACHED_BYTES idle: the older block goes.
-            let big = Layout::from_size_align(MAX_CACHED_BYTES / 2 + 1, 8).unwrap();
+            // Never more than the limit idle: the older block goes.
+            let big = Layout::from_size_align(MIN_LIMIT / 2 + 1, 8).unwrap();
             let (x, y) = (a.alloc(big), a.alloc(big));
             a.dealloc(x, big);
             a.dealloc(y, big);
-            assert!(a.idle_bytes() <= MAX_CACHED_BYTES);
+            assert!(a.idle_bytes() <= MIN_LIMIT);
             assert_eq!(a.take(BlockCache::class_layout(big)), Some(y));
             // Never more than SLOTS blocks idle.
             let small = Layout::from_size_align(MIN_CACHED, 8).unwrap();
-            const { assert!((SLOTS + 3) * MIN_CACHED < MAX_CACHED_BYTES) };
+            const { assert!((SLOTS + 3) * MIN_CACHED < MIN_LIMIT) };
             let blocks: Vec<*mut u8> = (0..SLOTS + 3).map(|_| a.alloc(small)).collect();
             for &p in &blocks {
                 a.dealloc(p, small);
@@ -358,6 +390,26 @@ mod tests {
             a.dealloc(a.alloc(layout), layout);
             assert!(a.idle_bytes() > 0);
             a.set_enabled(false);
+            assert_eq!(a.idle_bytes(), 0);
+            a.dealloc(a.alloc(layout), layout);
+            assert_eq!(a.idle_bytes(), 0);
+        }
+    }
+
+    #[test]
+    fn the_limit_bounds_what_stays_idle() {
+        let a = BlockCache::new();
+        let layout = Layout::from_size_align(2 << 20, 8).unwrap();
+        unsafe {
+            a.set_limit(8 << 20);
+            let blocks: Vec<*mut u8> = (0..6).map(|_| a.alloc(layout)).collect();
+            for &p in &blocks {
+                a.dealloc(p, layout);
+            }
+            assert_eq!(a.idle_bytes(), 4 * class_size(2 << 20));
+            // A lower limit gives the idle blocks back; a block over it is
+            // never kept.
+            a.set_limit(1 << 20);
             assert_eq!(a.idle_bytes(), 0);
             a.dealloc(a.alloc(layout), layout);
             assert_eq!(a.idle_bytes(), 0);

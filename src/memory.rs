@@ -27,17 +27,27 @@ fn cap() -> Option<u64> {
 /// Bytes available for maps: the smaller of the cap and MemAvailable.
 pub fn available_bytes() -> Option<u64> {
     let cap = cap();
-    let free = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
-        s.lines()
-            .find(|l| l.starts_with("MemAvailable:"))
-            .and_then(|l| l.split_whitespace().nth(1))
-            .and_then(|kb| kb.parse::<u64>().ok())
-            .map(|kb| kb.saturating_mul(1024))
-    });
+    let free = meminfo_bytes("MemAvailable:");
     match (cap, free) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
     }
+}
+
+/// The machine's memory (`MemTotal` of /proc/meminfo), where it is known.
+pub fn total_bytes() -> Option<u64> {
+    meminfo_bytes("MemTotal:")
+}
+
+/// A /proc/meminfo field (`field` with its colon), in bytes.
+fn meminfo_bytes(field: &str) -> Option<u64> {
+    std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines()
+            .find(|l| l.starts_with(field))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|kb| kb.parse::<u64>().ok())
+            .map(|kb| kb.saturating_mul(1024))
+    })
 }
 
 /// Bytes of `maps` f32 maps of `texels` texels each.

@@ -131,6 +131,7 @@ pub fn render_with<S: EyeStages>(
         let method = resolve_at_camera(call, S::BACKEND)?;
         let mut sw = Stopwatch::new();
         let (scene, _) = scene_of(call)?;
+        sw.lap("scene");
         let g = first_hits(stages, call, &scene)?;
         sw.lap("first_hits");
         let mut visibility = stages.shadow_mapping(call, &cfg, &scene, &g, &mut sw)?;
@@ -170,6 +171,7 @@ pub fn render_with<S: EyeStages>(
     }
     let mut sw = Stopwatch::new();
     let (scene, _) = scene_of(call)?;
+    sw.lap("scene");
     let g = first_hits(stages, call, &scene)?;
     sw.lap("first_hits");
     let mut f = frame(call, &scene, &g)?;
@@ -277,6 +279,7 @@ fn render_sphere<S: EyeStages>(
         _ => {
             check_traced_fit(call)?;
             let (scene, _) = scene_of(call)?;
+            sw.lap("scene");
             let g = first_hits(stages, call, &scene)?;
             sw.lap("first_hits");
             let bvh = sphere_bvh(light, &scene.corners);
@@ -387,6 +390,7 @@ fn render_traced<S: EyeStages>(
         _ => {
             check_traced_fit(call)?;
             let (scene, found) = scene_of(call)?;
+            sw.lap("scene");
             let g = first_hits(stages, call, &scene)?;
             sw.lap("first_hits");
             let f = frame(call, &scene, &g)?;

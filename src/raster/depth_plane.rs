@@ -26,23 +26,22 @@ pub struct DepthPlane {
     pub gy: [f32; 3],
 }
 
-/// `v` rounded to LIMB_BITS significant bits (0 below f32's normal range,
-/// where a GPU may flush it).
+/// `v` rounded to LIMB_BITS significant bits, halves away from zero (0
+/// below f32's normal range, where a GPU may flush it).
 fn round_to_limb(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() || v.abs() < f32::MIN_POSITIVE as f64 {
         return 0.0;
     }
-    // floor(log2 |v|) read from the exponent field (v is normal here) and
-    // the power of two built from bits: the libm log2 and powi they replace
-    // were a quarter of the rasterizer's time on the bunny at 64².
-    let e = ((v.to_bits() >> 52) & 0x7ff) as i32 - 1023;
-    let s = pow2(LIMB_BITS - 1 - e);
-    (v * s).round() / s
-}
-
-/// 2^n for n in f64's normal range (here -1016..=133).
-fn pow2(n: i32) -> f64 {
-    f64::from_bits(((n + 1023) as u64) << 52)
+    // On the bit pattern: keep the top LIMB_BITS - 1 stored mantissa bits
+    // (LIMB_BITS significant with the implicit one) after adding half of the
+    // last kept bit to the magnitude, so a carry rounds up into the exponent.
+    // That is `round(v * 2^(7-e)) / 2^(7-e)` with e = floor(log2 |v|), bit
+    // for bit (a test compares them), without the float round trip whose
+    // dependent chain was a seventh of the camera's rasterization at
+    // 1920x1080 on 2 000 000 triangles.
+    const DROPPED: u32 = 52 - (LIMB_BITS as u32 - 1);
+    let b = v.to_bits() + (1u64 << (DROPPED - 1));
+    f64::from_bits(b & !((1u64 << DROPPED) - 1))
 }
 
 /// Three limbs whose sum is `v` to about 24 bits.
@@ -101,18 +100,35 @@ mod tests {
         }
     }
 
+    /// 2^n for n in f64's normal range.
+    fn pow2(n: i32) -> f64 {
+        f64::from_bits(((n + 1023) as u64) << 52)
+    }
+
+    /// The limb rounding gives the bits of the plain formula it replaced,
+    /// `(v * s).round() / s`, over f32's normal range and both signs.
     #[test]
-    fn the_exponent_is_log2s_floor() {
-        // Away from a power of two (where log2 may round up to it) the
-        // exponent field and libm agree; at one, both give the power.
-        let mut x = 1.0e-30f64;
-        while x < 1.0e30 {
-            for v in [x, -x, x * 1.000001, 2f64.powi(x.log2().round() as i32)] {
+    fn limb_rounding_is_the_divided_form() {
+        let mut x = f32::MIN_POSITIVE as f64;
+        while x < 1.0e38 {
+            for v in [x, -x, x * 1.0000001, x * 1.7531, -x * 1.5] {
                 let e = ((v.to_bits() >> 52) & 0x7ff) as i32 - 1023;
-                assert_eq!(e, v.abs().log2().floor() as i32, "{v}");
-                assert_eq!(pow2(7 - e), 2f64.powi(7 - e), "{v}");
+                let s = pow2(LIMB_BITS - 1 - e);
+                assert_eq!(
+                    round_to_limb(v).to_bits(),
+                    ((v * s).round() / s).to_bits(),
+                    "{v}"
+                );
+                // Halves exactly: v with the ninth significant bit alone set
+                // below the kept ones rounds away from zero.
+                let half = f64::from_bits((v.to_bits() & !((1u64 << 45) - 1)) | (1u64 << 44));
+                assert_eq!(
+                    round_to_limb(half).to_bits(),
+                    ((half * s).round() / s).to_bits(),
+                    "{half}"
+                );
             }
-            x *= 1.37;
+            x *= 1.0173;
         }
     }
 

@@ -93,8 +93,8 @@ impl<'g> Prepared<'g> {
         // computed with), so the bands' one output type serves both.
         let none = f32::from_bits(u32::MAX);
         let mut outs = vec![
-            vec![f32::INFINITY; self.grid.len()],
-            vec![none; self.grid.len()],
+            filled(self.grid.len(), f32::INFINITY),
+            filled(self.grid.len(), none),
         ];
         self.bands(&mut outs, |k, rows, o| {
             let id = f32::from_bits(self.faces[k]);
@@ -108,7 +108,7 @@ impl<'g> Prepared<'g> {
         let faces = outs
             .pop()
             .unwrap_or_default()
-            .iter()
+            .par_iter()
             .map(|f| (f.to_bits() != u32::MAX).then_some(f.to_bits()))
             .collect();
         (outs.pop().unwrap_or_default(), faces)
@@ -143,9 +143,9 @@ impl<'g> Prepared<'g> {
 
     /// The nearest depth per texel, and the farthest when asked for.
     pub fn nearest_farthest(&self, want_farthest: bool) -> DepthLayers {
-        let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
+        let mut outs = vec![filled(self.grid.len(), f32::INFINITY)];
         if want_farthest {
-            outs.push(vec![f32::INFINITY; self.grid.len()]);
+            outs.push(filled(self.grid.len(), f32::INFINITY));
         }
         self.bands(&mut outs, |k, rows, o| {
             raster_tri(&self.tris[k], self.grid, rows, |idx, z| {
@@ -169,7 +169,7 @@ impl<'g> Prepared<'g> {
     /// Depth peeling: per texel, the nearest depth strictly beyond `previous`
     /// (by more than PEEL_GAP relative), `inf` where there is none.
     pub fn peel(&self, previous: &[f32]) -> Vec<f32> {
-        let mut outs = vec![vec![f32::INFINITY; self.grid.len()]];
+        let mut outs = vec![filled(self.grid.len(), f32::INFINITY)];
         let band_len = self.rows_per_band * self.grid.width;
         self.bands(&mut outs, |k, rows, o| {
             let base = rows.start / self.rows_per_band * band_len;
@@ -182,6 +182,14 @@ impl<'g> Prepared<'g> {
         });
         outs.pop().unwrap()
     }
+}
+
+/// `vec![value; n]` written by every thread (the pages of a 1920x1080 map
+/// are first touched in parallel, not on one thread).
+fn filled(n: usize, value: f32) -> Vec<f32> {
+    let mut v = Vec::with_capacity(n);
+    v.par_extend(rayon::iter::repeat_n(value, n));
+    v
 }
 
 /// Rasterizes a mesh whose vertices are already in light space into its
