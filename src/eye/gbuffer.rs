@@ -183,6 +183,7 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
     let (w, h) = (camera.width, camera.height);
     let n = w * h;
     assert_eq!(hit.len(), n, "one hit per pixel");
+    let xs: Vec<f64> = (0..w).map(|i| camera.pixel_tangent(i, 0).0).collect();
     // Every pixel of every buffer is written once, by the rows in parallel,
     // into capacity nothing filled first: filling them with the misses'
     // values (or zeroing a reused block) wrote 116 MB on one thread at
@@ -204,8 +205,22 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
         .enumerate()
         .for_each(
             |(j, (((((depth, position), normal), mesh_id), (face, bary)), hit))| {
+                // The pixel's ray as `Camera::pixel_direction` makes it, its
+                // tangents read from the column's and the row's (same bits).
+                let yu = camera.pixel_tangent(0, j).1 * camera.up;
+                let mut last: Option<Face> = None;
                 for (i, tri) in hit.iter().enumerate() {
-                    let s = tri.and_then(|tri| surface(camera, scene, i, j, tri));
+                    let s = tri.and_then(|tri| {
+                        let d = (camera.forward + xs[i] * camera.right + yu).normalize();
+                        // Neighbouring pixels often see the same face: its
+                        // plane is set up once for them.
+                        let f = match last {
+                            Some(f) if f.tri == tri => f,
+                            _ => Face::new(scene, tri),
+                        };
+                        last = Some(f);
+                        surface(camera, &f, d)
+                    });
                     let s = s.unwrap_or(Surface::NONE);
                     depth[i].write(s.depth);
                     position[i].write(s.position);
@@ -260,20 +275,49 @@ impl Surface {
     };
 }
 
-/// The hit of pixel (i, j)'s ray on triangle `tri`'s plane, in f64; `None`
-/// where the ray runs along the plane or meets it behind the eye.
-#[inline]
-fn surface(
-    camera: &Camera,
-    scene: &SceneTriangles,
-    i: usize,
-    j: usize,
+/// A face as the pixels that see it need it.
+#[derive(Clone, Copy)]
+struct Face {
     tri: u32,
-) -> Option<Surface> {
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    /// The plane's normal (b - a) x (c - a), its squared length and its
+    /// direction.
+    nrm: DVec3,
+    nn: f64,
+    unit: DVec3,
+    mesh: i32,
+    /// Its index within its mesh.
+    face: u32,
+}
+
+impl Face {
+    fn new(scene: &SceneTriangles, tri: u32) -> Face {
+        let [a, b, c] = scene.corners[tri as usize];
+        let nrm = (b - a).cross(c - a);
+        let mesh = scene.mesh_of[tri as usize];
+        Face {
+            tri,
+            a,
+            b,
+            c,
+            nrm,
+            nn: nrm.length_squared(),
+            unit: nrm.normalize(),
+            mesh,
+            face: tri - scene.first_face[mesh as usize],
+        }
+    }
+}
+
+/// The hit of the pixel's ray (unit direction `d` from the eye) on face
+/// `f`'s plane, in f64; `None` where the ray runs along the plane or meets
+/// it behind the eye.
+#[inline]
+fn surface(camera: &Camera, f: &Face, d: DVec3) -> Option<Surface> {
     let eye = camera.eye;
-    let d = camera.pixel_direction(i, j);
-    let [a, b, c] = scene.corners[tri as usize];
-    let nrm = (b - a).cross(c - a);
+    let (a, b, c, nrm) = (f.a, f.b, f.c, f.nrm);
     let den = nrm.dot(d);
     // The f32 hit refined in f64 on the triangle's plane.
     let t = nrm.dot(a - eye) / den;
@@ -283,18 +327,15 @@ fn surface(
     // Barycentrics of q = a + b1 (b - a) + b2 (c - a):
     // (q - a) x (c - a) = b1 N and (b - a) x (q - a) = b2 N.
     let q = eye + t * d;
-    let nn = nrm.length_squared();
-    let b1 = nrm.dot((q - a).cross(c - a)) / nn;
-    let b2 = nrm.dot((b - a).cross(q - a)) / nn;
-    let nrm = nrm.normalize();
-    let nrm = if den > 0.0 { -nrm } else { nrm };
-    let mesh = scene.mesh_of[tri as usize];
+    let b1 = nrm.dot((q - a).cross(c - a)) / f.nn;
+    let b2 = nrm.dot((b - a).cross(q - a)) / f.nn;
+    let unit = if den > 0.0 { -f.unit } else { f.unit };
     Some(Surface {
         depth: (t * d.dot(camera.forward)) as f32,
         position: q.to_array(),
-        normal: nrm.as_vec3().to_array(),
-        mesh,
-        face: tri - scene.first_face[mesh as usize],
+        normal: unit.as_vec3().to_array(),
+        mesh: f.mesh,
+        face: f.face,
         bary: [b1 as f32, b2 as f32],
     })
 }

@@ -19,7 +19,7 @@ const GUARD: f64 = 4096.0;
 
 /// A triangle ready to rasterize: snapped pixel coordinates, its 1/Z plane,
 /// counter-clockwise in the sense that its edge functions are >= 0 inside.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SetupTri {
     pub x: [i64; 3],
     pub y: [i64; 3],
@@ -199,23 +199,25 @@ impl Projector {
     /// `None` when there are none.
     #[inline]
     fn texel_box(&self, x: &[i64; 3], y: &[i64; 3]) -> Option<((u32, u32), (u32, u32))> {
-        let span = |lo: i64, hi: i64, n: usize| -> Option<(u32, u32)> {
+        // The span of texel centres within snapped coordinates [lo, hi], as
+        // (first, last), empty when first > last.
+        let span = |lo: i64, hi: i64, n: usize| -> (i64, i64) {
             // Arithmetic shifts: floor division by ONE, a power of two.
             let first = ((lo - ONE / 2 + ONE - 1) >> SUBPIXEL_BITS).max(0);
             let last = ((hi - ONE / 2) >> SUBPIXEL_BITS).min(n as i64 - 1);
-            (first <= last).then_some((first as u32, last as u32))
+            (first, last)
         };
-        let xs = span(
+        let (x0, x1) = span(
             x[0].min(x[1]).min(x[2]),
             x[0].max(x[1]).max(x[2]),
             self.grid.width,
-        )?;
-        let ys = span(
+        );
+        let (y0, y1) = span(
             y[0].min(y[1]).min(y[2]),
             y[0].max(y[1]).max(y[2]),
             self.grid.height,
-        )?;
-        Some((xs, ys))
+        );
+        (x0 <= x1 && y0 <= y1).then_some(((x0 as u32, x1 as u32), (y0 as u32, y1 as u32)))
     }
 
     #[cfg(test)]
@@ -358,6 +360,48 @@ fn concat<T: Copy + Send + Sync>(chunks: &[Vec<T>]) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The parallel setup gives the triangles (and faces) that setting up
+    /// every face one by one gives, in order: fine faces mostly between
+    /// texel centres, large ones, and faces crossing the near plane and
+    /// the guard band.
+    #[test]
+    fn the_chunked_setup_is_the_setup_of_each_face() {
+        let mut seed = 5u64;
+        let mut r = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let grid = MapGrid::new(64, 48, [1.0, 0.75]).unwrap();
+        let mut verts = Vec::new();
+        let mut faces = Vec::new();
+        for k in 0..30_000u32 {
+            let size = [0.002, 0.02, 0.5][k as usize % 3];
+            let c = DVec3::new(4.0 * r() - 2.0, 3.0 * r() - 1.5, 2.0 * r() - 0.05);
+            for _ in 0..3 {
+                verts.push(c + size * DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5));
+            }
+            faces.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        let near = 1e-3;
+        let (tris, ids) = setup_triangles_with_faces(&grid, &verts, &faces, near);
+        let proj = Projector::new(&grid, near);
+        let (mut each, mut each_ids) = (Vec::new(), Vec::new());
+        for (k, f) in faces.iter().enumerate() {
+            proj.setup(
+                f.map(|i| proj.snap_packed(verts[i as usize])),
+                || f.map(|i| verts[i as usize]),
+                &mut each,
+            );
+            each_ids.resize(each.len(), k as u32);
+        }
+        assert!(tris.len() > 2000 && tris.len() < 25_000, "{}", tris.len());
+        assert_eq!(tris, each);
+        assert_eq!(ids, each_ids);
+        assert_eq!(setup_triangles(&grid, &verts, &faces, near), each);
+    }
 
     #[test]
     fn concat_keeps_every_chunk_in_order() {
