@@ -80,6 +80,8 @@ from softshadow.scenes.as_built import _camera, crowd, rect_light, slab
 from softshadow.scenes.primitives import torus
 
 README = ROOT / "README.md"
+# Seconds each timed region waits for the other renderer's threads to idle.
+SETTLE_S = 0.05
 START, END = "<!-- scale-table:start -->", "<!-- scale-table:end -->"
 
 Mesh = tuple[np.ndarray, np.ndarray]
@@ -253,6 +255,17 @@ def lit_pixels(img: Any, light: Any) -> int:
     return int(((p - np.asarray(light.center)) @ np.asarray(light.n) > 0).sum())
 
 
+def settle() -> None:
+    """Lets the other renderer's worker threads go idle before a timed region.
+
+    Dr.Jit's workers keep the cores busy for a while after a Mitsuba job
+    ends (and rayon's briefly after ours): without a pause, softshadow's
+    64-sample first hits, timed right after Mitsuba's 16-sample job, read
+    17-30 ms where alone they take 9 (mesh_125k).
+    """
+    time.sleep(SETTLE_S)
+
+
 def median_ms(xs: list[float]) -> float:
     return float(np.median(xs)) * 1e3
 
@@ -332,17 +345,22 @@ def main() -> None:
         for round_ in range(args.repeats + 1):  # round 0: the warm-up
             for label, method in methods.items():
                 for kind, s in (("first", ss.Scene(meshes=scene.meshes)), ("following", scene)):
+                    settle()
                     t = time.perf_counter()
                     ss.render(s, light, cam, method=method)
                     if round_ > 0:
                         calls.setdefault(label, {}).setdefault(kind, []).append(time.perf_counter() - t)
             for n in args.samples:
                 tm = times[n]
+                settle()
                 t = time.perf_counter()
                 img = ss.render(scene, light, cam, method=ss.Exact(samples=n))
                 wall = time.perf_counter() - t
+                settle()
                 mh = kernels.first_hits()
+                settle()
                 ms = kernels.shadow(n)
+                settle()
                 t = time.perf_counter()
                 vis = job.run(n)
                 job_s = time.perf_counter() - t
@@ -473,7 +491,8 @@ def main() -> None:
         return
     intro = (
         f"Times are medians of {runs(args.repeats)} after a warm-up round, softshadow and Mitsuba "
-        "alternating within each round. softshadow: the stages of `img.timings` of "
+        f"alternating within each round, each timed region after a {SETTLE_S * 1e3:.0f} ms pause (the other "
+        "renderer's worker threads stay busy for a while after its job). softshadow: the stages of `img.timings` of "
         "`ss.render(..., method=ss.Exact(samples=n))` on a prepared scene (`first hits` rasterizes the "
         "camera's view; `refit` fits the BVH kept from an earlier call to this call's light space, where a "
         "first call's `bvh` builds it; `shadow` traces the rays). "
