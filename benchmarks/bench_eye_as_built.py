@@ -26,7 +26,7 @@ from pathlib import Path
 from _report import DOCS, ROOT, Report, add_output_arguments, command_line, runs
 
 from softshadow import PCF, PCSS, Bitmask, Exact, ShadowMapping, SlopeScaleBias, Smoothies
-from softshadow.experiments.eye_plane import eye_plane, markdown_eye_plane
+from softshadow.experiments.eye_plane import SETTLE_S, eye_plane, markdown_eye_plane
 from softshadow.reference.cache import cached_reference_image
 from softshadow.scenes.as_built import CALIBRATION, HELD_OUT, SCENES
 
@@ -125,7 +125,8 @@ def main() -> None:
         return
     intro = (
         f"Times are medians of {runs(args.repeats)} after a warm-up round (calls and Mitsuba's jobs "
-        "interleaved, the order reversed every other round). Errors over the pixels the "
+        "interleaved, the order reversed every other round, each after a pause of "
+        f"{SETTLE_S * 1e3:.0f} ms for the other renderer's threads to go idle). Errors over the pixels the "
         f"{args.reference_samples}-sample reference shadows (`bench_scenes.py`'s, cached). Mitsuba's time "
         "at equal error is interpolated log-log between its sample counts; † where one sample a pixel "
         "already reaches that error, * where it extrapolates beyond its most samples. The bar "

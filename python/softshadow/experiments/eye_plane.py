@@ -16,8 +16,10 @@ where both renderers see the same mesh at the same place
 keep the mean over all those pixels, lit ones included, beside it).
 Each round times every call and every Mitsuba sample count once, in an
 order reversed every other round, so both sides of a ratio see the same
-load and neither always runs in the other's wake (Dr.Jit's and rayon's
-worker threads wind down after a call). Used by ``benchmarks/bench_eye.py``
+load, and each after a pause of :data:`SETTLE_S` so that neither runs in
+the other's wake (Dr.Jit's and rayon's worker threads wind down after a
+call: without the pause, softshadow's stages timed right after a Mitsuba
+job read up to twice their time, ``benchmarks/bench_scale.py``). Used by ``benchmarks/bench_eye.py``
 (tables, the README's eye table) and the study (plots).
 """
 
@@ -140,7 +142,12 @@ def describe(img: Any) -> str:
     return ", ".join(parts)
 
 
+SETTLE_S = 0.05
+"""Seconds each timed call waits first for the other renderer's threads."""
+
+
 def _timed(fn: Any) -> tuple[float, Any]:
+    time.sleep(SETTLE_S)
     t = time.perf_counter()
     out = fn()
     return time.perf_counter() - t, out
