@@ -72,14 +72,23 @@ impl Topology {
                 (v, edge_words(&v))
             })
             .unzip();
-        let mut nodes = t.nodes.clone();
-        // Leaves in parallel, then inner nodes from the last to the first:
-        // every build numbers a node's children after it (`subtree`,
-        // `serial_subtree`), so both are final when their parent is read.
-        nodes.par_iter_mut().filter(|n| n.count > 0).for_each(|n| {
-            let s = n.start as usize;
-            (n.min, n.max) = bounds(moved[s..s + n.count as usize].iter());
-        });
+        // Leaves in parallel (copied and fitted in one pass: a clone first
+        // was a serial copy of 40 MB on 2 000 000 triangles), then inner
+        // nodes from the last to the first: every build numbers a node's
+        // children after it (`subtree`, `serial_subtree`), so both are
+        // final when their parent is read.
+        let mut nodes: Vec<_> = t
+            .nodes
+            .par_iter()
+            .map(|&n| {
+                let mut n = n;
+                if n.count > 0 {
+                    let s = n.start as usize;
+                    (n.min, n.max) = bounds(moved[s..s + n.count as usize].iter());
+                }
+                n
+            })
+            .collect();
         if !moved.is_empty() {
             for k in (0..nodes.len()).rev() {
                 let n = nodes[k];
@@ -91,9 +100,15 @@ impl Topology {
                 }
             }
         }
-        let mut wide = t.wide.clone();
-        wide.par_iter_mut()
-            .for_each(|w| refit_slots(w, &nodes, &t.wide_source));
+        let wide = t
+            .wide
+            .par_iter()
+            .map(|&w| {
+                let mut w = w;
+                refit_slots(&mut w, &nodes, &t.wide_source);
+                w
+            })
+            .collect();
         Some(Bvh {
             nodes,
             edges,
