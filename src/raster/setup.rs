@@ -158,21 +158,18 @@ impl Projector {
         out: &mut Vec<SetupTri>,
     ) {
         if packed.iter().all(|p| p.x != OUTSIDE) {
-            // Most faces of a fine mesh end here: a cheap box test before
-            // anything is loaded or converted (2 000 000 faces, 640x480).
-            let x = packed.map(|p| p.x as i64);
-            let y = packed.map(|p| p.y as i64);
-            if self.texel_box(&x, &y).is_some() {
-                self.push_snapped(
-                    [0, 1, 2].map(|k| Snapped {
-                        x: x[k],
-                        y: y[k],
-                        w: packed[k].w,
-                        inside: true,
-                    }),
-                    out,
-                );
-            }
+            // Most faces of a fine mesh end in `push_snapped`'s first test
+            // (their box holds no texel centre), before their corners are
+            // read (2 000 000 faces at 640x480).
+            self.push_snapped(
+                packed.map(|p| Snapped {
+                    x: p.x as i64,
+                    y: p.y as i64,
+                    w: p.w,
+                    inside: true,
+                }),
+                out,
+            );
             return;
         }
         self.clip_and_push(tri(), out);
@@ -239,6 +236,11 @@ impl Projector {
         let mut x = [v[0].x, v[1].x, v[2].x];
         let mut y = [v[0].y, v[1].y, v[2].y];
         let mut w = [v[0].w, v[1].w, v[2].w];
+        // The box first (the cheapest test, and the one most faces of a
+        // fine mesh fail); it does not depend on the corners' order.
+        let Some(((i0, i1), (j0, j1))) = self.texel_box(&x, &y) else {
+            return;
+        };
         let mut area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
         if area == 0 {
             return;
@@ -249,9 +251,6 @@ impl Projector {
             w.swap(1, 2);
             area = -area;
         }
-        let Some(((i0, i1), (j0, j1))) = self.texel_box(&x, &y) else {
-            return;
-        };
         // 1/Z at the center of texel (i0, j0) from the exact edge functions
         // there (barycentric, well conditioned), and its gradient per texel.
         let (cx, cy) = (i0 as i64 * ONE + ONE / 2, j0 as i64 * ONE + ONE / 2);
