@@ -4,8 +4,8 @@
 // light into `seen` (a gather: each invocation owns its receiver's count);
 // then a resolve divides by the sample count. The jitter is
 // shadow_rays.rs's multi-jittered pattern, one every texel shares (its u64
-// hash emulated with u32 pairs); the ray-triangle test is its Möller-Trumbore
-// written in the same order of operations (explicit cross and dot products).
+// hash emulated with u32 pairs); the ray-triangle test is its watertight
+// one (bvh.rs's hit_t) written in the same order of operations.
 
 // Shared with Rust (`ExactParams` in exact.rs; a test compares layouts).
 struct ExactParams {
@@ -134,42 +134,74 @@ fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
-// bvh.rs's hit_t: Möller-Trumbore, where the line o + t d crosses
-// triangle t (edges included): ok = false when it does not.
+// bvh.rs's Shear: the ray's largest axis kz (the first of equals), the
+// next two kx, ky, and the shear taking d to kz.
+struct Shear {
+    k: vec3<u32>,
+    s: vec3<f32>,
+}
+
+fn shear_of(d: vec3<f32>) -> Shear {
+    let a = abs(d);
+    var kz = 2u;
+    if a.x >= a.y && a.x >= a.z {
+        kz = 0u;
+    } else if a.y >= a.z {
+        kz = 1u;
+    }
+    let kx = (kz + 1u) % 3u;
+    let ky = (kz + 2u) % 3u;
+    return Shear(vec3<u32>(kx, ky, kz), vec3<f32>(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]));
+}
+
+// bvh.rs's hit_t: the watertight test (Woop, Benthin & Wald 2013), where
+// the line o + t d crosses triangle t (edges included): ok = false when it
+// does not. The same operations in the same order.
 struct Crossing {
     ok: bool,
     t: f32,
 }
 
-fn hit_t(t: u32, o: vec3<f32>, d: vec3<f32>) -> Crossing {
+fn hit_t(t: u32, o: vec3<f32>, sh: Shear) -> Crossing {
     let none = Crossing(false, 0.0);
-    let v0 = vertex(t, 0u);
-    let e1 = vertex(t, 1u) - v0;
-    let e2 = vertex(t, 2u) - v0;
-    let p = cross3(d, e2);
-    let det = dot3(e1, p);
+    let kx = sh.k.x;
+    let ky = sh.k.y;
+    let kz = sh.k.z;
+    let ra = vertex(t, 0u) - o;
+    let rb = vertex(t, 1u) - o;
+    let rc = vertex(t, 2u) - o;
+    let ax = ra[kx] - sh.s.x * ra[kz];
+    let ay = ra[ky] - sh.s.y * ra[kz];
+    let bx = rb[kx] - sh.s.x * rb[kz];
+    let by = rb[ky] - sh.s.y * rb[kz];
+    let cx = rc[kx] - sh.s.x * rc[kz];
+    let cy = rc[ky] - sh.s.y * rc[kz];
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    let neg = u < 0.0 || v < 0.0 || w < 0.0;
+    let pos = u > 0.0 || v > 0.0 || w > 0.0;
+    if neg && pos {
+        return none;
+    }
+    let det = u + v + w;
     if det == 0.0 || !(abs(det) < bitcast<f32>(0x7f800000u)) {
         return none;
     }
-    let inv = 1.0 / det;
-    let s = o - v0;
-    let u = dot3(s, p) * inv;
-    if !(u >= 0.0 && u <= 1.0) {
-        return none;
-    }
-    let q = cross3(s, e1);
-    let v = dot3(d, q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return none;
-    }
-    return Crossing(true, dot3(e2, q) * inv);
+    let az = sh.s.z * ra[kz];
+    let bz = sh.s.z * rb[kz];
+    let cz = sh.s.z * rc[kz];
+    return Crossing(true, (u * az + v * bz + w * cz) / det);
 }
 
 // bvh.rs's hits: any crossing with t in (t0, t1).
-fn hits(t: u32, o: vec3<f32>, d: vec3<f32>) -> bool {
-    let c = hit_t(t, o, d);
+fn hits(t: u32, o: vec3<f32>, sh: Shear) -> bool {
+    let c = hit_t(t, o, sh);
     return c.ok && c.t > ep.t0 && c.t < ep.t1;
 }
+
+// bvh.rs's EXIT_SLACK: a box's exit t widened by it (1 + 4 ulps).
+const EXIT_SLACK: f32 = 1.000000476837158203125;
 
 // f32::min / f32::max: the non-NaN operand wins.
 fn fmin(a: f32, b: f32) -> f32 {
@@ -198,6 +230,7 @@ var<private> iterations: u32 = 0u;
 // bvh.rs's Bvh::occluded (the one-ray reference): whether o + t d, t in (t0, t1), hits a triangle.
 fn occluded(o: vec3<f32>, d: vec3<f32>) -> bool {
     let inv = vec3<f32>(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    let sh = shear_of(d);
     var stack: array<u32, 64>;
     var sp = 1u;
     stack[0] = 0u;
@@ -214,14 +247,14 @@ fn occluded(o: vec3<f32>, d: vec3<f32>) -> bool {
         let mn = vec3<f32>(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z));
         let mx = vec3<f32>(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z));
         let tmin = fmax(fmax(mn.x, fmax(mn.y, mn.z)), ep.t0);
-        let tmax = fmin(fmin(mx.x, fmin(mx.y, mx.z)), ep.t1);
+        let tmax = fmin(fmin(mx.x, fmin(mx.y, mx.z)) * EXIT_SLACK, ep.t1);
         if tmin > tmax {
             continue;
         }
         if n.count > 0u {
             iterations += n.count;
             for (var k = 0u; k < n.count; k++) {
-                if hits(n.start + k, o, d) {
+                if hits(n.start + k, o, sh) {
                     return true;
                 }
             }

@@ -63,7 +63,7 @@ use rayon::prelude::*;
 use std::sync::OnceLock;
 
 /// The first-hit module: the 64-bit helpers, the light's sampling (which
-/// exact.wgsl's ray caster calls), exact.wgsl (BVH access, Möller-Trumbore),
+/// exact.wgsl's ray caster calls), exact.wgsl (BVH access, the watertight test),
 /// then eye_hits.wgsl.
 pub const HITS_SOURCE: &str = concat!(
     include_str!("u64.wgsl"),

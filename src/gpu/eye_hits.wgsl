@@ -6,7 +6,7 @@
 // here operation for operation: the same slab test (glam 0.34's Vec3
 // min/max and min/max_element, which pick the second operand unless the
 // first compares strictly smaller/larger, then f32::max(0) and
-// f32::min(best), which ignore a NaN), the same Möller-Trumbore (exact.wgsl's
+// f32::min(best), which ignore a NaN), the same watertight test (exact.wgsl's
 // hit_t) and the same visiting order (children nearer first), so ties go the
 // same way. The CPU maps the slot to the input triangle (Bvh::order) and
 // builds the G-buffer from it (gbuffer::from_hits, f64).
@@ -51,7 +51,7 @@ fn entry_t(k: u32, o: vec3<f32>, inv: vec3<f32>, best: f32) -> f32 {
     let mn = vec3<f32>(sel_min(a.x, b.x), sel_min(a.y, b.y), sel_min(a.z, b.z));
     let mx = vec3<f32>(sel_max(a.x, b.x), sel_max(a.y, b.y), sel_max(a.z, b.z));
     let tmin = fmax(sel_max(sel_max(mn.x, mn.y), mn.z), 0.0);
-    let tmax = fmin(sel_min(sel_min(mx.x, mx.y), mx.z), best);
+    let tmax = fmin(sel_min(sel_min(mx.x, mx.y), mx.z) * EXIT_SLACK, best);
     if tmin <= tmax {
         return tmin;
     }
@@ -68,6 +68,7 @@ fn eye_hits(@builtin(global_invocation_id) gid: vec3<u32>,
     let o = vec3<f32>(0.0, 0.0, 0.0);
     let d = vec3<f32>(dirs[3u * idx], dirs[3u * idx + 1u], dirs[3u * idx + 2u]);
     let inv = vec3<f32>(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    let sh = shear_of(d);
     var best = bitcast<f32>(0x7f800000u);
     var hit = NO_HIT;
     var stack: array<u32, 64>;
@@ -90,7 +91,7 @@ fn eye_hits(@builtin(global_invocation_id) gid: vec3<u32>,
         if n.count > 0u {
             steps += n.count;
             for (var i = 0u; i < n.count; i++) {
-                let c = hit_t(n.start + i, o, d);
+                let c = hit_t(n.start + i, o, sh);
                 if c.ok && c.t > 0.0 && c.t < best {
                     best = c.t;
                     hit = n.start + i;

@@ -4,7 +4,7 @@
 //! The segment from the origin o to the light point s = (x, y, 0) is
 //! o + t d, d = s - o, and `exact` counts s hidden when it crosses the
 //! triangle (v0, v1, v2), edges included, at t in (t0, t1)
-//! (Möller-Trumbore, `bvh::hits`). With a_i = v_i - o and the triple
+//! (the watertight test, `bvh::hit_t`). With a_i = v_i - o and the triple
 //! product T = a0 · (a1 x a2):
 //!
 //! * d passes through the triangle at some t > 0 iff it lies in the cone
@@ -24,11 +24,11 @@
 //! rays start above or below the surface (`eye::rays::RayStart`).
 //!
 //! The half-planes' coefficients are computed in f64 from the f32 corners
-//! and evaluated in f32; Möller-Trumbore decides in f32 from other
+//! and evaluated in f32; the rays' test decides in f32 from other
 //! products, so the two can differ on a sample within rounding of an edge
 //! or of the triangle's plane: a ray that grazes (the masks' tests measure
 //! how rarely, `tests.rs`). A degenerate triangle (T = 0: no area, or o in
-//! its plane) hides nothing, as Möller-Trumbore's zero determinant does.
+//! its plane) hides nothing, as the rays' zero determinant does.
 
 use super::cells::{Cells, LANE};
 use glam::{DVec3, Vec3};
@@ -231,7 +231,7 @@ pub(crate) fn shadow_box(tri: &[Vec3; 3], o: Vec3) -> Option<Option<[[f32; 2]; 2
 /// Whether the origin `o` and the whole light `rect` (z = 0) lie on one
 /// side of `tri`'s plane, each farther from it than rounding reaches: then
 /// no segment between them meets the plane, and the triangle hides
-/// nothing (Möller-Trumbore's t lies outside (0, 1) by more than its
+/// nothing (the rays' t lies outside (0, 1) by more than its
 /// error). f64, from the f32 corners.
 #[inline]
 pub(crate) fn beside(tri: &[Vec3; 3], o: Vec3, rect: [[f32; 2]; 2]) -> bool {

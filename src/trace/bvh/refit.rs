@@ -17,15 +17,14 @@
 //! focused on other points: close), the closer the tree stays to a fresh
 //! SAH build.
 
-use super::{bounds, edge_words, Bvh};
+use super::{bounds, Bvh};
 use crate::trace::bvh_wide::refit_slots;
 use glam::Vec3;
 use rayon::prelude::*;
 
 /// A tree's shape without its coordinates (its nodes' boxes are those it
 /// was built with, and never read): what a refit reads, kept between calls
-/// without the triangles and their edges (72 of the tree's 160-odd bytes a
-/// triangle).
+/// without the triangles (36 of the tree's 120-odd bytes a triangle).
 pub struct Topology(Bvh);
 
 impl Bvh {
@@ -33,7 +32,6 @@ impl Bvh {
     pub fn into_topology(self) -> Topology {
         Topology(Bvh {
             tris: vec![],
-            edges: vec![],
             ..self
         })
     }
@@ -44,7 +42,6 @@ impl Bvh {
             nodes: self.nodes.clone(),
             tris: vec![],
             order: self.order.clone(),
-            edges: vec![],
             wide: self.wide.clone(),
             wide_parent: self.wide_parent.clone(),
             wide_source: self.wide_source.clone(),
@@ -62,16 +59,8 @@ impl Topology {
         if tris.len() != t.order.len() {
             return None;
         }
-        // The triangles in the tree's order and their edges in one pass
-        // (two took 45 of the refit's 110 ms on 2 000 000 triangles).
-        let (moved, edges): (Vec<[Vec3; 3]>, Vec<[f32; 9]>) = t
-            .order
-            .par_iter()
-            .map(|&i| {
-                let v = tris[i as usize];
-                (v, edge_words(&v))
-            })
-            .unzip();
+        // The triangles in the tree's order.
+        let moved: Vec<[Vec3; 3]> = t.order.par_iter().map(|&i| tris[i as usize]).collect();
         // Leaves in parallel (copied and fitted in one pass: a clone first
         // was a serial copy of 40 MB on 2 000 000 triangles), then inner
         // nodes from the last to the first: every build numbers a node's
@@ -111,7 +100,6 @@ impl Topology {
             .collect();
         Some(Bvh {
             nodes,
-            edges,
             tris: moved,
             order: t.order.clone(),
             wide,
