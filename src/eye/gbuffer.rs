@@ -216,7 +216,7 @@ pub fn from_hits(camera: &Camera, scene: &SceneTriangles, hit: &[Option<u32>]) -
                         // plane is set up once for them.
                         let f = match last {
                             Some(f) if f.tri == tri => f,
-                            _ => Face::new(scene, tri),
+                            _ => Face::new(scene, tri, camera.eye),
                         };
                         last = Some(f);
                         surface(camera, &f, d)
@@ -275,36 +275,42 @@ impl Surface {
     };
 }
 
-/// A face as the pixels that see it need it.
+/// A face as the pixels that see it need it: what `surface` computes of
+/// it alone, computed once (the same operations, so the same bits).
 #[derive(Clone, Copy)]
 struct Face {
     tri: u32,
     a: DVec3,
-    b: DVec3,
-    c: DVec3,
+    /// b - a and c - a.
+    ba: DVec3,
+    ca: DVec3,
     /// The plane's normal (b - a) x (c - a), its squared length and its
     /// direction.
     nrm: DVec3,
     nn: f64,
     unit: DVec3,
+    /// nrm . (a - eye): the eye's distance to the plane, times |nrm|.
+    plane: f64,
     mesh: i32,
     /// Its index within its mesh.
     face: u32,
 }
 
 impl Face {
-    fn new(scene: &SceneTriangles, tri: u32) -> Face {
+    fn new(scene: &SceneTriangles, tri: u32, eye: DVec3) -> Face {
         let [a, b, c] = scene.corners[tri as usize];
-        let nrm = (b - a).cross(c - a);
+        let (ba, ca) = (b - a, c - a);
+        let nrm = ba.cross(ca);
         let mesh = scene.mesh_of[tri as usize];
         Face {
             tri,
             a,
-            b,
-            c,
+            ba,
+            ca,
             nrm,
             nn: nrm.length_squared(),
             unit: nrm.normalize(),
+            plane: nrm.dot(a - eye),
             mesh,
             face: tri - scene.first_face[mesh as usize],
         }
@@ -317,18 +323,18 @@ impl Face {
 #[inline]
 fn surface(camera: &Camera, f: &Face, d: DVec3) -> Option<Surface> {
     let eye = camera.eye;
-    let (a, b, c, nrm) = (f.a, f.b, f.c, f.nrm);
+    let (a, nrm) = (f.a, f.nrm);
     let den = nrm.dot(d);
     // The f32 hit refined in f64 on the triangle's plane.
-    let t = nrm.dot(a - eye) / den;
+    let t = f.plane / den;
     if !(t.is_finite() && t > 0.0) {
         return None;
     }
     // Barycentrics of q = a + b1 (b - a) + b2 (c - a):
     // (q - a) x (c - a) = b1 N and (b - a) x (q - a) = b2 N.
     let q = eye + t * d;
-    let b1 = nrm.dot((q - a).cross(c - a)) / f.nn;
-    let b2 = nrm.dot((b - a).cross(q - a)) / f.nn;
+    let b1 = nrm.dot((q - a).cross(f.ca)) / f.nn;
+    let b2 = nrm.dot(f.ba.cross(q - a)) / f.nn;
     let unit = if den > 0.0 { -f.unit } else { f.unit };
     Some(Surface {
         depth: (t * d.dot(camera.forward)) as f32,

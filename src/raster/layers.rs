@@ -55,26 +55,9 @@ impl<'g> Prepared<'g> {
     }
 
     fn binned(grid: &'g MapGrid, tris: Vec<SetupTri>, faces: Vec<u32>) -> Prepared<'g> {
-        // Bin triangle indices by band (counting sort).
         let rows_per_band = band_rows(grid.height);
         let n_bands = grid.height.div_ceil(rows_per_band);
-        let mut counts = vec![0u32; n_bands + 1];
-        for t in &tris {
-            for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
-                counts[b + 1] += 1;
-            }
-        }
-        for b in 0..n_bands {
-            counts[b + 1] += counts[b];
-        }
-        let mut fill = counts.clone();
-        let mut binned = vec![0u32; counts[n_bands] as usize];
-        for (k, t) in tris.iter().enumerate() {
-            for b in t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band {
-                binned[fill[b] as usize] = k as u32;
-                fill[b] += 1;
-            }
-        }
+        let (binned, counts) = bin_by_band(&tris, rows_per_band, n_bands);
         Prepared {
             grid,
             tris,
@@ -202,4 +185,98 @@ pub fn rasterize(
     want_farthest: bool,
 ) -> DepthLayers {
     Prepared::new(grid, verts, faces, near).nearest_farthest(want_farthest)
+}
+
+/// Triangles binned per chunk before they are joined: the chunk's size.
+const BIN_CHUNK: usize = 8192;
+
+/// The triangles' indices by band of `rows_per_band` rows (a triangle in
+/// every band its rows [j0, j1] touch), each band's in triangle order, and
+/// where each band starts: band b is `binned[counts[b]..counts[b + 1]]`.
+/// Chunks of triangles are binned in parallel, then each band joins its
+/// chunks' lists in chunk order: the lists the counting sort on one thread
+/// made before (which took 0.7 of 7.3 ms of the camera's first hits on a
+/// sphere of 125 000 triangles at 640x480).
+fn bin_by_band(tris: &[SetupTri], rows_per_band: usize, n_bands: usize) -> (Vec<u32>, Vec<u32>) {
+    let bands = |t: &SetupTri| t.j0 as usize / rows_per_band..=t.j1 as usize / rows_per_band;
+    let lists: Vec<Vec<Vec<u32>>> = tris
+        .par_chunks(BIN_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut per_band = vec![Vec::new(); n_bands];
+            for (k, t) in chunk.iter().enumerate() {
+                for b in bands(t) {
+                    per_band[b].push((c * BIN_CHUNK + k) as u32);
+                }
+            }
+            per_band
+        })
+        .collect();
+    let mut counts = vec![0u32; n_bands + 1];
+    for b in 0..n_bands {
+        let n: usize = lists.iter().map(|l| l[b].len()).sum();
+        counts[b + 1] = counts[b] + n as u32;
+    }
+    let mut binned = vec![0u32; counts[n_bands] as usize];
+    let mut slices = Vec::with_capacity(n_bands);
+    let mut rest = binned.as_mut_slice();
+    for b in 0..n_bands {
+        let (band, tail) = rest.split_at_mut((counts[b + 1] - counts[b]) as usize);
+        slices.push(band);
+        rest = tail;
+    }
+    slices.into_par_iter().enumerate().for_each(|(b, out)| {
+        let mut at = 0;
+        for l in &lists {
+            out[at..at + l[b].len()].copy_from_slice(&l[b]);
+            at += l[b].len();
+        }
+    });
+    (binned, counts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::raster::depth_plane::DepthPlane;
+
+    #[test]
+    fn bands_list_their_triangles_in_order_as_one_thread_bins_them() {
+        // More triangles than a chunk, rows spread over every band.
+        let tris: Vec<SetupTri> = (0..3 * BIN_CHUNK + 17)
+            .map(|k| {
+                let j0 = (k * 7919 % 480) as u32;
+                let j1 = (j0 + (k % 5) as u32 * 37).min(479);
+                SetupTri {
+                    x: [0; 3],
+                    y: [0; 3],
+                    depth: DepthPlane {
+                        w_ref: 1.0,
+                        gx: [0.0; 3],
+                        gy: [0.0; 3],
+                    },
+                    i0: 0,
+                    i1: 0,
+                    j0,
+                    j1,
+                }
+            })
+            .collect();
+        let (rows, n_bands) = (30, 16);
+        let (binned, counts) = bin_by_band(&tris, rows, n_bands);
+        for b in 0..n_bands {
+            let want: Vec<u32> = (0..tris.len() as u32)
+                .filter(|&k| {
+                    let t = &tris[k as usize];
+                    (t.j0 as usize / rows..=t.j1 as usize / rows).contains(&b)
+                })
+                .collect();
+            assert!(!want.is_empty());
+            assert_eq!(
+                &binned[counts[b] as usize..counts[b + 1] as usize],
+                &want[..]
+            );
+        }
+        assert_eq!(counts[n_bands] as usize, binned.len());
+    }
 }
