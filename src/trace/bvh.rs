@@ -703,8 +703,9 @@ impl Shear {
 /// three sides agree in sign, either sign.
 ///
 /// Möller-Trumbore (the test before) decided each edge from its triangle's
-/// own first corner and edge vectors: on a jittered grid, 1 ray in 100
-/// aimed at shared corners, and 1 in 2 300 at shared edges, found neither
+/// own first corner and edge vectors: on a jittered grid, 363 of 9 449
+/// rays aimed at shared corners (1 in 26), and 13 of 30 000 at shared
+/// edges (1 in 2 300), found neither
 /// triangle (the test `no_ray_slips_between_triangles_that_share_an_edge`).
 ///
 /// Every operation is one f32 operation in the order written, which the
