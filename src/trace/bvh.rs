@@ -697,9 +697,11 @@ impl Shear {
 /// the same two values (negated, exactly, where it lists them the other
 /// way round). So a line through a shared edge lies on one side for both
 /// triangles, or on the edge for both (a hit for both, edges counting),
-/// and no rounding lets it slip between them; a line through a shared
-/// corner sees that corner at one point near the origin, whose sides of
-/// the corner's edges are rounded consistently. Faces are not culled: the
+/// and no rounding lets it slip between them. A line through a shared
+/// corner sees the corner at one point near the origin, and each edge
+/// around it is again one number that both its triangles share (no such
+/// ray slipped in the test below; the paper argues the corner case in
+/// full). Faces are not culled: the
 /// three sides agree in sign, either sign.
 ///
 /// Möller-Trumbore (the test before) decided each edge from its triangle's
